@@ -1,0 +1,143 @@
+#include "engine/buffer.h"
+
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "engine/context.h"
+#include "engine/vk_check.h"
+
+namespace litgs::engine {
+namespace {
+
+std::string mib(uint64_t bytes) {
+  std::ostringstream s;
+  s.precision(4);
+  s << static_cast<double>(bytes) / (1024.0 * 1024.0) << " MiB (" << bytes << " bytes)";
+  return s.str();
+}
+
+void check_limit(const std::string& name, uint64_t size, uint64_t limit, const char* limit_name,
+                 const Context& ctx) {
+  if (limit != 0 && size > limit)
+    throw std::length_error("buffer '" + name + "' needs " + mib(size) + ", over the device's " + limit_name +
+                            " of " + mib(limit) + " on " + ctx.info().name +
+                            "; split it (structure of arrays) or use fewer elements");
+}
+
+}  // namespace
+
+Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKind kind)
+    : context_(&context), name_(std::move(name)), size_bytes_(size_bytes) {
+  const DeviceInfo& info = context.info();
+  check_limit(name_, size_bytes, info.max_storage_buffer_range, "maxStorageBufferRange", context);
+  check_limit(name_, size_bytes, info.max_memory_allocation_size, "maxMemoryAllocationSize", context);
+
+  // Vulkan forbids empty buffers; an empty array still gets a valid handle to bind.
+  const VkDeviceSize alloc_size = size_bytes == 0 ? 16 : (size_bytes + 3) & ~VkDeviceSize{3};
+  VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bci.size = alloc_size;
+  bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+              VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+  bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VkDevice dev = context.device();
+  LITGS_VK_CHECK(vkCreateBuffer(dev, &bci, nullptr, &buffer_));
+
+  try {
+    VkMemoryRequirements req{};
+    vkGetBufferMemoryRequirements(dev, buffer_, &req);
+    const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    // Device-local memory that is also host-visible (CPU drivers, resizable BAR) is mapped: no staging.
+    const uint32_t type = kind == MemoryKind::kDeviceLocal
+                              ? context.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, host)
+                              : context.find_memory_type(req.memoryTypeBits, host, VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+    VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    ai.allocationSize = req.size;
+    ai.memoryTypeIndex = type;
+    const VkResult r = vkAllocateMemory(dev, &ai, nullptr, &memory_);
+    if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY)
+      throw std::length_error("out of memory allocating buffer '" + name_ + "' of " + mib(req.size) + " on " +
+                              context.info().name);
+    LITGS_VK_CHECK(r);
+    LITGS_VK_CHECK(vkBindBufferMemory(dev, buffer_, memory_, 0));
+    if ((context.memory_type_flags(type) & host) == host)
+      LITGS_VK_CHECK(vkMapMemory(dev, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
+  } catch (...) {
+    release();
+    throw;
+  }
+}
+
+Buffer::~Buffer() { release(); }
+
+Buffer::Buffer(Buffer&& other) noexcept
+    : context_(other.context_),
+      name_(std::move(other.name_)),
+      size_bytes_(other.size_bytes_),
+      buffer_(std::exchange(other.buffer_, VK_NULL_HANDLE)),
+      memory_(std::exchange(other.memory_, VK_NULL_HANDLE)),
+      mapped_(std::exchange(other.mapped_, nullptr)) {}
+
+Buffer& Buffer::operator=(Buffer&& other) noexcept {
+  if (this != &other) {
+    release();
+    context_ = other.context_;
+    name_ = std::move(other.name_);
+    size_bytes_ = other.size_bytes_;
+    buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
+    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    mapped_ = std::exchange(other.mapped_, nullptr);
+  }
+  return *this;
+}
+
+void Buffer::release() {
+  if (!context_) return;
+  VkDevice dev = context_->device();
+  if (mapped_) vkUnmapMemory(dev, memory_);
+  if (buffer_) vkDestroyBuffer(dev, buffer_, nullptr);
+  if (memory_) vkFreeMemory(dev, memory_, nullptr);
+  mapped_ = nullptr;
+  buffer_ = VK_NULL_HANDLE;
+  memory_ = VK_NULL_HANDLE;
+}
+
+void Buffer::check_range(uint64_t bytes, uint64_t offset, const char* what) const {
+  if (offset > size_bytes_ || bytes > size_bytes_ - offset)
+    throw std::out_of_range(std::string(what) + " of " + std::to_string(bytes) + " bytes at offset " +
+                            std::to_string(offset) + " is outside buffer '" + name_ + "' of " +
+                            std::to_string(size_bytes_) + " bytes");
+}
+
+void Buffer::upload(const void* data, uint64_t bytes, uint64_t offset) {
+  check_range(bytes, offset, "upload");
+  if (bytes == 0) return;
+  if (mapped_) {
+    std::memcpy(static_cast<char*>(mapped_) + offset, data, bytes);
+    return;
+  }
+  Buffer staging(*context_, name_ + " (staging)", bytes, MemoryKind::kHostVisible);
+  std::memcpy(staging.mapped_, data, bytes);
+  context_->run_once([&](VkCommandBuffer cmd) {
+    VkBufferCopy region{0, offset, bytes};
+    vkCmdCopyBuffer(cmd, staging.handle(), buffer_, 1, &region);
+  });
+}
+
+void Buffer::download(void* data, uint64_t bytes, uint64_t offset) const {
+  check_range(bytes, offset, "download");
+  if (bytes == 0) return;
+  if (mapped_) {
+    std::memcpy(data, static_cast<const char*>(mapped_) + offset, bytes);
+    return;
+  }
+  Buffer staging(*context_, name_ + " (readback)", bytes, MemoryKind::kHostVisible);
+  context_->run_once([&](VkCommandBuffer cmd) {
+    VkBufferCopy region{offset, 0, bytes};
+    vkCmdCopyBuffer(cmd, buffer_, staging.handle(), 1, &region);
+  });
+  std::memcpy(data, staging.mapped_, bytes);
+}
+
+}  // namespace litgs::engine

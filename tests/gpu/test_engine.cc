@@ -1,0 +1,157 @@
+// The engine's contracts: buffers, limits, binding checks and barrier placement.
+#include <gtest/gtest.h>
+
+#include <numeric>
+#include <vector>
+
+#include "engine/buffer.h"
+#include "engine/vk_check.h"
+#include "engine/sequence.h"
+#include "gpu_test.h"
+#include "kernels/scan/scan_shared.h"
+#include "kernels/spirv_registry.h"
+#include "kernels/subgroup_kernel.h"
+
+namespace litgs {
+namespace {
+
+using engine::Access;
+using testing::GpuTest;
+
+class EngineTest : public GpuTest {};
+
+TEST_F(EngineTest, ReportsDeviceFacts) {
+  const auto& info = context().info();
+  EXPECT_FALSE(info.name.empty());
+  EXPECT_GE(info.subgroup_size, 1u);
+  EXPECT_EQ(info.subgroup_size & (info.subgroup_size - 1), 0u) << "subgroup size is a power of two";
+  EXPECT_GT(info.max_storage_buffer_range, 0u);
+  EXPECT_FALSE(info.memory_heaps.empty());
+}
+
+TEST_F(EngineTest, UploadDownloadRoundTrips) {
+  std::vector<uint32_t> data(1000);
+  std::iota(data.begin(), data.end(), 7u);
+  engine::DeviceArray<uint32_t> device(context(), "roundtrip", data.size());
+  device.upload(data);
+  EXPECT_EQ(device.download(), data);
+  EXPECT_EQ(device.download(10, 3), (std::vector<uint32_t>{17, 18, 19}));
+}
+
+TEST_F(EngineTest, HostVisibleBufferRoundTrips) {
+  std::vector<float> data = {1.5f, -2.0f, 3.25f};
+  engine::DeviceArray<float> device(context(), "host visible", data.size(), engine::MemoryKind::kHostVisible);
+  device.upload(data);
+  EXPECT_EQ(device.download(), data);
+}
+
+TEST_F(EngineTest, EmptyBufferIsValid) {
+  engine::DeviceArray<uint32_t> empty(context(), "empty", 0);
+  EXPECT_EQ(empty.size(), 0u);
+  EXPECT_TRUE(empty.download().empty());
+}
+
+TEST_F(EngineTest, OversizedBufferNamesBufferAndLimit) {
+  const uint64_t too_big = context().info().max_storage_buffer_range + 4;
+  try {
+    engine::Buffer b(context(), "gaussian means", too_big);
+    FAIL() << "expected std::length_error";
+  } catch (const std::length_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("gaussian means"), std::string::npos) << what;
+    EXPECT_NE(what.find("maxStorageBufferRange"), std::string::npos) << what;
+  }
+}
+
+TEST_F(EngineTest, OutOfRangeUploadIsRejected) {
+  engine::DeviceArray<uint32_t> small(context(), "small", 4);
+  std::vector<uint32_t> five(5, 1u);
+  EXPECT_THROW(small.upload(five), std::out_of_range);
+}
+
+TEST_F(EngineTest, UnknownShaderIsNamed) {
+  try {
+    kernels::spirv("no/such_kernel");
+    FAIL();
+  } catch (const std::out_of_range& e) {
+    EXPECT_NE(std::string(e.what()).find("no/such_kernel"), std::string::npos);
+  }
+}
+
+TEST_F(EngineTest, DispatchChecksBindingsAndPushConstants) {
+  auto kernel = kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
+  engine::DeviceArray<uint32_t> a(context(), "a", 16);
+  engine::Sequence seq(context());
+  kernels::ScanParams params{16, 16, 0, 0};
+  // Missing binding 1.
+  EXPECT_THROW(seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}}, params), std::invalid_argument);
+  // Repeated binding 0.
+  EXPECT_THROW(seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {0, &a.buffer(), Access::kRead}},
+                            params),
+               std::invalid_argument);
+  // Wrong push-constant size.
+  const uint32_t wrong = 0;
+  EXPECT_THROW(seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {1, &a.buffer(), Access::kRead}},
+                            wrong),
+               std::invalid_argument);
+}
+
+TEST_F(EngineTest, BarriersOnlyWhereHazardsAre) {
+  auto kernel = kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
+  engine::DeviceArray<uint32_t> a(context(), "a", 64), b(context(), "b", 64), offsets(context(), "offsets", 1);
+  std::vector<uint32_t> ones(64, 1u);
+  a.upload(ones);
+  b.upload(ones);
+  engine::Sequence seq(context());
+  kernels::ScanParams params{64, 64, 0, 0};
+  // Independent buffers: no barrier between the two scans.
+  seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {1, &offsets.buffer(), Access::kRead}}, params);
+  seq.dispatch(*kernel, {1}, {{0, &b.buffer(), Access::kReadWrite}, {1, &offsets.buffer(), Access::kRead}}, params);
+  EXPECT_EQ(seq.barrier_count(), 0u);
+  // Copy a into b after both were written: one barrier.
+  seq.copy(a.buffer(), b.buffer(), 64 * sizeof(uint32_t));
+  EXPECT_EQ(seq.barrier_count(), 1u);
+  seq.submit_and_wait();
+  std::vector<uint32_t> expected(64);
+  std::iota(expected.begin(), expected.end(), 0u);
+  EXPECT_EQ(b.download(), expected);
+  const auto profile = seq.profile();
+  if (context().info().timestamps) {
+    ASSERT_EQ(profile.size(), 1u);
+    EXPECT_EQ(profile[0].name, "scan/scan_downsweep");
+    EXPECT_EQ(profile[0].dispatches, 2u);
+    EXPECT_GE(profile[0].ms, 0.0);
+  }
+}
+
+TEST_F(EngineTest, SequenceReplays) {
+  auto kernel = kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
+  engine::DeviceArray<uint32_t> a(context(), "a", 8), offsets(context(), "offsets", 1);
+  engine::Sequence seq(context());
+  seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {1, &offsets.buffer(), Access::kRead}},
+               kernels::ScanParams{8, 8, 0, 0});
+  for (uint32_t round = 1; round <= 2; ++round) {
+    a.upload(std::vector<uint32_t>(8, round));
+    seq.submit_and_wait();
+    EXPECT_EQ(a.download()[7], 7u * round);
+  }
+  EXPECT_THROW(seq.fill(a.buffer(), 0u, 32), std::logic_error) << "recording after submit needs reset()";
+  seq.reset();
+  seq.fill(a.buffer(), 5u, 32);
+  seq.submit_and_wait();
+  EXPECT_EQ(a.download(), std::vector<uint32_t>(8, 5u));
+}
+
+TEST(EngineNoDevice, SelectorThatMatchesNothingIsNamed) {
+  engine::ContextOptions options;
+  options.device_selector = "no-such-gpu-xyz";
+  try {
+    engine::Context context(options);
+    FAIL() << "expected NoDeviceError";
+  } catch (const engine::NoDeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("no-such-gpu-xyz"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace litgs

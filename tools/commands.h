@@ -1,0 +1,13 @@
+// The subcommands of litgs-engine. Each registers itself on the CLI11 app and runs when chosen.
+#pragma once
+
+namespace CLI {
+class App;
+}
+
+namespace litgs::tools {
+
+void add_info_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
+
+}  // namespace litgs::tools

@@ -1,0 +1,26 @@
+// litgs-engine: one binary, one subcommand per job.
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+
+#include "engine/vk_check.h"
+#include "tools/commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"litgs-engine: LiDAR-inertial-thermal Gaussian splatting on any Vulkan device"};
+  app.require_subcommand(1);
+  litgs::tools::add_info_command(app);
+  litgs::tools::add_bench_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const litgs::engine::NoDeviceError& e) {
+    std::cerr << "litgs-engine: " << e.what() << "\n";
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << "litgs-engine: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
