@@ -25,7 +25,7 @@ void main() {
     const uint digit = in_range ? (keys[i] >> p.shift) & mask : 0u;
     const uvec4 peers = lanes_with_same_digit(digit, in_range);
     // One lane per distinct digit (the highest) adds the group's size: no two lanes touch one counter.
-    if (in_range && subgroupBallotFindMSB(peers) == lane) s_count[digit] += subgroupBallotBitCount(peers);
+    if (in_range && is_last_peer(peers)) s_count[digit] += peer_count(peers);
     subgroupMemoryBarrierShared();
     subgroupBarrier();
   }

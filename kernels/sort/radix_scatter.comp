@@ -31,13 +31,13 @@ void main() {
     const uint digit = (key >> p.shift) & mask;
     const uint first = s_next[digit];
     const uvec4 peers = lanes_with_same_digit(digit, in_range);
-    const uint dst = first + subgroupBallotExclusiveBitCount(peers);
+    const uint dst = first + peer_rank(peers);
     subgroupMemoryBarrierShared();
     subgroupBarrier();  // every lane has read s_next before the group's last lane advances it
     if (in_range) {
       keys_out[dst] = key;
       values_out[dst] = values_in[i];
-      if (subgroupBallotFindMSB(peers) == lane) s_next[digit] = first + subgroupBallotBitCount(peers);
+      if (is_last_peer(peers)) s_next[digit] = first + peer_count(peers);
     }
     subgroupMemoryBarrierShared();
     subgroupBarrier();
