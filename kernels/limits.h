@@ -7,4 +7,13 @@
 // workgroup well below that, leaving room for their other loops.
 #define MAX_BATCHES_PER_WORKGROUP 32768
 
+
+// Element-wise kernels (one invocation per Gaussian or per intersection) use workgroups of this size, so
+// that 16.7M elements fit in the 65535 workgroups every device allows in one dimension.
+#define ELEMENTWISE_GROUP_SIZE 256
+
+// A pixel walks at most this many entries of its tile's list (lavapipe's loop cap; see above). Tiles with
+// longer lists are truncated and counted.
+#define MAX_TILE_LIST_WALK 60000
+
 #endif

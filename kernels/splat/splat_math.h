@@ -232,12 +232,12 @@ struct ParamGrad {
 
 SM_FN ParamGrad project_gaussian_backward(ViewGeometry v, vec3 mean, vec3 log_scale, vec4 quat_raw,
                                           real opacity_logit, ProjectedGrad g) {
-  ParamGrad out;
-  out.mean = vec3(real(0.0));
-  out.log_scale = vec3(real(0.0));
-  out.quat = vec4(real(0.0));
+  ParamGrad r;
+  r.mean = vec3(real(0.0));
+  r.log_scale = vec3(real(0.0));
+  r.quat = vec4(real(0.0));
   const real opacity = real(1.0) / (real(1.0) + exp(-opacity_logit));
-  out.opacity_logit = g.opacity * opacity * (real(1.0) - opacity);
+  r.opacity_logit = g.opacity * opacity * (real(1.0) - opacity);
 
   const vec3 p = v.R * mean + v.t;
   bool clamped_x, clamped_y;
@@ -266,12 +266,12 @@ SM_FN ParamGrad project_gaussian_backward(ViewGeometry v, vec3 mean, vec3 log_sc
   const mat3 dMs = real(2.0) * dcov3 * Ms;
   const vec3 ds = vec3(dot(Rq[0], dMs[0]), dot(Rq[1], dMs[1]), dot(Rq[2], dMs[2]));
   const vec3 ls_lo = vec3(real(SPLAT_LOG_SCALE_MIN)), ls_hi = vec3(real(SPLAT_LOG_SCALE_MAX));
-  out.log_scale = ds * s;
-  if (log_scale.x < ls_lo.x || log_scale.x > ls_hi.x) out.log_scale.x = real(0.0);
-  if (log_scale.y < ls_lo.y || log_scale.y > ls_hi.y) out.log_scale.y = real(0.0);
-  if (log_scale.z < ls_lo.z || log_scale.z > ls_hi.z) out.log_scale.z = real(0.0);
+  r.log_scale = ds * s;
+  if (log_scale.x < ls_lo.x || log_scale.x > ls_hi.x) r.log_scale.x = real(0.0);
+  if (log_scale.y < ls_lo.y || log_scale.y > ls_hi.y) r.log_scale.y = real(0.0);
+  if (log_scale.z < ls_lo.z || log_scale.z > ls_hi.z) r.log_scale.z = real(0.0);
   const mat3 dRq = mat3(dMs[0] * s.x, dMs[1] * s.y, dMs[2] * s.z);
-  out.quat = quat_grad(quat_raw, dRq);
+  r.quat = quat_grad(quat_raw, dRq);
 
   // Camera point: mean2d, depth and the Jacobian (through the clamped tx = x/z, ty = y/z).
   const real rz = real(1.0) / p.z, rz2 = rz * rz;
@@ -293,8 +293,8 @@ SM_FN ParamGrad project_gaussian_backward(ViewGeometry v, vec3 mean, vec3 log_sc
     dp.y += d_ty * rz;
     dp.z += -d_ty * p.y * rz2;
   }
-  out.mean = transpose(v.R) * dp;
-  return out;
+  r.mean = transpose(v.R) * dp;
+  return r;
 }
 
 // ---- One pixel ----

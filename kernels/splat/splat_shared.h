@@ -42,7 +42,7 @@ using uint = uint32_t;
 #define PROJECT_BINDING_TILE_RECTS 10    // [N][4] tile x0 y0 x1 y1, half-open; empty if culled (out)
 #define PROJECT_BINDING_DEPTH_KEYS 11    // [N] sortable depth bits, 0xFFFFFFFF if culled (out)
 #define PROJECT_BINDING_ORDER 12         // [N] identity permutation, the depth sort's values (out)
-#define PROJECT_BINDING_COUNTERS 13      // [4] uint: culled non-finite, culled other (atomic, out)
+#define PROJECT_BINDING_COUNTERS 13      // [4] uint: [0] += Gaussians culled as non-finite (atomic)
 
 // ---- gather_counts.comp: one invocation per depth-sorted position ----
 #define GATHER_BINDING_ORDER 0           // [N] Gaussian index by depth rank
@@ -74,6 +74,7 @@ using uint = uint32_t;
 #define FWD_BINDING_DEPTH 9              // [H][W] expected depth sum(w z)/sum(w) (out)
 #define FWD_BINDING_ALPHA 10             // [H][W] accumulated alpha = 1 - T (out)
 #define FWD_BINDING_LAST 11              // [H][W] number of list entries the pixel walked (out)
+#define FWD_BINDING_COUNTERS 12          // the counters of project.comp; [1] += tiles truncated
 
 // ---- rasterize_backward.comp: one workgroup per tile ----
 #define BWD_BINDING_RANGES 0

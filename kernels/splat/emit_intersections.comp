@@ -1,0 +1,30 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Per depth-sorted position: one (tile, intersection) pair per touched tile, in depth order, so that a
+// stable sort by tile keeps every tile's list front to back. The rectangle was computed once, in project.
+#include "limits.h"
+#include "splat/splat_shared.h"
+
+layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
+layout(std430, binding = EMIT_BINDING_ORDER) readonly buffer Order { uint order[]; };
+layout(std430, binding = EMIT_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 rects[]; };
+layout(std430, binding = EMIT_BINDING_OFFSETS) readonly buffer Offsets { uint offsets[]; };
+layout(std430, binding = EMIT_BINDING_TILE_KEYS) writeonly buffer TileKeys { uint tile_keys[]; };
+layout(std430, binding = EMIT_BINDING_ISECT_IDS) writeonly buffer IsectIds { uint isect_ids[]; };
+layout(std430, binding = EMIT_BINDING_ISECT_GAUSSIAN) writeonly buffer IsectGaussian { uint isect_gaussian[]; };
+layout(push_constant) uniform Push { SplatView view; };
+
+void main() {
+  const uint s = gl_GlobalInvocationID.x;
+  if (s >= view.count) return;
+  const uint g = order[s];
+  const uvec4 r = rects[g];
+  uint e = offsets[s];
+  for (uint ty = r.y; ty < r.w; ++ty)
+    for (uint tx = r.x; tx < r.z; ++tx) {
+      tile_keys[e] = ty * view.tiles_x + tx;
+      isect_ids[e] = e;
+      isect_gaussian[e] = g;
+      ++e;
+    }
+}

@@ -1,0 +1,82 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Per Gaussian: gradients of the raw parameters from those of its projected quantities and colour.
+#include "limits.h"
+#include "splat/splat_shared.h"
+#include "splat/splat_math.h"
+#include "splat/splat_view.glsl"
+
+layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
+layout(std430, binding = PBWD_BINDING_MEANS) readonly buffer Means { float means[]; };
+layout(std430, binding = PBWD_BINDING_LOG_SCALES) readonly buffer LogScales { float log_scales[]; };
+layout(std430, binding = PBWD_BINDING_QUATS) readonly buffer Quats { float quats[]; };
+layout(std430, binding = PBWD_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
+layout(std430, binding = PBWD_BINDING_SH) readonly buffer Sh { float sh[]; };
+layout(std430, binding = PBWD_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 rects[]; };
+layout(std430, binding = PBWD_BINDING_GRAD2D) readonly buffer Grad2d { float grad2d[]; };
+layout(std430, binding = PBWD_BINDING_GRAD_MEANS) writeonly buffer GMeans { float g_means[]; };
+layout(std430, binding = PBWD_BINDING_GRAD_LOG_SCALES) writeonly buffer GLogScales { float g_log_scales[]; };
+layout(std430, binding = PBWD_BINDING_GRAD_QUATS) writeonly buffer GQuats { float g_quats[]; };
+layout(std430, binding = PBWD_BINDING_GRAD_OPACITY_LOGITS) writeonly buffer GLogits { float g_logits[]; };
+layout(std430, binding = PBWD_BINDING_GRAD_SH) writeonly buffer GSh { float g_sh[]; };
+layout(std430, binding = PBWD_BINDING_GRAD_MEANS2D) writeonly buffer GMeans2d { float g_means2d[]; };
+
+void main() {
+  const uint i = gl_GlobalInvocationID.x;
+  if (i >= view.count) return;
+  const uint K = view.sh_coeffs;
+  const uvec4 r = rects[i];
+  if (r.z <= r.x) {  // culled: no gradient
+    for (uint a = 0u; a < 3u; ++a) {
+      g_means[3 * i + a] = 0.0;
+      g_log_scales[3 * i + a] = 0.0;
+    }
+    for (uint a = 0u; a < 4u; ++a) g_quats[4 * i + a] = 0.0;
+    g_logits[i] = 0.0;
+    for (uint k = 0u; k < K * CHANNELS; ++k) g_sh[i * K * CHANNELS + k] = 0.0;
+    g_means2d[2 * i] = 0.0;
+    g_means2d[2 * i + 1] = 0.0;
+    return;
+  }
+  const uint base = i * GRAD2D_STRIDE;
+  ProjectedGrad pg;
+  pg.mean2d = vec2(grad2d[base], grad2d[base + 1]);
+  pg.conic = vec3(grad2d[base + 2], grad2d[base + 3], grad2d[base + 4]);
+  pg.opacity = grad2d[base + 5];
+  pg.depth = grad2d[base + 6];
+
+  const vec3 mean = vec3(means[3 * i], means[3 * i + 1], means[3 * i + 2]);
+  const vec3 log_scale = vec3(log_scales[3 * i], log_scales[3 * i + 1], log_scales[3 * i + 2]);
+  const vec4 quat = vec4(quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]);
+  const ParamGrad p = project_gaussian_backward(view_geometry(), mean, log_scale, quat, opacity_logits[i], pg);
+
+  // Colour = sum_k basis_k c_k + 0.5, clamped at 0; its direction depends on the mean.
+  const vec3 ray = mean - camera_centre();
+  const vec3 dir = normalize(ray);
+  float basis[SPLAT_MAX_SH_COEFFS];
+  sh_basis(view.sh_degree, dir, basis);
+  float weights[SPLAT_MAX_SH_COEFFS];
+  for (uint k = 0u; k < uint(SPLAT_MAX_SH_COEFFS); ++k) weights[k] = 0.0;
+  for (uint c = 0u; c < CHANNELS; ++c) {
+    const float g_color = grad2d[base + SPLAT_GRAD2D_FIXED + c];
+    float sum = 0.5;
+    for (uint k = 0u; k < K; ++k) sum += basis[k] * sh[(i * K + k) * CHANNELS + c];
+    const bool clamped = sum < 0.0;
+    for (uint k = 0u; k < K; ++k) {
+      const uint idx = (i * K + k) * CHANNELS + c;
+      g_sh[idx] = clamped ? 0.0 : basis[k] * g_color;
+      if (!clamped) weights[k] += g_color * sh[idx];
+    }
+  }
+  const vec3 ddir = sh_basis_dir_grad(view.sh_degree, dir, weights);
+  const vec3 dray = (ddir - dir * dot(dir, ddir)) / length(ray);
+  const vec3 gm = p.mean + dray;
+  for (uint a = 0u; a < 3u; ++a) {
+    g_means[3 * i + a] = gm[a];
+    g_log_scales[3 * i + a] = p.log_scale[a];
+  }
+  for (uint a = 0u; a < 4u; ++a) g_quats[4 * i + a] = p.quat[a];
+  g_logits[i] = p.opacity_logit;
+  g_means2d[2 * i] = pg.mean2d.x;
+  g_means2d[2 * i + 1] = pg.mean2d.y;
+}

@@ -1,0 +1,377 @@
+#include "kernels/splat/rasterizer.h"
+
+#include <algorithm>
+#include <bit>
+#include <stdexcept>
+#include <string>
+
+#include "kernels/limits.h"
+#include "kernels/spirv_registry.h"
+#include "kernels/splat/splat_shared.h"
+
+namespace litgs::kernels {
+
+using engine::Access;
+using engine::DeviceArray;
+
+namespace {
+
+// Grows `array` to hold at least `count` elements (by 1.5x steps, so buffers track the model's size).
+template <class T>
+void ensure(engine::Context& ctx, std::unique_ptr<DeviceArray<T>>& array, size_t count, const char* name) {
+  if (array && array->size() >= count) return;
+  const size_t grown = array ? std::max(count, array->size() + array->size() / 2) : count;
+  array.reset();
+  array = std::make_unique<DeviceArray<T>>(ctx, name, std::max<size_t>(grown, 1));
+}
+
+engine::Groups elementwise(size_t n) {
+  return {static_cast<uint32_t>((n + ELEMENTWISE_GROUP_SIZE - 1) / ELEMENTWISE_GROUP_SIZE)};
+}
+
+SplatView make_view(const SplatCamera& c, uint32_t count, uint32_t sh_coeffs) {
+  SplatView v{};
+  for (int col = 0; col < 3; ++col)
+    for (int row = 0; row < 3; ++row) v.rot[col * 3 + row] = static_cast<float>(c.R_cam_world[col][row]);
+  for (int a = 0; a < 3; ++a) v.trans[a] = static_cast<float>(c.t_cam_world[a]);
+  v.fx = static_cast<float>(c.fx);
+  v.fy = static_cast<float>(c.fy);
+  v.cx = static_cast<float>(c.cx);
+  v.cy = static_cast<float>(c.cy);
+  v.near_m = static_cast<float>(c.near_m);
+  v.width = c.width;
+  v.height = c.height;
+  v.tiles_x = (c.width + SPLAT_TILE_SIZE - 1) / SPLAT_TILE_SIZE;
+  v.tiles_y = (c.height + SPLAT_TILE_SIZE - 1) / SPLAT_TILE_SIZE;
+  v.count = count;
+  v.sh_degree = c.sh_degree;
+  v.sh_coeffs = sh_coeffs;
+  return v;
+}
+
+}  // namespace
+
+struct Rasterizer::Buffers {
+  // Per Gaussian.
+  std::unique_ptr<DeviceArray<float>> means2d, conics, depths, opacities, colors, grad2d;
+  std::unique_ptr<DeviceArray<uint32_t>> rects, depth_keys, order, counts, offsets;
+  std::unique_ptr<DeviceArray<float>> g_means, g_log_scales, g_quats, g_logits, g_sh, g_means2d;
+  // Per intersection.
+  std::unique_ptr<DeviceArray<uint32_t>> tile_keys, isect_ids, isect_gaussian;
+  std::unique_ptr<DeviceArray<float>> isect_grads;
+  // Per pixel and per tile.
+  std::unique_ptr<DeviceArray<float>> image, depth, alpha, grad_image, grad_depth, grad_alpha;
+  std::unique_ptr<DeviceArray<uint32_t>> last, ranges;
+  std::unique_ptr<DeviceArray<uint32_t>> counters;  // [4]
+};
+
+DeviceGaussians::DeviceGaussians(engine::Context& context, const GaussianModel& model)
+    : count(model.size()),
+      channels(model.channels),
+      sh_degree(model.sh_degree),
+      means(context, "gaussians: means", model.size() * 3),
+      log_scales(context, "gaussians: log_scales", model.size() * 3),
+      quats(context, "gaussians: quats", model.size() * 4),
+      opacity_logits(context, "gaussians: opacity_logits", model.size()),
+      sh(context, "gaussians: sh", model.sh.size()) {
+  upload(model);
+}
+
+void DeviceGaussians::upload(const GaussianModel& model) {
+  model.check();
+  if (model.size() != count || model.channels != channels || model.sh_degree != sh_degree)
+    throw std::invalid_argument("DeviceGaussians::upload: the model's size, channels or SH degree changed");
+  means.upload(model.means);
+  log_scales.upload(model.log_scales);
+  quats.upload(model.quats);
+  opacity_logits.upload(model.opacity_logits);
+  sh.upload(model.sh);
+}
+
+GaussianModel DeviceGaussians::download() const {
+  GaussianModel m;
+  m.channels = channels;
+  m.sh_degree = sh_degree;
+  m.means = means.download();
+  m.log_scales = log_scales.download();
+  m.quats = quats.download();
+  m.opacity_logits = opacity_logits.download();
+  m.sh = sh.download();
+  return m;
+}
+
+Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOptions options)
+    : context_(&context), channels_(channels), options_(options), sort_(context), scan_(context),
+      buffers_(std::make_unique<Buffers>()) {
+  if (channels < 1 || channels > SPLAT_MAX_CHANNELS)
+    throw std::invalid_argument("Rasterizer: channels = " + std::to_string(channels) + ", must be 1.." +
+                                std::to_string(SPLAT_MAX_CHANNELS));
+  project_ = make("splat/project", 14);
+  gather_ = make("splat/gather_counts", 3);
+  emit_ = make("splat/emit_intersections", 6);
+  ranges_ = make("splat/tile_ranges", 2);
+  forward_ = make("splat/rasterize_forward", 13);
+  const char* backward = options_.deterministic ? "splat/rasterize_backward_deterministic"
+                         : uses_float_atomics()  ? "splat/rasterize_backward_float_atomics"
+                                                 : "splat/rasterize_backward_cas_atomics";
+  backward_ = make(backward, 15);
+  reduce_ = make("splat/reduce_isect_grads", 5);
+  project_backward_ = make("splat/project_backward", 13);
+  buffers_->counters = std::make_unique<DeviceArray<uint32_t>>(context, "splat: counters", 4);
+}
+
+Rasterizer::~Rasterizer() = default;
+
+bool Rasterizer::uses_float_atomics() const {
+  return !options_.deterministic && !options_.force_cas_atomics && context_->info().float_atomic_add;
+}
+
+std::unique_ptr<engine::Kernel> Rasterizer::make(const char* name, uint32_t bindings) {
+  engine::KernelDesc desc;
+  desc.name = name;
+  desc.spirv = spirv(name);
+  desc.binding_count = bindings;
+  desc.push_constant_bytes = sizeof(SplatView);
+  desc.spec_constants = {{1, channels_}};
+  return std::make_unique<engine::Kernel>(*context_, std::move(desc));
+}
+
+void Rasterizer::append_profile(const engine::Sequence& sequence) {
+  for (const auto& k : sequence.profile()) {
+    auto it = std::find_if(profile_.begin(), profile_.end(), [&](const auto& p) { return p.name == k.name; });
+    if (it == profile_.end()) {
+      profile_.push_back(k);
+    } else {
+      it->ms += k.ms;
+      it->dispatches += k.dispatches;
+    }
+  }
+}
+
+void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
+  camera.check();
+  if (g.channels != channels_)
+    throw std::invalid_argument("Rasterizer::forward: the model has " + std::to_string(g.channels) +
+                                " channels, the rasterizer was built for " + std::to_string(channels_));
+  if (camera.sh_degree > g.sh_degree)
+    throw std::invalid_argument("Rasterizer::forward: camera.sh_degree " + std::to_string(camera.sh_degree) +
+                                " exceeds the model's degree " + std::to_string(g.sh_degree));
+  if (g.size() > 0xFFFFFFFFull) throw std::length_error("Rasterizer::forward: more than 2^32 Gaussians");
+  engine::Context& ctx = *context_;
+  Buffers& b = *buffers_;
+  const uint32_t n = static_cast<uint32_t>(g.size());
+  const uint32_t K = (g.sh_degree + 1) * (g.sh_degree + 1);
+  const size_t pixels = static_cast<size_t>(camera.width) * camera.height;
+  SplatView view = make_view(camera, n, K);
+  const size_t tiles = static_cast<size_t>(view.tiles_x) * view.tiles_y;
+
+  ensure(ctx, b.means2d, 2 * size_t{n}, "splat: means2d");
+  ensure(ctx, b.conics, 3 * size_t{n}, "splat: conics");
+  ensure(ctx, b.depths, n, "splat: depths");
+  ensure(ctx, b.opacities, n, "splat: opacities");
+  ensure(ctx, b.colors, size_t{n} * channels_, "splat: colors");
+  ensure(ctx, b.rects, 4 * size_t{n}, "splat: tile rects");
+  ensure(ctx, b.depth_keys, n, "splat: depth keys");
+  ensure(ctx, b.order, n, "splat: depth order");
+  ensure(ctx, b.counts, n, "splat: tile counts");
+  ensure(ctx, b.offsets, n, "splat: tile offsets");
+  ensure(ctx, b.image, pixels * channels_, "splat: image");
+  ensure(ctx, b.depth, pixels, "splat: expected depth");
+  ensure(ctx, b.alpha, pixels, "splat: alpha");
+  ensure(ctx, b.last, pixels, "splat: last");
+  ensure(ctx, b.ranges, 2 * tiles, "splat: tile ranges");
+  profile_.clear();
+
+  // 1. Project, sort by depth, count tiles per depth rank, scan.
+  engine::Sequence s1(ctx);
+  s1.fill(b.counters->buffer(), 0u, 4 * sizeof(uint32_t));
+  s1.dispatch(*project_, elementwise(n),
+              {{PROJECT_BINDING_MEANS, &g.means.buffer(), Access::kRead},
+               {PROJECT_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
+               {PROJECT_BINDING_QUATS, &g.quats.buffer(), Access::kRead},
+               {PROJECT_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kRead},
+               {PROJECT_BINDING_SH, &g.sh.buffer(), Access::kRead},
+               {PROJECT_BINDING_MEANS2D, &b.means2d->buffer(), Access::kWrite},
+               {PROJECT_BINDING_CONICS, &b.conics->buffer(), Access::kWrite},
+               {PROJECT_BINDING_DEPTHS, &b.depths->buffer(), Access::kWrite},
+               {PROJECT_BINDING_OPACITIES, &b.opacities->buffer(), Access::kWrite},
+               {PROJECT_BINDING_COLORS, &b.colors->buffer(), Access::kWrite},
+               {PROJECT_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kWrite},
+               {PROJECT_BINDING_DEPTH_KEYS, &b.depth_keys->buffer(), Access::kWrite},
+               {PROJECT_BINDING_ORDER, &b.order->buffer(), Access::kWrite},
+               {PROJECT_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
+              view);
+  sort_.record(s1, *b.depth_keys, *b.order, n, 32);
+  s1.dispatch(*gather_, elementwise(n),
+              {{GATHER_BINDING_ORDER, &b.order->buffer(), Access::kRead},
+               {GATHER_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kRead},
+               {GATHER_BINDING_COUNTS, &b.counts->buffer(), Access::kWrite}},
+              view);
+  s1.copy(b.counts->buffer(), b.offsets->buffer(), uint64_t{n} * sizeof(uint32_t));
+  scan_.record(s1, b.offsets->buffer(), n);
+  s1.submit_and_wait();
+  append_profile(s1);
+
+  // The one readback: how many (tile, Gaussian) intersections to emit and sort.
+  uint64_t m = 0;
+  if (n > 0) m = uint64_t{b.offsets->download(n - 1, 1)[0]} + b.counts->download(n - 1, 1)[0];
+  if (m > 0xFFFFFFFFull) throw std::length_error("Rasterizer::forward: more than 2^32 tile intersections");
+  intersections_ = m;
+  ensure(ctx, b.tile_keys, m, "splat: tile keys");
+  ensure(ctx, b.isect_ids, m, "splat: intersection ids");
+  ensure(ctx, b.isect_gaussian, m, "splat: intersection gaussians");
+
+  // 2. Emit intersections in depth order, stable sort by tile, tile ranges, blend.
+  engine::Sequence s2(ctx);
+  s2.fill(b.ranges->buffer(), 0u, 2 * tiles * sizeof(uint32_t));
+  s2.dispatch(*emit_, elementwise(n),
+              {{EMIT_BINDING_ORDER, &b.order->buffer(), Access::kRead},
+               {EMIT_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kRead},
+               {EMIT_BINDING_OFFSETS, &b.offsets->buffer(), Access::kRead},
+               {EMIT_BINDING_TILE_KEYS, &b.tile_keys->buffer(), Access::kWrite},
+               {EMIT_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kWrite},
+               {EMIT_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kWrite}},
+              view);
+  const uint32_t tile_bits = static_cast<uint32_t>(std::max<size_t>(1, std::bit_width(tiles - 1)));
+  sort_.record(s2, *b.tile_keys, *b.isect_ids, static_cast<uint32_t>(m), tile_bits);
+  SplatView ranges_view = view;
+  ranges_view.count = static_cast<uint32_t>(m);
+  s2.dispatch(*ranges_, elementwise(m),
+              {{RANGES_BINDING_TILE_KEYS, &b.tile_keys->buffer(), Access::kRead},
+               {RANGES_BINDING_RANGES, &b.ranges->buffer(), Access::kReadWrite}},
+              ranges_view);
+  s2.dispatch(*forward_, {view.tiles_x, view.tiles_y},
+              {{FWD_BINDING_RANGES, &b.ranges->buffer(), Access::kRead},
+               {FWD_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kRead},
+               {FWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
+               {FWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
+               {FWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
+               {FWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
+               {FWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
+               {FWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
+               {FWD_BINDING_IMAGE, &b.image->buffer(), Access::kWrite},
+               {FWD_BINDING_DEPTH, &b.depth->buffer(), Access::kWrite},
+               {FWD_BINDING_ALPHA, &b.alpha->buffer(), Access::kWrite},
+               {FWD_BINDING_LAST, &b.last->buffer(), Access::kWrite},
+               {FWD_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
+              view);
+  s2.submit_and_wait();
+  append_profile(s2);
+  last_gaussians_ = &g;
+  last_camera_ = camera;
+}
+
+RenderImages<float> Rasterizer::download_images() {
+  if (!last_gaussians_) throw std::logic_error("Rasterizer::download_images before forward");
+  const Buffers& b = *buffers_;
+  const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
+  RenderImages<float> out;
+  out.width = last_camera_.width;
+  out.height = last_camera_.height;
+  out.channels = channels_;
+  out.image = b.image->download(0, pixels * channels_);
+  out.depth = b.depth->download(0, pixels);
+  out.alpha = b.alpha->download(0, pixels);
+  out.last = b.last->download(0, pixels);
+  out.culled_nonfinite = b.counters->download(0, 1)[0];
+  out.intersections = intersections_;
+  return out;
+}
+
+void Rasterizer::backward(const RenderGradInput& grad) {
+  if (!last_gaussians_) throw std::logic_error("Rasterizer::backward before forward");
+  engine::Context& ctx = *context_;
+  Buffers& b = *buffers_;
+  const DeviceGaussians& g = *last_gaussians_;
+  const uint32_t n = static_cast<uint32_t>(g.size());
+  const uint32_t K = (g.sh_degree + 1) * (g.sh_degree + 1);
+  const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
+  if (grad.image.size() != pixels * channels_)
+    throw std::invalid_argument("Rasterizer::backward: grad image has " + std::to_string(grad.image.size()) +
+                                " values, expected C*H*W = " + std::to_string(pixels * channels_));
+  for (const auto* v : {&grad.depth, &grad.alpha})
+    if (!v->empty() && v->size() != pixels)
+      throw std::invalid_argument("Rasterizer::backward: grad depth/alpha has " + std::to_string(v->size()) +
+                                  " values, expected H*W = " + std::to_string(pixels) + " (or none)");
+  const SplatView view = make_view(last_camera_, n, K);
+  const uint32_t stride = SPLAT_GRAD2D_FIXED + channels_;
+
+  ensure(ctx, b.grad_image, pixels * channels_, "splat: grad image");
+  ensure(ctx, b.grad_depth, pixels, "splat: grad depth");
+  ensure(ctx, b.grad_alpha, pixels, "splat: grad alpha");
+  ensure(ctx, b.grad2d, size_t{n} * stride, "splat: grad2d");
+  ensure(ctx, b.g_means, 3 * size_t{n}, "splat: grad means");
+  ensure(ctx, b.g_log_scales, 3 * size_t{n}, "splat: grad log_scales");
+  ensure(ctx, b.g_quats, 4 * size_t{n}, "splat: grad quats");
+  ensure(ctx, b.g_logits, n, "splat: grad opacity_logits");
+  ensure(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
+  ensure(ctx, b.g_means2d, 2 * size_t{n}, "splat: grad means2d");
+  if (options_.deterministic) ensure(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
+  b.grad_image->upload(grad.image);
+  b.grad_depth->upload(grad.depth.empty() ? std::vector<float>(pixels, 0.0f) : grad.depth);
+  b.grad_alpha->upload(grad.alpha.empty() ? std::vector<float>(pixels, 0.0f) : grad.alpha);
+
+  engine::Sequence s(ctx);
+  const engine::Buffer& rows = options_.deterministic ? b.isect_grads->buffer() : b.grad2d->buffer();
+  const uint64_t row_values = options_.deterministic ? intersections_ * stride : uint64_t{n} * stride;
+  s.fill(rows, 0u, row_values * sizeof(float));
+  s.dispatch(*backward_, {view.tiles_x, view.tiles_y},
+             {{BWD_BINDING_RANGES, &b.ranges->buffer(), Access::kRead},
+              {BWD_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kRead},
+              {BWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
+              {BWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
+              {BWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
+              {BWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
+              {BWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
+              {BWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
+              {BWD_BINDING_DEPTH, &b.depth->buffer(), Access::kRead},
+              {BWD_BINDING_ALPHA, &b.alpha->buffer(), Access::kRead},
+              {BWD_BINDING_LAST, &b.last->buffer(), Access::kRead},
+              {BWD_BINDING_GRAD_IMAGE, &b.grad_image->buffer(), Access::kRead},
+              {BWD_BINDING_GRAD_DEPTH, &b.grad_depth->buffer(), Access::kRead},
+              {BWD_BINDING_GRAD_ALPHA, &b.grad_alpha->buffer(), Access::kRead},
+              {BWD_BINDING_GRAD2D, &rows, Access::kReadWrite}},
+             view);
+  if (options_.deterministic)
+    s.dispatch(*reduce_, elementwise(n),
+               {{REDUCE_BINDING_ORDER, &b.order->buffer(), Access::kRead},
+                {REDUCE_BINDING_OFFSETS, &b.offsets->buffer(), Access::kRead},
+                {REDUCE_BINDING_COUNTS, &b.counts->buffer(), Access::kRead},
+                {REDUCE_BINDING_ISECT_GRADS, &b.isect_grads->buffer(), Access::kRead},
+                {REDUCE_BINDING_GRAD2D, &b.grad2d->buffer(), Access::kWrite}},
+               view);
+  s.dispatch(*project_backward_, elementwise(n),
+             {{PBWD_BINDING_MEANS, &g.means.buffer(), Access::kRead},
+              {PBWD_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
+              {PBWD_BINDING_QUATS, &g.quats.buffer(), Access::kRead},
+              {PBWD_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kRead},
+              {PBWD_BINDING_SH, &g.sh.buffer(), Access::kRead},
+              {PBWD_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kRead},
+              {PBWD_BINDING_GRAD2D, &b.grad2d->buffer(), Access::kRead},
+              {PBWD_BINDING_GRAD_MEANS, &b.g_means->buffer(), Access::kWrite},
+              {PBWD_BINDING_GRAD_LOG_SCALES, &b.g_log_scales->buffer(), Access::kWrite},
+              {PBWD_BINDING_GRAD_QUATS, &b.g_quats->buffer(), Access::kWrite},
+              {PBWD_BINDING_GRAD_OPACITY_LOGITS, &b.g_logits->buffer(), Access::kWrite},
+              {PBWD_BINDING_GRAD_SH, &b.g_sh->buffer(), Access::kWrite},
+              {PBWD_BINDING_GRAD_MEANS2D, &b.g_means2d->buffer(), Access::kWrite}},
+             view);
+  s.submit_and_wait();
+  append_profile(s);
+}
+
+GaussianGrads<float> Rasterizer::download_grads() const {
+  if (!last_gaussians_ || !buffers_->g_means) throw std::logic_error("Rasterizer::download_grads before backward");
+  const Buffers& b = *buffers_;
+  const size_t n = last_gaussians_->size();
+  const size_t K = (last_gaussians_->sh_degree + 1) * (last_gaussians_->sh_degree + 1);
+  GaussianGrads<float> out;
+  out.means = b.g_means->download(0, 3 * n);
+  out.log_scales = b.g_log_scales->download(0, 3 * n);
+  out.quats = b.g_quats->download(0, 4 * n);
+  out.opacity_logits = b.g_logits->download(0, n);
+  out.sh = b.g_sh->download(0, n * K * channels_);
+  out.means2d = b.g_means2d->download(0, 2 * n);
+  return out;
+}
+
+}  // namespace litgs::kernels

@@ -1,0 +1,81 @@
+// The differentiable Gaussian rasterizer on the device: projection, depth sort, tile binning (a stable
+// tile sort of depth-ordered intersections), forward alpha blending, and backward to every parameter.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "engine/buffer.h"
+#include "engine/context.h"
+#include "engine/kernel.h"
+#include "engine/sequence.h"
+#include "kernels/sort/radix_sort.h"
+#include "kernels/splat/splat_types.h"
+
+namespace litgs::kernels {
+
+struct RasterizerOptions {
+  // Bit-identical gradients run to run: per-intersection gradient rows summed in a fixed order, instead of
+  // float atomics. Slower; for tests and reproducible runs.
+  bool deterministic = false;
+  // Use the compare-and-swap fallback even where VK_EXT_shader_atomic_float exists (tests both paths).
+  bool force_cas_atomics = false;
+};
+
+// A Gaussian model on the device, one buffer per attribute (structure of arrays, each binding bounded).
+struct DeviceGaussians {
+  DeviceGaussians(engine::Context& context, const GaussianModel& model);
+  void upload(const GaussianModel& model);  // same size, channels and degree
+  GaussianModel download() const;
+  size_t size() const { return count; }
+
+  size_t count;
+  uint32_t channels, sh_degree;
+  engine::DeviceArray<float> means;           // [N][3]
+  engine::DeviceArray<float> log_scales;      // [N][3]
+  engine::DeviceArray<float> quats;           // [N][4]
+  engine::DeviceArray<float> opacity_logits;  // [N]
+  engine::DeviceArray<float> sh;              // [N][K][C]
+};
+
+class Rasterizer {
+ public:
+  Rasterizer(engine::Context& context, uint32_t channels, RasterizerOptions options = {});
+  ~Rasterizer();
+
+  // Renders the model from the camera: two submits, with one 8-byte readback (the intersection count)
+  // between them. Outputs stay on the device until downloaded.
+  void forward(const DeviceGaussians& gaussians, const SplatCamera& camera);
+  RenderImages<float> download_images();
+
+  // Gradients of sum(grad . outputs) of the last forward, for the same Gaussians (one submit).
+  void backward(const RenderGradInput& grad);
+  GaussianGrads<float> download_grads() const;
+
+  // Per-kernel GPU times of the last forward (and backward, if run after it).
+  const std::vector<engine::KernelTime>& profile() const { return profile_; }
+  uint64_t intersections() const { return intersections_; }
+  uint32_t channels() const { return channels_; }
+  bool uses_float_atomics() const;
+
+ private:
+  struct Buffers;
+  std::unique_ptr<engine::Kernel> make(const char* name, uint32_t bindings);
+  void append_profile(const engine::Sequence& sequence);
+
+  engine::Context* context_;
+  uint32_t channels_;
+  RasterizerOptions options_;
+  RadixSort sort_;
+  ExclusiveScan scan_;
+  std::unique_ptr<engine::Kernel> project_, gather_, emit_, ranges_, forward_, backward_, reduce_,
+      project_backward_;
+  std::unique_ptr<Buffers> buffers_;
+  const DeviceGaussians* last_gaussians_ = nullptr;
+  SplatCamera last_camera_;
+  uint64_t intersections_ = 0;
+  std::vector<engine::KernelTime> profile_;
+};
+
+}  // namespace litgs::kernels

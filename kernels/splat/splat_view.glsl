@@ -1,0 +1,27 @@
+// The view of every splat kernel, from push constants, as the shared math's ViewGeometry.
+layout(push_constant) uniform Push { SplatView view; };
+
+ViewGeometry view_geometry() {
+  ViewGeometry v;
+  v.R = mat3(view.rot[0], view.rot[1], view.rot[2], view.rot[3], view.rot[4], view.rot[5], view.rot[6],
+             view.rot[7], view.rot[8]);
+  v.t = vec3(view.trans[0], view.trans[1], view.trans[2]);
+  v.fx = view.fx;
+  v.fy = view.fy;
+  v.cx = view.cx;
+  v.cy = view.cy;
+  v.near_m = view.near_m;
+  v.width = float(view.width);
+  v.height = float(view.height);
+  return v;
+}
+
+vec3 camera_centre() {
+  const ViewGeometry v = view_geometry();
+  return -(transpose(v.R) * v.t);
+}
+
+// Model channel count (1 thermal, 3 RGB): a specialization constant so buffers and loops fit the model.
+layout(constant_id = 1) const uint CHANNELS = 1;
+// Gradient values per Gaussian (or intersection) between the per-pixel and per-Gaussian passes.
+const uint GRAD2D_STRIDE = SPLAT_GRAD2D_FIXED + CHANNELS;
