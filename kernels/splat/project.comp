@@ -30,10 +30,12 @@ void main() {
   const vec3 log_scale = vec3(log_scales[3 * i], log_scales[3 * i + 1], log_scales[3 * i + 2]);
   const vec4 quat = vec4(quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]);
   const Projected pr = project_gaussian(view_geometry(), mean, log_scale, quat, opacity_logits[i]);
-  if (!pr.finite) atomicAdd(counters[0], 1u);
+  bool sh_finite = true;
+  for (uint k = 0u; k < view.sh_coeffs * CHANNELS; ++k) sh_finite = sh_finite && is_finite_real(sh[i * view.sh_coeffs * CHANNELS + k]);
+  if (!pr.finite || !sh_finite) atomicAdd(counters[0], 1u);
 
   uvec4 rect = uvec4(0u);
-  if (pr.visible) {
+  if (pr.visible && sh_finite) {
     const float T = float(SPLAT_TILE_SIZE);
     const vec2 lo = floor((pr.mean2d - pr.extent) / T);
     const vec2 hi = floor((pr.mean2d + pr.extent) / T) + 1.0;

@@ -66,8 +66,10 @@ Prepared prepare(const GaussianModel& m, const SplatCamera& cam) {
     const sm::Projected pr =
         sm::project_gaussian(v, vec3_at(m.means, i), vec3_at(m.log_scales, i), vec4_at(m.quats, i), m.opacity_logits[i]);
     p.proj[i] = pr;
-    if (!pr.finite) ++p.culled_nonfinite;
-    if (!pr.visible) continue;
+    bool sh_finite = true;
+    for (uint32_t k = 0; k < K * C; ++k) sh_finite = sh_finite && std::isfinite(m.sh[i * K * C + k]);
+    if (!pr.finite || !sh_finite) ++p.culled_nonfinite;
+    if (!pr.visible || !sh_finite) continue;
     const double T = SPLAT_TILE_SIZE;
     auto clampi = [](double x, uint32_t hi) {
       return static_cast<uint32_t>(std::clamp(x, 0.0, static_cast<double>(hi)));
@@ -99,7 +101,6 @@ Prepared prepare(const GaussianModel& m, const SplatCamera& cam) {
         p.tile_lists[ty * p.tiles_x + tx].push_back(g);
         ++p.intersections;
       }
-  p.culled_nonfinite = p.culled_nonfinite;
   return p;
 }
 
