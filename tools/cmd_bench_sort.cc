@@ -122,11 +122,9 @@ void run_bench_sort(const BenchSortOptions& o) {
 
 }  // namespace
 
-void add_bench_command(CLI::App& app) {
-  CLI::App* bench = app.add_subcommand("bench", "Benchmarks that print figures against a baseline");
-  bench->require_subcommand(1);
+void add_bench_sort_command(CLI::App& bench) {
   auto o = std::make_shared<BenchSortOptions>();
-  CLI::App* sort = bench->add_subcommand("sort", "Device radix sort of random key-value pairs vs std::stable_sort");
+  CLI::App* sort = bench.add_subcommand("sort", "Device radix sort of random key-value pairs vs std::stable_sort");
   sort->add_option("--n", o->n, "Pairs to sort")->capture_default_str();
   sort->add_option("--bits", o->bits, "Low key bits to sort on (1..32)")->capture_default_str();
   sort->add_option("--runs", o->runs, "Timed runs (at least 5) after one warm-up")->capture_default_str();

@@ -1,13 +1,15 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_vote : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_shuffle : require
 // One workgroup per 16x16 tile, one invocation per pixel: alpha-blend the tile's list front to back.
-// Every lane reads the same list entry at a time (uniform loads, no shared memory, no barriers: cheap on
-// CPU drivers, cached on GPUs). A subgroup leaves the loop when all its pixels are done.
 #include "limits.h"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
+#include "splat/footprint.glsl"
 
 layout(local_size_x = SPLAT_TILE_SIZE, local_size_y = SPLAT_TILE_SIZE) in;
 
@@ -25,6 +27,10 @@ layout(std430, binding = FWD_BINDING_ALPHA) writeonly buffer Alpha { float alpha
 layout(std430, binding = FWD_BINDING_LAST) writeonly buffer Last { uint last_out[]; };
 layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]; };
 
+// Each subgroup walks the tile's list on its own, SUBGROUP-wide chunk by chunk: lane k loads entry k of the
+// chunk (one vector load per field), a ballot keeps the entries whose 1/255 footprint reaches the subgroup's
+// pixels, and every lane then reads those entries from lane k by shuffle, in list order. No shared memory,
+// no barriers; on CPU drivers a shuffle is a register permute, far cheaper than a load per entry.
 void main() {
   const uvec2 pixel = gl_GlobalInvocationID.xy;
   const bool inside = pixel.x < view.width && pixel.y < view.height;
@@ -34,31 +40,51 @@ void main() {
   if (gl_LocalInvocationIndex == 0u && end < range.y) atomicAdd(counters[1], 1u);
 
   const vec2 centre = vec2(pixel) + 0.5;
+  const vec2 subgroup_lo = subgroupMin(centre), subgroup_hi = subgroupMax(centre);
   float T = 1.0;
-  float accum[SPLAT_MAX_CHANNELS] = float[SPLAT_MAX_CHANNELS](0.0, 0.0, 0.0, 0.0);
+  vec4 accum = vec4(0.0);  // a vector, not an array: CPU drivers spill dynamically indexed arrays
   float depth_sum = 0.0;
   uint last = 0u;
   bool done = !inside;
-  for (uint i = range.x; i < end; ++i) {
+  for (uint chunk = range.x; chunk < end; chunk += gl_SubgroupSize) {
     if (subgroupAll(done)) break;
-    const uint g = isect_gaussian[isect_ids[i]];
-    if (done) continue;
-    const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
-    const vec2 d = centre - vec2(means2d[2 * g], means2d[2 * g + 1]);
-    const float sigma = gaussian_sigma(conic, d);
-    if (sigma < 0.0) continue;
-    const float alpha = min(float(SPLAT_ALPHA_MAX), opacities[g] * exp(-sigma));
-    if (alpha < float(SPLAT_ALPHA_MIN)) continue;
-    const float next_T = T * (1.0 - alpha);
-    if (next_T < float(SPLAT_T_MIN)) {
-      done = true;
-      continue;
+    // Lane k loads entry chunk + k.
+    const uint entry = chunk + gl_SubgroupInvocationID;
+    vec4 mean_extent = vec4(0.0), conic_opacity = vec4(0.0), color = vec4(0.0);
+    float depth = 0.0;
+    bool relevant = false;
+    if (entry < end) {
+      const uint g = isect_gaussian[isect_ids[entry]];
+      const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
+      const float opacity = opacities[g];
+      mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
+      conic_opacity = vec4(conic, opacity);
+      for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
+      depth = depths[g];
+      relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
     }
-    const float w = alpha * T;
-    for (uint c = 0u; c < CHANNELS; ++c) accum[c] += w * colors[g * CHANNELS + c];
-    depth_sum += w * depths[g];
-    T = next_T;
-    last = i - range.x + 1u;
+    uvec4 todo = subgroupBallot(relevant);
+    for (uint word = 0u; word < 4u; ++word) {
+      while (todo[word] != 0u) {
+        const uint k = 32u * word + uint(findLSB(todo[word]));
+        todo[word] &= todo[word] - 1u;
+        const vec4 me = subgroupShuffle(mean_extent, k);
+        const vec4 co = subgroupShuffle(conic_opacity, k);
+        const vec2 d = centre - me.xy;
+        const float sigma = gaussian_sigma(co.xyz, d);
+        const float alpha = min(float(SPLAT_ALPHA_MAX), co.w * exp(-min(sigma, SIGMA_CUTOFF)));
+        const float next_T = T * (1.0 - alpha);
+        // Predicated rather than branched: CPU drivers run the lanes as one SIMD register.
+        const bool hit = !done && sigma >= 0.0 && alpha >= float(SPLAT_ALPHA_MIN);
+        const bool stop = hit && next_T < float(SPLAT_T_MIN);
+        done = done || stop;
+        const float w = hit && !stop ? alpha * T : 0.0;
+        accum += w * subgroupShuffle(color, k);
+        depth_sum += w * subgroupShuffle(depth, k);
+        T = hit && !stop ? next_T : T;
+        last = hit && !stop ? chunk + k - range.x + 1u : last;
+      }
+    }
   }
   if (!inside) return;
   const uint pix = pixel.y * view.width + pixel.x;

@@ -1,0 +1,112 @@
+// `litgs-engine bench render`: forward and forward+backward of the rasterizer on a seeded random scene.
+#include <CLI/CLI.hpp>
+
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <stdexcept>
+
+#include "engine/context.h"
+#include "kernels/splat/rasterizer.h"
+#include "tools/bench_scene.h"
+#include "tools/bench_stats.h"
+#include "tools/commands.h"
+#include "tools/device_json.h"
+
+namespace litgs::tools {
+namespace {
+
+struct BenchRenderOptions {
+  uint32_t gaussians = 100000;
+  uint32_t width = 640, height = 512;
+  uint32_t sh_degree = 3;
+  uint32_t channels = 1;
+  bool backward = false;
+  bool deterministic = false;
+  uint32_t runs = 5;  // timed runs after one warm-up
+  uint32_t seed = 1;
+  bool json = false;
+  void check() const {
+    if (sh_degree > 3) throw std::invalid_argument("--sh-degree must be 0..3");
+    if (channels < 1 || channels > 4) throw std::invalid_argument("--channels must be 1..4");
+    if (width == 0 || height == 0) throw std::invalid_argument("--width and --height must be positive");
+    if (runs < 1) throw std::invalid_argument("--runs must be at least 1");
+  }
+};
+
+void run_bench_render(const BenchRenderOptions& o) {
+  o.check();
+  engine::Context context;
+  const kernels::GaussianModel model = bench_scene(o.gaussians, o.channels, o.sh_degree, o.width, o.height, o.seed);
+  const kernels::SplatCamera camera = bench_camera(o.width, o.height, o.sh_degree);
+  kernels::DeviceGaussians gaussians(context, model);
+  kernels::RasterizerOptions options;
+  options.deterministic = o.deterministic;
+  kernels::Rasterizer rasterizer(context, o.channels, options);
+
+  kernels::RenderGradInput grad;
+  std::mt19937 rng(o.seed + 1);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  grad.image.resize(size_t{o.channels} * o.width * o.height);
+  for (auto& g : grad.image) g = u(rng);
+  grad.depth.assign(size_t{o.width} * o.height, 0.0f);
+  grad.alpha.assign(size_t{o.width} * o.height, 0.0f);
+
+  std::vector<double> forward_ms, total_ms;
+  for (uint32_t r = 0; r <= o.runs; ++r) {
+    const double f = time_ms([&] { rasterizer.forward(gaussians, camera); });
+    const double b = o.backward ? time_ms([&] { rasterizer.backward(grad); }) : 0.0;
+    if (r == 0) continue;  // warm-up: buffers grow, pipelines warm
+    forward_ms.push_back(f);
+    total_ms.push_back(f + b);
+  }
+  const auto& profile = rasterizer.profile();
+  if (o.json) {
+    nlohmann::json kernels = nlohmann::json::array();
+    for (const auto& k : profile) kernels.push_back({{"name", k.name}, {"ms", k.ms}, {"dispatches", k.dispatches}});
+    nlohmann::json j = {{"gaussians", o.gaussians},       {"width", o.width},
+                        {"height", o.height},             {"sh_degree", o.sh_degree},
+                        {"channels", o.channels},         {"runs", o.runs},
+                        {"forward_ms", median(forward_ms)}, {"intersections", rasterizer.intersections()},
+                        {"kernels", kernels},             {"device", device_json(context.info())}};
+    if (o.backward) j["forward_backward_ms"] = median(total_ms);
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  std::cout << std::fixed << std::setprecision(2) << "bench render: " << o.gaussians << " Gaussians, " << o.width
+            << "x" << o.height << ", " << o.channels << " channel(s), SH degree " << o.sh_degree << ", median of "
+            << o.runs << " runs after a warm-up, on " << context.info().name << "\n"
+            << "  intersections        " << rasterizer.intersections() << "\n"
+            << "  forward              " << median(forward_ms) << " ms\n";
+  if (o.backward)
+    std::cout << "  forward + backward   " << median(total_ms) << " ms"
+              << (o.deterministic ? " (deterministic)" : rasterizer.uses_float_atomics() ? " (float atomics)"
+                                                                                        : " (CAS atomics)")
+              << "\n";
+  std::cout << "  per kernel (last run, GPU timestamps):\n";
+  for (const auto& k : profile)
+    std::cout << "    " << std::left << std::setw(42) << k.name << std::right << std::setw(3) << k.dispatches
+              << "x " << std::setw(9) << k.ms << " ms\n";
+}
+
+}  // namespace
+
+void add_bench_render_command(CLI::App& bench) {
+  auto o = std::make_shared<BenchRenderOptions>();
+  CLI::App* cmd = bench.add_subcommand("render", "Rasterizer forward (and backward) on a seeded random scene");
+  cmd->add_option("--gaussians", o->gaussians, "Number of Gaussians")->capture_default_str();
+  cmd->add_option("--width", o->width, "Image width")->capture_default_str();
+  cmd->add_option("--height", o->height, "Image height")->capture_default_str();
+  cmd->add_option("--sh-degree", o->sh_degree, "SH degree 0..3")->capture_default_str();
+  cmd->add_option("--channels", o->channels, "Channels (1 thermal, 3 RGB)")->capture_default_str();
+  cmd->add_flag("--backward", o->backward, "Also time forward + backward");
+  cmd->add_flag("--deterministic", o->deterministic, "Deterministic backward (no float atomics)");
+  cmd->add_option("--runs", o->runs, "Timed runs after one warm-up")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Scene seed")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print one JSON object");
+  cmd->callback([o] { run_bench_render(*o); });
+}
+
+}  // namespace litgs::tools
