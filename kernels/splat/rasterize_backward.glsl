@@ -38,16 +38,66 @@ layout(std430, binding = BWD_BINDING_GRAD2D) buffer Grad2d { uint grad2d_bits[];
 layout(std430, binding = BWD_BINDING_GRAD2D) buffer Grad2d { float grad2d[]; };
 #endif
 
-#if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
-const uint MAX_SUBGROUPS = (SPLAT_TILE_SIZE * SPLAT_TILE_SIZE);  // subgroups of one lane at worst
-shared float s_partial[MAX_SUBGROUPS][SPLAT_GRAD2D_FIXED + SPLAT_MAX_CHANNELS];
-shared uint s_walk;
-#endif
+#include "splat/footprint.glsl"
 
+// The gradient values of one entry for one pixel, as three vectors (no arrays: CPU drivers spill them):
+// g0 = dL/d(mean2d.x, mean2d.y, conic.a, conic.b), g1 = dL/d(conic.c, opacity, depth, -), g2 = dL/d(colour).
+struct EntryGrad {
+  vec4 g0, g1, g2;
+};
+
+// One list entry, walked back to front. `in_walk`: the entry lies within this pixel's forward walk.
+// Updates the running transmittance and the sums of what lies behind. Predicated, not branched.
+EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4 color, float depth, bool in_walk,
+                         float T_final, vec4 dL_dC, float dL_dN, float dL_dA, inout float T, inout vec4 acc_c,
+                         inout float acc_z) {
+  const vec2 d = centre - mean_extent.xy;
+  const float sigma = gaussian_sigma(conic_opacity.xyz, d);
+  const float vis = exp(-min(sigma, SIGMA_CUTOFF));
+  const float raw = conic_opacity.w * vis;
+  const float alpha = min(float(SPLAT_ALPHA_MAX), raw);
+  const bool hit = in_walk && sigma >= 0.0 && alpha >= float(SPLAT_ALPHA_MIN);
+  const float one_minus = 1.0 - alpha;
+  const float Ti = T / one_minus;
+  const float w = hit ? alpha * Ti : 0.0;
+  float dL_dalpha = dot(dL_dC, color * Ti - acc_c / one_minus) + dL_dN * (depth * Ti - acc_z / one_minus) +
+                    dL_dA * T_final / one_minus;
+  dL_dalpha = hit && raw <= float(SPLAT_ALPHA_MAX) ? dL_dalpha : 0.0;  // the 0.99 clamp has no gradient
+  const float dL_dsigma = -dL_dalpha * alpha;
+  EntryGrad r;
+  r.g0 = vec4(-dL_dsigma * (conic_opacity.x * d.x + conic_opacity.y * d.y),
+              -dL_dsigma * (conic_opacity.y * d.x + conic_opacity.z * d.y), dL_dsigma * 0.5 * d.x * d.x,
+              dL_dsigma * d.x * d.y);
+  r.g1 = vec4(dL_dsigma * 0.5 * d.y * d.y, dL_dalpha * vis, w * dL_dN, 0.0);
+  r.g2 = w * dL_dC;
+  acc_c += w * color;
+  acc_z += w * depth;
+  T = hit ? Ti : T;
+  return r;
+}
+
+// Loads list entry `i`'s Gaussian.
+void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity, out vec4 color, out float depth) {
+  g = isect_gaussian[isect_ids[i]];
+  const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
+  const float opacity = opacities[g];
+  mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
+  conic_opacity = vec4(conic, opacity);
+  color = vec4(0.0);
+  for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
+  depth = depths[g];
+}
+
+#if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
+const uint MAX_SUBGROUPS = SPLAT_TILE_SIZE * SPLAT_TILE_SIZE;  // subgroups of one lane at worst
+shared vec4 s_partial[MAX_SUBGROUPS][3];
+shared uint s_walk;
+#else
 void add_to(uint index, float value) {
+  if (value == 0.0) return;
 #if SPLAT_BWD_MODE == SPLAT_BWD_FLOAT_ATOMICS
   atomicAdd(grad2d[index], value);
-#elif SPLAT_BWD_MODE == SPLAT_BWD_CAS_ATOMICS
+#else
   uint expected = grad2d_bits[index];
   for (;;) {
     const uint desired = floatBitsToUint(uintBitsToFloat(expected) + value);
@@ -57,6 +107,14 @@ void add_to(uint index, float value) {
   }
 #endif
 }
+
+void add_entry_grads(uint g, vec4 a0, vec4 a1, vec4 a2) {
+  const uint base = g * GRAD2D_STRIDE;
+  for (uint k = 0u; k < 4u; ++k) add_to(base + k, a0[k]);
+  for (uint k = 0u; k < 3u; ++k) add_to(base + 4u + k, a1[k]);
+  for (uint c = 0u; c < CHANNELS; ++c) add_to(base + SPLAT_GRAD2D_FIXED + c, a2[c]);
+}
+#endif
 
 void main() {
   const uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -75,85 +133,85 @@ void main() {
   const float D = inside ? fwd_depth[pix] : 0.0;
   const float dL_dN = has_depth ? g_depth / A : 0.0;
   const float dL_dA = (inside ? grad_alpha[pix] : 0.0) - (has_depth ? g_depth * D / A : 0.0);
-  float dL_dC[SPLAT_MAX_CHANNELS] = float[SPLAT_MAX_CHANNELS](0.0, 0.0, 0.0, 0.0);
+  vec4 dL_dC = vec4(0.0);
   for (uint c = 0u; c < CHANNELS; ++c) dL_dC[c] = inside ? grad_image[c * plane + pix] : 0.0;
 
-  // How far back to walk: this subgroup's longest walk (atomic modes) or the tile's (deterministic mode,
-  // where every subgroup must take part in every step's workgroup sum).
+  float T = T_final;
+  vec4 acc_c = vec4(0.0);
+  float acc_z = 0.0;
+
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
+  // Every subgroup takes part in every entry's workgroup sum, in a fixed order: the same bits every run.
   if (gl_LocalInvocationIndex == 0u) s_walk = 0u;
   barrier();
   atomicMax(s_walk, my_last);
   barrier();
   const uint walk = s_walk;
-#else
-  const uint walk = subgroupMax(my_last);
-#endif
-
-  float T = T_final;
-  float acc_c[SPLAT_MAX_CHANNELS] = float[SPLAT_MAX_CHANNELS](0.0, 0.0, 0.0, 0.0);
-  float acc_z = 0.0;
   for (uint j = walk; j > 0u; --j) {
+    uint g;
+    vec4 mean_extent, conic_opacity, color;
+    float depth;
+    load_entry(range.x + j - 1u, g, mean_extent, conic_opacity, color, depth);
     const uint e = isect_ids[range.x + j - 1u];
-    const uint g = isect_gaussian[e];
-    float v[SPLAT_GRAD2D_FIXED + SPLAT_MAX_CHANNELS];
-    for (uint k = 0u; k < GRAD2D_STRIDE; ++k) v[k] = 0.0;
-    bool contributes = false;
-    if (j <= my_last) {
-      const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
-      const vec2 d = centre - vec2(means2d[2 * g], means2d[2 * g + 1]);
-      const float sigma = gaussian_sigma(conic, d);
-      const float vis = exp(-sigma);
-      const float raw = opacities[g] * vis;
-      const float alpha = min(float(SPLAT_ALPHA_MAX), raw);
-      if (sigma >= 0.0 && alpha >= float(SPLAT_ALPHA_MIN)) {
-        contributes = true;
-        const float one_minus = 1.0 - alpha;
-        const float Ti = T / one_minus;
-        const float w = alpha * Ti;
-        float dL_dalpha = 0.0;
-        for (uint c = 0u; c < CHANNELS; ++c) {
-          const float color = colors[g * CHANNELS + c];
-          v[SPLAT_GRAD2D_FIXED + c] = w * dL_dC[c];
-          dL_dalpha += dL_dC[c] * (color * Ti - acc_c[c] / one_minus);
-          acc_c[c] += w * color;
-        }
-        const float z = depths[g];
-        v[6] = w * dL_dN;
-        dL_dalpha += dL_dN * (z * Ti - acc_z / one_minus) + dL_dA * T_final / one_minus;
-        acc_z += w * z;
-        T = Ti;
-        if (raw <= float(SPLAT_ALPHA_MAX)) {
-          v[5] = dL_dalpha * vis;
-          const float dL_dsigma = -dL_dalpha * alpha;
-          v[2] = dL_dsigma * 0.5 * d.x * d.x;
-          v[3] = dL_dsigma * d.x * d.y;
-          v[4] = dL_dsigma * 0.5 * d.y * d.y;
-          v[0] = -dL_dsigma * (conic.x * d.x + conic.y * d.y);
-          v[1] = -dL_dsigma * (conic.y * d.x + conic.z * d.y);
-        }
-      }
-    }
-#if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
-    for (uint k = 0u; k < GRAD2D_STRIDE; ++k) {
-      const float sum = subgroupAdd(v[k]);
-      if (subgroupElect()) s_partial[gl_SubgroupID][k] = sum;
+    const EntryGrad r = entry_backward(centre, mean_extent, conic_opacity, color, depth, j <= my_last, T_final,
+                                       dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
+    const vec4 s0 = subgroupAdd(r.g0), s1 = subgroupAdd(r.g1), s2 = subgroupAdd(r.g2);
+    if (subgroupElect()) {
+      s_partial[gl_SubgroupID][0] = s0;
+      s_partial[gl_SubgroupID][1] = s1;
+      s_partial[gl_SubgroupID][2] = s2;
     }
     barrier();
-    // Fixed order over subgroups: the same sum every run.
-    if (gl_LocalInvocationIndex < GRAD2D_STRIDE) {
-      float total = 0.0;
+    if (gl_LocalInvocationIndex < 3u) {
+      vec4 total = vec4(0.0);
       for (uint sg = 0u; sg < gl_NumSubgroups; ++sg) total += s_partial[sg][gl_LocalInvocationIndex];
-      grad2d[e * GRAD2D_STRIDE + gl_LocalInvocationIndex] = total;
+      const uint base = e * GRAD2D_STRIDE;
+      if (gl_LocalInvocationIndex == 0u)
+        for (uint k = 0u; k < 4u; ++k) grad2d[base + k] = total[k];
+      else if (gl_LocalInvocationIndex == 1u)
+        for (uint k = 0u; k < 3u; ++k) grad2d[base + 4u + k] = total[k];
+      else
+        for (uint c = 0u; c < CHANNELS; ++c) grad2d[base + SPLAT_GRAD2D_FIXED + c] = total[c];
     }
     barrier();
+  }
 #else
-    if (subgroupAny(contributes)) {
-      for (uint k = 0u; k < GRAD2D_STRIDE; ++k) {
-        const float sum = subgroupAdd(v[k]);
-        if (subgroupElect() && sum != 0.0) add_to(g * GRAD2D_STRIDE + k, sum);
+  // Each subgroup walks back from its longest walk, a subgroup-wide chunk at a time: lane k loads entry k
+  // of the chunk, a ballot keeps entries whose footprint reaches the subgroup, and the lanes take them from
+  // lane k by shuffle, last to first. Lane k gathers its entry's subgroup sums and adds them once.
+  const uint walk = subgroupMax(my_last);
+  const uint S = gl_SubgroupSize;
+  const vec2 subgroup_lo = subgroupMin(centre), subgroup_hi = subgroupMax(centre);
+  for (uint chunk_end = walk; chunk_end > 0u; chunk_end = chunk_end > S ? chunk_end - S : 0u) {
+    const uint chunk_start = chunk_end > S ? chunk_end - S : 0u;
+    const uint rel = chunk_start + gl_SubgroupInvocationID;  // entry position within the tile's list
+    uint g = 0u;
+    vec4 mean_extent = vec4(0.0), conic_opacity = vec4(0.0), color = vec4(0.0);
+    float depth = 0.0;
+    bool relevant = false;
+    if (rel < chunk_end) {
+      load_entry(range.x + rel, g, mean_extent, conic_opacity, color, depth);
+      relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
+    }
+    vec4 a0 = vec4(0.0), a1 = vec4(0.0), a2 = vec4(0.0);
+    uvec4 todo = subgroupBallot(relevant);
+    for (int word = 3; word >= 0; --word) {
+      while (todo[word] != 0u) {
+        const uint bit = uint(findMSB(todo[word]));
+        todo[word] &= ~(1u << bit);
+        const uint k = 32u * uint(word) + bit;
+        const EntryGrad r = entry_backward(centre, subgroupShuffle(mean_extent, k), subgroupShuffle(conic_opacity, k),
+                                           subgroupShuffle(color, k), subgroupShuffle(depth, k),
+                                           chunk_start + k < my_last, T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
+        const vec4 s0 = subgroupAdd(r.g0), s1 = subgroupAdd(r.g1), s2 = subgroupAdd(r.g2);
+        if (gl_SubgroupInvocationID == k) {
+          a0 += s0;
+          a1 += s1;
+          a2 += s2;
+        }
       }
     }
-#endif
+    if (relevant) add_entry_grads(g, a0, a1, a2);
   }
+#endif
 }

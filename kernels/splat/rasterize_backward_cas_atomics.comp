@@ -3,6 +3,8 @@
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+#extension GL_KHR_shader_subgroup_shuffle : require
 
 // Backward of the per-pixel pass; see rasterize_backward.glsl.
 #define SPLAT_BWD_MODE SPLAT_BWD_CAS_ATOMICS
