@@ -34,7 +34,7 @@ struct SceneConfig {
   CameraIntrinsics camera;
   Eigen::Matrix4d T_cam_lidar = Eigen::Matrix4d::Identity();  // maps LiDAR points into the camera frame
   Eigen::Matrix4d T_imu_lidar = Eigen::Matrix4d::Identity();  // maps LiDAR points into the IMU frame
-  double time_offset_cam_lidar_s = 0;  // a camera stamp t_cam is LiDAR time t_cam + offset
+  double time_offset_cam_lidar_s = 0;  // seconds: the LiDAR-clock time of a camera stamp is t_cam + offset
   PoseFrame poses_frame = PoseFrame::kCamera;
   bool has_lidar_map = true;  // false: the scene has no lidar/map.pcd (e.g. a photogrammetry import)
   // Recentring: original world coordinates = scene world coordinates + world_offset_m (keeps float32 work

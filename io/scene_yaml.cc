@@ -214,7 +214,7 @@ void write_scene_yaml(const std::filesystem::path& path, const SceneConfig& c) {
     out << "T_imu_lidar:  # maps LiDAR points into the IMU frame\n";
     for (int r = 0; r < 4; ++r) out << "  - " << row_text(c.T_imu_lidar, r) << "\n";
     out << "time_offset_cam_lidar_s: " << format_double(c.time_offset_cam_lidar_s)
-        << "  # camera stamp t is LiDAR time t + offset\n"
+        << "  # seconds: t_lidar = t_cam + offset\n"
         << "poses_frame: " << (c.poses_frame == PoseFrame::kCamera ? "camera" : "imu")
         << "  # poses.txt holds T_world_cam (camera) or T_world_imu (imu)\n"
         << "lidar_map: " << (c.has_lidar_map ? "true" : "false") << "  # lidar/map.pcd present\n"

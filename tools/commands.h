@@ -9,5 +9,6 @@ namespace litgs::tools {
 
 void add_info_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_import_command(CLI::App& app);
 
 }  // namespace litgs::tools
