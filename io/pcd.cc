@@ -1,5 +1,6 @@
 #include "io/pcd.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -96,7 +97,8 @@ Header parse_header(const std::filesystem::path& path, const std::string& bytes)
       for (size_t i = 1; i < t.size(); ++i) types.emplace_back(t[i]);
     } else if (key == "COUNT") {
       counts_line = line_no;
-      for (size_t i = 1; i < t.size(); ++i) counts.push_back(as_size(t[i], "COUNT"));
+      for (size_t i = 1; i < t.size(); ++i)
+        counts.push_back(static_cast<size_t>(parse_int(t[i], path, line_no, "COUNT", 0, 1 << 20)));
     } else if (key == "WIDTH") {
       count_values(1);
       width = as_size(t[1], "WIDTH");
@@ -216,7 +218,7 @@ PointCloud read_pcd(const std::filesystem::path& path, const PcdReadOptions& opt
   std::vector<size_t> step(nf);
   std::string decompressed;
   if (h.kind == DataKind::kBinary) {
-    if (data_size < h.points * h.stride)
+    if (h.points > data_size / h.stride)  // (division: a forged POINTS must not overflow the product)
       fail_at_byte(path, h.data_offset,
                    "truncated: " + std::to_string(h.points) + " points of " + std::to_string(h.stride) +
                        " bytes need " + std::to_string(h.points * h.stride) +
@@ -227,7 +229,7 @@ PointCloud read_pcd(const std::filesystem::path& path, const PcdReadOptions& opt
     uint32_t compressed = 0, uncompressed = 0;
     std::memcpy(&compressed, data, 4);
     std::memcpy(&uncompressed, data + 4, 4);
-    if (uncompressed != h.points * h.stride)
+    if (h.points > 0xFFFFFFFFu / h.stride || uncompressed != h.points * h.stride)
       fail_at_byte(path, h.data_offset + 4,
                    "uncompressed size " + std::to_string(uncompressed) + " differs from POINTS*point size " +
                        std::to_string(h.points * h.stride));
@@ -250,9 +252,12 @@ PointCloud read_pcd(const std::filesystem::path& path, const PcdReadOptions& opt
   }
 
   PointCloud cloud;
-  cloud.positions.reserve(h.points);
-  if (l.intensity >= 0) cloud.intensity.reserve(h.points);
-  if (l.nx >= 0) cloud.normals.reserve(h.points);
+  // An ascii point takes at least two bytes per value: never trust POINTS for the allocation alone.
+  const size_t expected =
+      h.kind == DataKind::kAscii ? std::min(h.points, data_size / (2 * h.tokens) + 1) : h.points;
+  cloud.positions.reserve(expected);
+  if (l.intensity >= 0) cloud.intensity.reserve(expected);
+  if (l.nx >= 0) cloud.normals.reserve(expected);
   for (int e : l.extra) cloud.extra.push_back({h.fields[e].name, {}});
 
   std::vector<double> v(nf);

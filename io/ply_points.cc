@@ -1,5 +1,6 @@
 #include "io/ply_points.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "io/error.h"
@@ -138,8 +139,9 @@ PointCloud read_ply_points(const std::filesystem::path& path) {
       if (ix < 0 || iy < 0 || iz < 0) fail(path, header_lines, "the vertex element lacks one of x y z");
       const int normals = (inx >= 0) + (iny >= 0) + (inz >= 0);
       if (normals != 0 && normals != 3) fail(path, header_lines, "nx ny nz must come together");
-      cloud.positions.reserve(el.count);
-      if (ii >= 0) cloud.intensity.reserve(el.count);
+      const size_t expected = std::min(el.count, bytes.size());  // a forged count must not allocate terabytes
+      cloud.positions.reserve(expected);
+      if (ii >= 0) cloud.intensity.reserve(expected);
       for (int k : extra) cloud.extra.push_back({el.properties[k].name, {}});
     }
     values.assign(el.properties.size(), 0.0);
@@ -185,7 +187,8 @@ PointCloud read_ply_points(const std::filesystem::path& path) {
             need(scalar_size(p.count_type));
             const double n = read_scalar(data + pos, p.count_type, big);
             pos += scalar_size(p.count_type);
-            if (!(n >= 0)) fail_at_byte(path, pos, "negative list length");
+            if (!(n >= 0) || n > static_cast<double>(bytes.size()))
+              fail_at_byte(path, pos, "list length " + format_double(n) + " is impossible");
             need(static_cast<size_t>(n) * scalar_size(p.type));
             pos += static_cast<size_t>(n) * scalar_size(p.type);
           } else {

@@ -113,6 +113,17 @@ TEST_F(PcdTest, HeaderErrorsNameTheLine) {
   testing::expect_io_error([&] { read_pcd(dir_ / "missing.pcd"); }, {"missing.pcd", "does not exist"});
 }
 
+TEST_F(PcdTest, ForgedPointCountsFailWithoutHugeAllocations) {
+  const std::string head = "FIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nWIDTH 1099511627775\nHEIGHT 1\n";
+  testing::expect_io_error([&] { read_pcd(write_text("b.pcd", head + "DATA binary\n0123456789")); },
+                           {"b.pcd", "truncated", "1099511627775 points"});
+  testing::expect_io_error([&] { read_pcd(write_text("a.pcd", head + "DATA ascii\n1 2 3\n")); },
+                           {"a.pcd:8:", "truncated", "1 present"});
+  testing::expect_io_error(
+      [&] { read_pcd(write_text("c.pcd", head + "DATA binary_compressed\n" + std::string(8, '\xff'))); },
+      {"c.pcd", "uncompressed size"});
+}
+
 TEST_F(PcdTest, AsciiValueErrorsNameTheLine) {
   const std::string head = "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 2\nHEIGHT 1\nDATA ascii\n";
   testing::expect_io_error([&] { read_pcd(write_text("t.pcd", head + "1 2 3\n4 5\n")); },

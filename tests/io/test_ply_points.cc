@@ -73,6 +73,20 @@ TEST_F(PlyTest, CorruptFilesHaveClearErrors) {
       {"f.ply:4:", "unknown property type 'half'"});
 }
 
+TEST_F(PlyTest, ForgedCountsFailWithoutHugeAllocations) {
+  const std::string head =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 1099511627775\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  testing::expect_io_error([&] { read_ply_points(write_text("v.ply", head + "0123456789ab")); },
+                           {"v.ply", "truncated", "entry 1 of 1099511627775"});
+  const std::string faces =
+      "ply\nformat binary_little_endian 1.0\nelement face 1\n"
+      "property list uint int vertex_indices\nelement vertex 0\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  testing::expect_io_error([&] { read_ply_points(write_text("f.ply", faces + std::string(4, '\xff'))); },
+                           {"f.ply", "list length 4294967295 is impossible"});
+}
+
 TEST_F(PlyTest, SkipsFacesAndReadsBigEndian) {
   std::string s =
       "ply\nformat binary_big_endian 1.0\nelement face 1\nproperty list uchar int vertex_indices\n"
