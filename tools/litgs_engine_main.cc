@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   litgs::tools::add_info_command(app);
   litgs::tools::add_bench_command(app);
+  litgs::tools::add_import_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

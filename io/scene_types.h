@@ -1,0 +1,83 @@
+// The value types of a scene directory (see docs/scene-format.md), apart from the files' readers.
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/point_cloud.h"
+#include "io/tum.h"
+
+namespace litgs::io {
+
+enum class CameraModel {
+  kPinhole,      // distortion: OpenCV radtan k1 k2 p1 p2 [k3] (or none)
+  kEquidistant,  // fisheye (OpenCV fisheye / Kalibr equidistant): k1 k2 k3 k4 (or none)
+};
+
+// Which moving frame the poses of poses.txt describe: T_world_cam or T_world_imu.
+enum class PoseFrame { kCamera, kImu };
+
+// The thermal camera. Pixel coordinates put the centre of the top-left pixel at (0, 0) (OpenCV).
+struct CameraIntrinsics {
+  CameraModel model = CameraModel::kPinhole;
+  int width = 0, height = 0;              // pixels
+  double fx = 0, fy = 0, cx = 0, cy = 0;  // pixels
+  std::vector<double> distortion;         // see CameraModel; empty = none
+  int bit_depth = 16;                     // of the thermal images: 8 or 16
+};
+
+// scene.yaml. Units are fixed: metres, seconds, radians.
+struct SceneConfig {
+  CameraIntrinsics camera;
+  Eigen::Matrix4d T_cam_lidar = Eigen::Matrix4d::Identity();  // maps LiDAR points into the camera frame
+  Eigen::Matrix4d T_imu_lidar = Eigen::Matrix4d::Identity();  // maps LiDAR points into the IMU frame
+  double time_offset_cam_lidar_s = 0;  // seconds: the LiDAR-clock time of a camera stamp is t_cam + offset
+  PoseFrame poses_frame = PoseFrame::kCamera;
+  bool has_lidar_map = true;  // false: the scene has no lidar/map.pcd (e.g. a photogrammetry import)
+  // Recentring: original world coordinates = scene world coordinates + world_offset_m (keeps float32 work
+  // near the origin for data sets that sit far from it).
+  Eigen::Vector3d world_offset_m = Eigen::Vector3d::Zero();
+  std::string source;  // free text: where the scene came from
+};
+
+// One thermal frame: thermal/<t_s>.png|.tiff (the stem is the timestamp).
+struct SceneFrame {
+  double t_s = 0;
+  std::filesystem::path image;  // relative to the scene directory
+};
+
+// One LiDAR scan in its sensor frame: lidar/scans/<t_s>.pcd. Listed by the reader, loaded on demand.
+struct SceneScan {
+  double t_s = 0;
+  std::filesystem::path file;  // relative to the scene directory
+};
+
+struct ImuSample {
+  double t_s = 0;
+  Eigen::Vector3d gyro_rad_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_m_s2 = Eigen::Vector3d::Zero();
+};
+
+// A visual map point of the upstream estimator with its 3x3 covariance (symmetric positive definite).
+struct Anchor {
+  Eigen::Vector3d p_world = Eigen::Vector3d::Zero();  // metres
+  Eigen::Matrix3d cov_m2 = Eigen::Matrix3d::Identity();
+};
+
+// A plane n . x + d = 0 in the world frame, |n| = 1.
+struct Plane {
+  Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
+  double d = 0;
+};
+
+// gt/: whatever ground truth the scene has (synthetic scenes: all of it).
+struct GroundTruth {
+  std::vector<TumPose> poses;     // gt/poses.txt, same frame as poses.txt (empty if absent)
+  std::optional<PointCloud> map;  // gt/map.pcd
+  std::vector<Plane> planes;      // gt/planes.txt
+};
+
+}  // namespace litgs::io

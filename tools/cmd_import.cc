@@ -1,0 +1,43 @@
+// `litgs-engine import metashape --xml FILE --images DIR --out SCENE`: other tools' outputs into a scene
+// directory (docs/scene-format.md). CPU only: no Vulkan device is created.
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <memory>
+
+#include "io/import_metashape.h"
+#include "tools/commands.h"
+
+namespace litgs::tools {
+
+void add_import_command(CLI::App& app) {
+  CLI::App* import = app.add_subcommand("import", "Convert another tool's output into a scene directory");
+  import->require_subcommand(1);
+
+  auto o = std::make_shared<io::MetashapeImportOptions>();
+  auto offset = std::make_shared<std::vector<double>>();
+  CLI::App* ms = import->add_subcommand("metashape", "Agisoft Metashape camera XML plus its images");
+  ms->add_option("--xml", o->xml, "Camera XML (File > Export > Cameras)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  ms->add_option("--images", o->images, "Folder of <camera label>.tiff|.tif|.png")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  ms->add_option("--out", o->out, "Scene directory to write")->required();
+  ms->add_option("--calibration", o->calibration, "Stand-alone calibration XML replacing the sensor's own")
+      ->check(CLI::ExistingFile);
+  ms->add_option("--world-offset", *offset,
+                 "Recentring offset X Y Z in metres (default: mean camera centre, rounded to metres)")
+      ->expected(3);
+  ms->add_option("--image-format", o->image_extension, "Extension of the written frames: .png or .tiff")
+      ->capture_default_str();
+  ms->callback([o, offset] {
+    if (!offset->empty()) o->world_offset_m = Eigen::Vector3d((*offset)[0], (*offset)[1], (*offset)[2]);
+    const io::MetashapeImportReport r = io::import_metashape(*o);
+    std::cout << "import metashape: " << r.frames << " frames into " << o->out.string() << " ("
+              << r.skipped_unaligned << " unaligned cameras skipped), world offset [" << r.world_offset_m.x()
+              << ", " << r.world_offset_m.y() << ", " << r.world_offset_m.z() << "] m\n";
+    for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
+  });
+}
+
+}  // namespace litgs::tools
