@@ -35,7 +35,9 @@ struct Reader {
   void only_keys(const YAML::Node& map, const std::set<std::string>& keys, const std::string& where) const {
     if (!map.IsMap()) fail(path, line(map), "'" + where + "' must be a mapping");
     for (const auto& kv : map) {
-      const std::string k = kv.first.as<std::string>();
+      if (!kv.first.IsScalar())
+        fail(path, line(kv.first), "'" + where + "' has a key that is not a plain name");
+      const std::string k = kv.first.Scalar();
       if (!keys.count(k)) fail(path, line(kv.first), "unknown key '" + where + k + "'");
     }
   }
@@ -127,7 +129,21 @@ std::string check_scene_config(const SceneConfig& c) {
   return {};
 }
 
+namespace {
+SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path);
+}  // namespace
+
 SceneConfig read_scene_yaml(const std::filesystem::path& path) {
+  try {
+    return read_scene_yaml_unguarded(path);
+  } catch (const YAML::Exception& e) {  // anything yaml-cpp throws past our own checks (bad conversions, ...)
+    fail(path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "YAML: " + e.msg);
+  }
+}
+
+namespace {
+
+SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) fail(path, 0, "file does not exist");
   YAML::Node root;
   try {
@@ -191,6 +207,8 @@ SceneConfig read_scene_yaml(const std::filesystem::path& path) {
   if (!problem.empty()) fail(path, r.line(root), problem);
   return c;
 }
+
+}  // namespace
 
 void write_scene_yaml(const std::filesystem::path& path, const SceneConfig& c) {
   const std::string problem = check_scene_config(c);

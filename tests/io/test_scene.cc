@@ -234,6 +234,11 @@ TEST_F(SceneTest, BadSceneYamlNamesTheLine) {
   testing::expect_io_error([&] { read_scene(dir_); }, {"scene.yaml:4:", "only 'm'"});
   replace("camera:\n", "camera: [\n");
   testing::expect_io_error([&] { read_scene(dir_); }, {"scene.yaml:", "YAML syntax"});
+  // Found by the mutation test: a key that is not a plain name made yaml-cpp throw its own exception.
+  write_text("scene.yaml", "format: litgs-scene\n[a, b]: 1\n");
+  testing::expect_io_error([&] { read_scene(dir_); }, {"scene.yaml:2:", "not a plain name"});
+  write_text("scene.yaml", "just text\n");
+  testing::expect_io_error([&] { read_scene(dir_); }, {"scene.yaml:1:", "must be a mapping"});
   write_text("scene.yaml", good);
   EXPECT_NO_THROW(read_scene(dir_));
 }
