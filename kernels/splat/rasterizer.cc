@@ -280,11 +280,6 @@ RenderImages<float> Rasterizer::download_images() {
 
 void Rasterizer::backward(const RenderGradInput& grad) {
   if (!last_gaussians_) throw std::logic_error("Rasterizer::backward before forward");
-  engine::Context& ctx = *context_;
-  Buffers& b = *buffers_;
-  const DeviceGaussians& g = *last_gaussians_;
-  const uint32_t n = static_cast<uint32_t>(g.size());
-  const uint32_t K = (g.sh_degree + 1) * (g.sh_degree + 1);
   const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
   if (grad.image.size() != pixels * channels_)
     throw std::invalid_argument("Rasterizer::backward: grad image has " + std::to_string(grad.image.size()) +
@@ -293,12 +288,44 @@ void Rasterizer::backward(const RenderGradInput& grad) {
     if (!v->empty() && v->size() != pixels)
       throw std::invalid_argument("Rasterizer::backward: grad depth/alpha has " + std::to_string(v->size()) +
                                   " values, expected H*W = " + std::to_string(pixels) + " (or none)");
-  const SplatView view = make_view(last_camera_, n, K);
-  const uint32_t stride = SPLAT_GRAD2D_FIXED + channels_;
+  upstream_buffers();
+  Buffers& b = *buffers_;
+  b.grad_image->upload(grad.image);
+  b.grad_depth->upload(grad.depth.empty() ? std::vector<float>(pixels, 0.0f) : grad.depth);
+  b.grad_alpha->upload(grad.alpha.empty() ? std::vector<float>(pixels, 0.0f) : grad.alpha);
+  engine::Sequence s(*context_);
+  record_backward(s);
+  s.submit_and_wait();
+  append_profile(s);
+}
 
+Rasterizer::DeviceOutputs Rasterizer::device_outputs() const {
+  if (!last_gaussians_) throw std::logic_error("Rasterizer::device_outputs before forward");
+  const Buffers& b = *buffers_;
+  return {&b.image->buffer(), &b.depth->buffer(), &b.alpha->buffer(), &b.rects->buffer()};
+}
+
+Rasterizer::DeviceUpstream Rasterizer::upstream_buffers() {
+  if (!last_gaussians_) throw std::logic_error("Rasterizer::upstream_buffers before forward");
+  engine::Context& ctx = *context_;
+  Buffers& b = *buffers_;
+  const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
   ensure(ctx, b.grad_image, pixels * channels_, "splat: grad image");
   ensure(ctx, b.grad_depth, pixels, "splat: grad depth");
   ensure(ctx, b.grad_alpha, pixels, "splat: grad alpha");
+  return {&b.grad_image->buffer(), &b.grad_depth->buffer(), &b.grad_alpha->buffer()};
+}
+
+Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
+  if (!last_gaussians_) throw std::logic_error("Rasterizer::record_backward before forward");
+  engine::Context& ctx = *context_;
+  Buffers& b = *buffers_;
+  const DeviceGaussians& g = *last_gaussians_;
+  const uint32_t n = static_cast<uint32_t>(g.size());
+  const uint32_t K = (g.sh_degree + 1) * (g.sh_degree + 1);
+  const SplatView view = make_view(last_camera_, n, K);
+  const uint32_t stride = SPLAT_GRAD2D_FIXED + channels_;
+  upstream_buffers();
   ensure(ctx, b.grad2d, size_t{n} * stride, "splat: grad2d");
   ensure(ctx, b.g_means, 3 * size_t{n}, "splat: grad means");
   ensure(ctx, b.g_log_scales, 3 * size_t{n}, "splat: grad log_scales");
@@ -307,11 +334,6 @@ void Rasterizer::backward(const RenderGradInput& grad) {
   ensure(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
   ensure(ctx, b.g_means2d, 2 * size_t{n}, "splat: grad means2d");
   if (options_.deterministic) ensure(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
-  b.grad_image->upload(grad.image);
-  b.grad_depth->upload(grad.depth.empty() ? std::vector<float>(pixels, 0.0f) : grad.depth);
-  b.grad_alpha->upload(grad.alpha.empty() ? std::vector<float>(pixels, 0.0f) : grad.alpha);
-
-  engine::Sequence s(ctx);
   const engine::Buffer& rows = options_.deterministic ? b.isect_grads->buffer() : b.grad2d->buffer();
   const uint64_t row_values = options_.deterministic ? intersections_ * stride : uint64_t{n} * stride;
   s.fill(rows, 0u, row_values * sizeof(float));
@@ -355,8 +377,8 @@ void Rasterizer::backward(const RenderGradInput& grad) {
               {PBWD_BINDING_GRAD_SH, &b.g_sh->buffer(), Access::kWrite},
               {PBWD_BINDING_GRAD_MEANS2D, &b.g_means2d->buffer(), Access::kWrite}},
              view);
-  s.submit_and_wait();
-  append_profile(s);
+  return {&b.g_means->buffer(), &b.g_log_scales->buffer(), &b.g_quats->buffer(), &b.g_logits->buffer(),
+          &b.g_sh->buffer(), &b.g_means2d->buffer()};
 }
 
 GaussianGrads<float> Rasterizer::download_grads() const {

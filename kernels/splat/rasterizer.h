@@ -53,6 +53,36 @@ class Rasterizer {
   void backward(const RenderGradInput& grad);
   GaussianGrads<float> download_grads() const;
 
+  // Device-side use inside a training step (no host round trip): the last forward's outputs, the upstream
+  // gradient buffers to fill, and the parameter gradients the backward writes. Sizes: outputs and upstream
+  // gradients hold at least C*H*W (image) or H*W values; parameter gradients at least N rows.
+  struct DeviceOutputs {
+    const engine::Buffer* image;   // [C][H][W]
+    const engine::Buffer* depth;   // [H][W]
+    const engine::Buffer* alpha;   // [H][W]
+    const engine::Buffer* rects;   // [N][4] uint tile rectangles; empty (x1 <= x0) when culled
+  };
+  DeviceOutputs device_outputs() const;
+  struct DeviceUpstream {
+    const engine::Buffer* image;  // [C][H][W] dL/dimage
+    const engine::Buffer* depth;  // [H][W] dL/ddepth
+    const engine::Buffer* alpha;  // [H][W] dL/dalpha
+  };
+  // Makes sure the upstream buffers exist for the last forward's size and returns them (zero-filled on
+  // creation; the caller overwrites or fills them before record_backward).
+  DeviceUpstream upstream_buffers();
+  struct DeviceGrads {
+    const engine::Buffer* means;           // [N][3]
+    const engine::Buffer* log_scales;      // [N][3]
+    const engine::Buffer* quats;           // [N][4]
+    const engine::Buffer* opacity_logits;  // [N]
+    const engine::Buffer* sh;              // [N][K][C]
+    const engine::Buffer* means2d;         // [N][2]
+  };
+  // Records the backward from the upstream buffers into `sequence` (no submit), for a training step that
+  // records loss kernels before it and the optimizer after it.
+  DeviceGrads record_backward(engine::Sequence& sequence);
+
   // Per-kernel GPU times of the last forward (and backward, if run after it).
   const std::vector<engine::KernelTime>& profile() const { return profile_; }
   uint64_t intersections() const { return intersections_; }
