@@ -1,0 +1,202 @@
+#include "host/train/training_data.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "io/scene.h"
+
+namespace litgs::host {
+namespace {
+
+// T_world_cam of every frame: the pose at the frame's time (matched, else interpolated), moved from the
+// IMU to the camera if poses.txt describes the IMU.
+Eigen::Isometry3d pose_at(const io::Scene& scene, double t, double tolerance) {
+  const auto& poses = scene.poses;
+  if (poses.empty()) throw std::invalid_argument("poses.txt has no poses");
+  auto it = std::lower_bound(poses.begin(), poses.end(), t, [](const io::TumPose& p, double x) { return p.t_s < x; });
+  auto rotation_of = [&](const io::TumPose& p) {
+    if (!p.has_rotation)
+      throw std::invalid_argument("poses.txt: the pose at t = " + std::to_string(p.t_s) +
+                                  " has no rotation (0 0 0 0); training needs full poses");
+    return p.q_world_body;
+  };
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  const io::TumPose* exact = nullptr;
+  if (it != poses.end() && std::abs(it->t_s - t) <= tolerance) exact = &*it;
+  if (it != poses.begin() && std::abs(std::prev(it)->t_s - t) <= tolerance) exact = &*std::prev(it);
+  if (exact) {
+    T.linear() = rotation_of(*exact).toRotationMatrix();
+    T.translation() = exact->p_world;
+  } else {
+    if (it == poses.begin() || it == poses.end())
+      throw std::invalid_argument("frame at t = " + std::to_string(t) + " s lies outside the trajectory of poses.txt");
+    const io::TumPose& a = *std::prev(it);
+    const io::TumPose& b = *it;
+    const double s = (t - a.t_s) / (b.t_s - a.t_s);
+    T.linear() = rotation_of(a).slerp(s, rotation_of(b)).toRotationMatrix();
+    T.translation() = (1 - s) * a.p_world + s * b.p_world;
+  }
+  if (scene.config.poses_frame == io::PoseFrame::kImu) {
+    const Eigen::Matrix4d T_imu_cam = scene.config.T_imu_lidar * scene.config.T_cam_lidar.inverse();
+    T = T * Eigen::Isometry3d(T_imu_cam);
+  }
+  return T;
+}
+
+// Normalized undistorted (x, y) -> normalized distorted, for the scene's camera model.
+Eigen::Vector2d distort(const io::CameraIntrinsics& k, double x, double y) {
+  const auto& d = k.distortion;
+  auto coef = [&](size_t i) { return i < d.size() ? d[i] : 0.0; };
+  if (k.model == io::CameraModel::kEquidistant) {
+    const double r = std::sqrt(x * x + y * y);
+    if (r < 1e-12) return {x, y};
+    const double th = std::atan(r), th2 = th * th;
+    const double thd = th * (1 + th2 * (coef(0) + th2 * (coef(1) + th2 * (coef(2) + th2 * coef(3)))));
+    return {x * thd / r, y * thd / r};
+  }
+  const double r2 = x * x + y * y;
+  const double radial = 1 + r2 * (coef(0) + r2 * (coef(1) + r2 * coef(4)));
+  const double p1 = coef(2), p2 = coef(3);
+  return {x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x), y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y};
+}
+
+// Bilinear sample at OpenCV pixel coordinates (pixel centres at integers); -1 outside the image.
+double sample(const std::vector<float>& img, int w, int h, double u, double v) {
+  if (u < -0.5 || v < -0.5 || u > w - 0.5 || v > h - 0.5) return -1.0;
+  const double uc = std::clamp(u, 0.0, w - 1.0), vc = std::clamp(v, 0.0, h - 1.0);
+  const int x0 = std::min(static_cast<int>(uc), w - 2 < 0 ? 0 : w - 2), y0 = std::min(static_cast<int>(vc), h - 2 < 0 ? 0 : h - 2);
+  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+  const double fx = uc - x0, fy = vc - y0;
+  auto at = [&](int x, int y) { return static_cast<double>(img[static_cast<size_t>(y) * w + x]); };
+  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+}
+
+}  // namespace
+
+void TrainingDataOptions::check() const {
+  if (!(downscale >= 1.0) || !std::isfinite(downscale))
+    throw std::invalid_argument("TrainingDataOptions.downscale = " + std::to_string(downscale) + " must be >= 1");
+  if (!(low_percentile >= 0 && low_percentile < high_percentile && high_percentile <= 100))
+    throw std::invalid_argument("TrainingDataOptions: percentiles must satisfy 0 <= low < high <= 100");
+  if (!(frozen_threshold >= 0)) throw std::invalid_argument("TrainingDataOptions.frozen_threshold must be >= 0");
+}
+
+TrainingData load_training_data(const std::filesystem::path& dir, const TrainingDataOptions& o) {
+  o.check();
+  io::SceneReadOptions read;
+  read.load_map = false;
+  const io::Scene scene = io::read_scene(dir, read);
+  const io::CameraIntrinsics& k = scene.config.camera;
+  if (scene.frames.empty()) throw std::invalid_argument(dir.string() + ": the scene has no thermal frames");
+
+  // Raw frames, and the intensity mapping shared by all of them.
+  std::vector<std::vector<float>> raw(scene.frames.size());
+  std::vector<uint64_t> histogram(65536, 0);
+  for (size_t i = 0; i < scene.frames.size(); ++i) {
+    const io::Image img = io::load_frame(dir, scene, i);
+    raw[i].resize(static_cast<size_t>(img.width) * img.height);
+    for (size_t p = 0; p < raw[i].size(); ++p) {
+      const uint16_t v = img.data[p * img.channels];
+      raw[i][p] = v;
+      ++histogram[v];
+    }
+  }
+  TrainingData out;
+  const bool percentile = o.mapping == IntensityMapping::kPercentile ||
+                          (o.mapping == IntensityMapping::kAuto && k.bit_depth == 16);
+  if (percentile) {
+    uint64_t total = 0;
+    for (uint64_t c : histogram) total += c;
+    auto value_at = [&](double pct) {
+      const double target = pct / 100.0 * static_cast<double>(total);
+      uint64_t seen = 0;
+      for (size_t v = 0; v < histogram.size(); ++v) {
+        seen += histogram[v];
+        if (static_cast<double>(seen) >= target) return static_cast<double>(v);
+      }
+      return 65535.0;
+    };
+    out.stretch_low = value_at(o.low_percentile);
+    out.stretch_high = value_at(o.high_percentile);
+    if (!(out.stretch_high > out.stretch_low)) out.stretch_high = out.stretch_low + 1;
+  } else {
+    out.stretch_low = 0;
+    out.stretch_high = k.bit_depth == 16 ? 65535.0 : 255.0;
+  }
+  const double range = out.stretch_high - out.stretch_low;
+  for (auto& frame : raw)
+    for (float& v : frame) v = static_cast<float>(std::clamp((v - out.stretch_low) / range, 0.0, 1.0));
+
+  // Training resolution and pinhole camera (pixel centres at +0.5, the rasterizer's convention).
+  const uint32_t W = static_cast<uint32_t>(std::max(1.0, std::round(k.width / o.downscale)));
+  const uint32_t H = static_cast<uint32_t>(std::max(1.0, std::round(k.height / o.downscale)));
+  const double sx = static_cast<double>(k.width) / W, sy = static_cast<double>(k.height) / H;
+  const double fx = k.fx / sx, fy = k.fy / sy, cx = (k.cx + 0.5) / sx, cy = (k.cy + 0.5) / sy;
+  out.width = W;
+  out.height = H;
+  out.world_offset_m = scene.config.world_offset_m;
+  // Supersample each training pixel so that downscaling averages instead of aliasing.
+  const int sub = std::max(1, static_cast<int>(std::ceil(std::max(sx, sy))));
+
+  std::vector<Eigen::Vector3d> centres;
+  const std::vector<float>* previous = nullptr;
+  for (size_t i = 0; i < scene.frames.size(); ++i) {
+    if (previous) {
+      double diff = 0;
+      for (size_t p = 0; p < raw[i].size(); ++p) diff += std::abs(raw[i][p] - (*previous)[p]);
+      if (diff / static_cast<double>(raw[i].size()) < o.frozen_threshold) {
+        ++out.frozen_skipped;
+        continue;
+      }
+    }
+    previous = &raw[i];
+    TrainingView view;
+    view.name = scene.frames[i].image.filename().string();
+    view.t_s = scene.frames[i].t_s;
+    view.heldout = o.holdout_every > 0 && i % o.holdout_every == 0;
+    const Eigen::Isometry3d T_world_cam = pose_at(scene, view.t_s, o.pose_match_tolerance_s);
+    const Eigen::Matrix3d R = T_world_cam.linear().transpose();
+    const Eigen::Vector3d t = -R * T_world_cam.translation();
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) view.camera.R_cam_world[c][r] = R(r, c);
+      view.camera.t_cam_world[c] = t[c];
+    }
+    view.camera.fx = fx;
+    view.camera.fy = fy;
+    view.camera.cx = cx;
+    view.camera.cy = cy;
+    view.camera.width = W;
+    view.camera.height = H;
+    centres.push_back(T_world_cam.translation());
+
+    view.image.assign(static_cast<size_t>(W) * H, 0.0f);
+    for (uint32_t y = 0; y < H; ++y)
+      for (uint32_t x = 0; x < W; ++x) {
+        double sum = 0;
+        int count = 0;
+        for (int sy_i = 0; sy_i < sub; ++sy_i)
+          for (int sx_i = 0; sx_i < sub; ++sx_i) {
+            const double px = x + (sx_i + 0.5) / sub, py = y + (sy_i + 0.5) / sub;  // training pixel coords
+            const Eigen::Vector2d d = distort(k, (px - cx) / fx, (py - cy) / fy);
+            const double v = sample(raw[i], k.width, k.height, k.fx * d.x() + k.cx, k.fy * d.y() + k.cy);
+            if (v >= 0) {
+              sum += v;
+              ++count;
+            }
+          }
+        view.image[static_cast<size_t>(y) * W + x] = count ? static_cast<float>(sum / count) : 0.0f;
+      }
+    out.views.push_back(std::move(view));
+  }
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& c : centres) mean += c;
+  mean /= static_cast<double>(centres.size());
+  double radius = 0;
+  for (const auto& c : centres) radius = std::max(radius, (c - mean).norm());
+  out.scene_extent_m = std::max(1.1 * radius, 1e-3);
+  return out;
+}
+
+}  // namespace litgs::host

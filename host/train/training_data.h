@@ -1,0 +1,56 @@
+// The training views of a scene: cameras at the training resolution and target images in [0, 1].
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "kernels/splat/splat_types.h"
+
+namespace litgs::host {
+
+enum class IntensityMapping {
+  kAuto,        // percentile stretch for 16-bit frames, value / 255 for 8-bit ones
+  kPercentile,  // robust stretch shared by all frames: [low, high] percentiles -> [0, 1], clamped
+  kLinear,      // value / (2^bits - 1)
+};
+
+struct TrainingDataOptions {
+  double downscale = 1.0;              // images and intrinsics divided by this (>= 1)
+  uint32_t holdout_every = 8;          // frames i with i % holdout_every == 0 are held out (0: none)
+  IntensityMapping mapping = IntensityMapping::kAuto;
+  double low_percentile = 0.5;         // of all frames' raw values together, not per frame
+  double high_percentile = 99.5;
+  // Frames whose mean absolute difference to the previous kept frame is below this fraction of the
+  // stretch range are frozen by the camera's non-uniformity correction and skipped.
+  double frozen_threshold = 1e-4;
+  // Poses are matched to frames by timestamp; farther than this they are interpolated, and outside the
+  // trajectory an error.
+  double pose_match_tolerance_s = 1e-3;
+  void check() const;  // throws std::invalid_argument naming the bad field
+};
+
+struct TrainingView {
+  std::string name;              // the frame's file name
+  double t_s = 0;
+  kernels::SplatCamera camera;   // pinhole, undistorted, at the training resolution
+  std::vector<float> image;      // [H][W] target in [0, 1]
+  bool heldout = false;
+};
+
+struct TrainingData {
+  std::vector<TrainingView> views;
+  double stretch_low = 0, stretch_high = 1;  // raw values mapped to 0 and 1
+  Eigen::Vector3d world_offset_m = Eigen::Vector3d::Zero();  // scene world = original world - offset
+  double scene_extent_m = 1;   // 1.1 x the largest camera-centre distance from their mean (3DGS)
+  size_t frozen_skipped = 0;
+  uint32_t width = 0, height = 0;  // training resolution
+};
+
+// Reads the scene directory, maps intensities, undistorts (radtan k1 k2 p1 p2 [k3]) and downscales.
+// Throws io::IoError / std::invalid_argument naming the file or the problem.
+TrainingData load_training_data(const std::filesystem::path& scene_dir, const TrainingDataOptions& options);
+
+}  // namespace litgs::host
