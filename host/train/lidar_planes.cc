@@ -1,0 +1,110 @@
+#include "host/train/lidar_planes.h"
+
+#include <Eigen/Eigenvalues>
+#include <nanoflann.hpp>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace litgs::host {
+namespace {
+
+struct Adaptor {
+  const std::vector<Eigen::Vector3d>& pts;
+  size_t kdtree_get_point_count() const { return pts.size(); }
+  double kdtree_get_pt(size_t i, size_t d) const { return pts[i][static_cast<int>(d)]; }
+  template <class B>
+  bool kdtree_get_bbox(B&) const {
+    return false;
+  }
+};
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Adaptor>, Adaptor, 3>;
+
+}  // namespace
+
+void PlaneFitOptions::check() const {
+  if (neighbours < 3) throw std::invalid_argument("PlaneFitOptions.neighbours must be >= 3");
+  if (!(max_flatness > 0)) throw std::invalid_argument("PlaneFitOptions.max_flatness must be > 0");
+  if (!(max_radius_m > 0)) throw std::invalid_argument("PlaneFitOptions.max_radius_m must be > 0");
+}
+
+size_t PlanarMap::planar_count() const {
+  size_t n = 0;
+  for (uint8_t p : planar) n += p;
+  return n;
+}
+
+PlanarMap fit_planes(const std::vector<Eigen::Vector3d>& points, const PlaneFitOptions& o) {
+  o.check();
+  PlanarMap map;
+  map.points.reserve(points.size());
+  for (const auto& p : points) map.points.push_back(p.cast<float>());
+  map.normals.assign(points.size(), Eigen::Vector3f::Zero());
+  map.planar.assign(points.size(), 0);
+  if (points.size() < o.neighbours) return map;
+  Adaptor adaptor{points};
+  Tree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  tree.buildIndex();
+  std::vector<uint32_t> idx(o.neighbours);
+  std::vector<double> d2(o.neighbours);
+  const double max_d2 = o.max_radius_m * o.max_radius_m;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const size_t found = tree.knnSearch(points[i].data(), o.neighbours, idx.data(), d2.data());
+    if (found < o.neighbours || d2[found - 1] > max_d2) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (size_t j = 0; j < found; ++j) mean += points[idx[j]];
+    mean /= static_cast<double>(found);
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (size_t j = 0; j < found; ++j) {
+      const Eigen::Vector3d d = points[idx[j]] - mean;
+      cov += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    const Eigen::Vector3d ev = eig.eigenvalues();  // ascending
+    if (!(ev[1] > 0) || ev[0] / ev[1] > o.max_flatness) continue;
+    map.normals[i] = eig.eigenvectors().col(0).cast<float>().normalized();
+    map.planar[i] = 1;
+  }
+  return map;
+}
+
+ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& c) {
+  const size_t W = c.width, H = c.height;
+  ViewPlaneMaps out;
+  out.points.assign(W * H * 4, 0.0f);
+  out.normals.assign(W * H * 4, 0.0f);
+  std::vector<float> zbuf(W * H, std::numeric_limits<float>::infinity());
+  std::vector<int64_t> owner(W * H, -1);
+  // Every point takes part in the z-buffer (a non-planar point in front hides the plane behind it); only
+  // pixels whose nearest point is planar carry an entry.
+  for (size_t i = 0; i < map.points.size(); ++i) {
+    const Eigen::Vector3f& p = map.points[i];
+    const glm::dvec3 q = c.R_cam_world * glm::dvec3(p.x(), p.y(), p.z()) + c.t_cam_world;
+    if (q.z <= c.near_m) continue;
+    const double u = c.fx * q.x / q.z + c.cx, v = c.fy * q.y / q.z + c.cy;
+    if (u < 0 || v < 0 || u >= static_cast<double>(W) || v >= static_cast<double>(H)) continue;
+    const size_t pix = static_cast<size_t>(v) * W + static_cast<size_t>(u);
+    if (q.z < zbuf[pix]) {
+      zbuf[pix] = static_cast<float>(q.z);
+      owner[pix] = static_cast<int64_t>(i);
+    }
+  }
+  for (size_t pix = 0; pix < W * H; ++pix) {
+    if (owner[pix] < 0 || !map.planar[static_cast<size_t>(owner[pix])]) continue;
+    const size_t i = static_cast<size_t>(owner[pix]);
+    const Eigen::Vector3f& p = map.points[i];
+    const glm::dvec3 q = c.R_cam_world * glm::dvec3(p.x(), p.y(), p.z()) + c.t_cam_world;
+    const Eigen::Vector3f& n = map.normals[i];
+    const glm::dvec3 nc = c.R_cam_world * glm::dvec3(n.x(), n.y(), n.z());
+    for (int a = 0; a < 3; ++a) {
+      out.points[4 * pix + a] = static_cast<float>(q[a]);
+      out.normals[4 * pix + a] = static_cast<float>(nc[a]);
+    }
+    out.points[4 * pix + 3] = 1.0f;
+    ++out.valid_count;
+  }
+  return out;
+}
+
+}  // namespace litgs::host

@@ -1,0 +1,41 @@
+// What the geometric loss needs from the LiDAR map: a plane normal per map point (local plane fit), and per
+// view the nearest map point of each pixel with its normal, in the camera frame.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "kernels/splat/splat_types.h"
+
+namespace litgs::host {
+
+struct PlaneFitOptions {
+  uint32_t neighbours = 12;      // map points in each local plane fit
+  double max_flatness = 0.05;    // smallest / middle eigenvalue of the neighbourhood: above it, not planar
+  double max_radius_m = 1.0;     // neighbours farther than this make the fit invalid (sparse areas)
+  void check() const;            // throws std::invalid_argument naming the bad field
+};
+
+// A LiDAR map with a unit normal per point where its neighbourhood is planar.
+struct PlanarMap {
+  std::vector<Eigen::Vector3f> points;   // world, metres (the scene's recentred frame)
+  std::vector<Eigen::Vector3f> normals;  // unit, sign towards... arbitrary (the loss squares the residual)
+  std::vector<uint8_t> planar;           // 1 where the fit is valid
+  size_t planar_count() const;
+};
+
+PlanarMap fit_planes(const std::vector<Eigen::Vector3d>& points, const PlaneFitOptions& options);
+
+// Per-pixel LiDAR point and normal of one view, the layout of the geometric loss kernel:
+// points [H][W][4] = (x, y, z, valid) and normals [H][W][4] = (nx, ny, nz, 0), camera frame.
+struct ViewPlaneMaps {
+  std::vector<float> points;
+  std::vector<float> normals;
+  uint32_t valid_count = 0;
+};
+
+// Nearest planar map point per pixel by a z-buffer (pixel centres at +0.5, the rasterizer's convention).
+ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& camera);
+
+}  // namespace litgs::host
