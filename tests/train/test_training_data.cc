@@ -1,0 +1,129 @@
+// Training data from the real DUNR thermal scene (imported from its Metashape project): the shared
+// percentile stretch, held-out split, undistorted downscaled cameras; initialization from the COLMAP points
+// in the control-point frame (the scene's recentring must apply to them); LiDAR plane fits.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "host/train/init_gaussians.h"
+#include "host/train/lidar_planes.h"
+#include "host/train/training_data.h"
+#include "io/import_metashape.h"
+
+namespace litgs::host {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kDunr = fs::path(LITGS_DATA_DIR) / "thermitage-dunr";
+
+class DunrScene : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("litgs-train-dunr-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    io::MetashapeImportOptions o;
+    o.xml = kDunr / "metashape" / "DUNR-ImgCoords-TIR.xml";
+    o.images = kDunr / "radtiff";
+    o.out = dir_;
+    io::import_metashape(o);
+    TrainingDataOptions t;
+    t.downscale = 2.0;
+    data_ = new TrainingData(load_training_data(dir_, t));
+  }
+  static void TearDownTestSuite() {
+    delete data_;
+    fs::remove_all(dir_);
+  }
+  static inline fs::path dir_;
+  static inline TrainingData* data_ = nullptr;
+};
+
+TEST_F(DunrScene, SharedPercentileStretchMatchesTheDataReadme) {
+  // The data README: 0.5 and 99.5 percentiles over all frames are 3835 and 4237.
+  EXPECT_NEAR(data_->stretch_low, 3835, 3);
+  EXPECT_NEAR(data_->stretch_high, 4237, 3);
+  double lo = 1, hi = 0, mean = 0;
+  size_t n = 0;
+  for (const auto& v : data_->views)
+    for (float x : v.image) {
+      lo = std::min<double>(lo, x), hi = std::max<double>(hi, x), mean += x;
+      ++n;
+    }
+  EXPECT_GE(lo, 0.0);
+  EXPECT_LE(hi, 1.0);
+  mean /= static_cast<double>(n);
+  EXPECT_GT(mean, 0.2);
+  EXPECT_LT(mean, 0.8);
+}
+
+TEST_F(DunrScene, ViewsHeldOutAndCameras) {
+  ASSERT_EQ(data_->views.size() + data_->frozen_skipped, 45u);
+  size_t heldout = 0;
+  for (const auto& v : data_->views) heldout += v.heldout;
+  EXPECT_EQ(heldout, 6u) << "frames 0, 8, ..., 40";
+  EXPECT_EQ(data_->width, 320u);
+  EXPECT_EQ(data_->height, 256u);
+  const auto& c = data_->views[0].camera;
+  EXPECT_NEAR(c.fx, 767.0 / 2.0, 15.0);
+  EXPECT_NEAR(c.cx, 160.0, 20.0);
+  EXPECT_GT(data_->scene_extent_m, 1.0);
+  EXPECT_LT(data_->scene_extent_m, 100.0);
+}
+
+TEST_F(DunrScene, ColmapPointsLandInFrontOfTheCamerasAfterRecentring) {
+  const auto pts = load_points(kDunr / "colmap-triangulated-points.ply", data_->world_offset_m);
+  ASSERT_EQ(pts.size(), 3988u);
+  size_t seen = 0;
+  for (const auto& p : pts) {
+    bool visible = false;
+    for (const auto& v : data_->views) {
+      const auto& c = v.camera;
+      const glm::dvec3 q = c.R_cam_world * glm::dvec3(p.x(), p.y(), p.z()) + c.t_cam_world;
+      const double u = c.fx * q.x / q.z + c.cx, w = c.fy * q.y / q.z + c.cy;
+      if (q.z > 0.1 && u >= 0 && w >= 0 && u < c.width && w < c.height) visible = true;
+    }
+    seen += visible;
+  }
+  EXPECT_GT(seen, pts.size() * 95 / 100) << "recentred points project into the views";
+  const auto model = init_from_points(pts, *data_, InitOptions{});
+  ASSERT_EQ(model.size(), pts.size());
+  EXPECT_NO_THROW(model.check());
+  for (float s : model.log_scales) ASSERT_TRUE(std::isfinite(s));
+  // Colours sampled from the views: not all the 0.5 gray of unseen points.
+  size_t coloured = 0;
+  for (size_t i = 0; i < model.size(); ++i) coloured += model.sh[i * model.sh_coeffs()] != 0.0f;
+  EXPECT_GT(coloured, model.size() * 9 / 10);
+}
+
+TEST(LidarPlanes, PlaneAndCornerPoints) {
+  // A noisy plane z = 2 and a few points of a pole in front of it.
+  std::mt19937 rng(1);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = -20; i <= 20; ++i)
+    for (int j = -20; j <= 20; ++j) pts.emplace_back(0.05 * i, 0.05 * j, 2.0 + noise(rng));
+  const PlanarMap map = fit_planes(pts, PlaneFitOptions{});
+  EXPECT_GT(map.planar_count(), pts.size() * 9 / 10);
+  for (size_t i = 0; i < pts.size(); ++i)
+    if (map.planar[i]) {
+      ASSERT_GT(std::abs(map.normals[i].z()), 0.98f);
+    }
+  kernels::SplatCamera cam;
+  cam.width = 40;
+  cam.height = 30;
+  cam.fx = cam.fy = 40;
+  cam.cx = 20;
+  cam.cy = 15;
+  const ViewPlaneMaps v = project_planes(map, cam);
+  EXPECT_GT(v.valid_count, 300u);
+  for (size_t p = 0; p < size_t{40} * 30; ++p)
+    if (v.points[4 * p + 3] == 1.0f) {
+      ASSERT_NEAR(v.points[4 * p + 2], 2.0f, 0.02f);
+    }
+}
+
+}  // namespace
+}  // namespace litgs::host
