@@ -1,0 +1,33 @@
+// Every option of a training run, with the 3DGS defaults where they apply; the CLI maps onto it field by
+// field.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace litgs::host {
+
+struct TrainOptions {
+  uint32_t iterations = 7000;
+  double lambda_geo = 0.6;         // L = (1 - lambda_geo) L_pho + lambda_geo L_geo (0: photometric only)
+  double lambda_ssim = 0.2;        // L_pho = (1 - lambda_ssim) L1 + lambda_ssim (1 - SSIM)
+  uint32_t sh_degree = 3;          // final SH degree; the active degree rises by one every sh_degree_every
+  uint32_t sh_degree_every = 1000;
+  // Adaptive density control (3DGS defaults, in iterations).
+  uint32_t densify_from = 500;
+  uint32_t densify_until = 15000;  // clipped to the run
+  uint32_t densify_every = 100;
+  uint32_t opacity_reset_every = 3000;
+  float densify_grad_threshold = 0.0002f;  // of the averaged screen-space mean gradient, 3DGS units
+  uint32_t max_gaussians = 2000000;        // cap of the model size
+  // Evaluation, checkpoints, reproducibility.
+  uint32_t eval_every = 0;         // 0: only at the end
+  uint32_t checkpoint_every = 0;   // 0: none
+  bool resume = false;             // continue from the newest checkpoint in the output directory
+  bool deterministic = false;      // bit-identical gradients (slower)
+  uint32_t seed = 0;               // view order and densification noise
+  uint32_t progress_every = 50;    // log cadence when stdout is not a terminal
+  void check() const;              // throws std::invalid_argument naming the bad field
+};
+
+}  // namespace litgs::host

@@ -1,0 +1,51 @@
+// The training loop: which kernels run when. Views sampled without replacement, SH degree ramp,
+// densification window and cadence, evaluation, atomic checkpoints and exact resume, one small readback
+// per iteration (the rasterizer's intersection count).
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "engine/context.h"
+#include "host/train/lidar_planes.h"
+#include "host/train/train_options.h"
+#include "host/train/training_data.h"
+#include "kernels/splat/splat_types.h"
+
+namespace litgs::host {
+
+struct EvalResult {
+  uint32_t iteration = 0;
+  double psnr_db = 0;   // mean over held-out views
+  double ssim = 0;
+  double depth_plane_rmse_m = -1;  // against ground-truth planes where the scene has them; -1 otherwise
+};
+
+struct TrainReport {
+  uint32_t iterations = 0;
+  double wall_s = 0;
+  double ms_per_iteration = 0;
+  size_t gaussians = 0;
+  uint64_t peak_device_bytes = 0;
+  EvalResult final_eval;
+  std::vector<EvalResult> evals;
+  size_t nonfinite_pruned = 0;
+};
+
+struct TrainProgress {
+  uint32_t iteration, total;
+  double loss;      // last read back (every few iterations)
+  double psnr_db;   // last evaluation (or NaN)
+  size_t gaussians;
+  double iterations_per_s;
+};
+
+// Trains `initial` on `data` and writes `out_dir/point_cloud.ply` and `out_dir/metrics.json` (atomically).
+// `planes` (optional) drives the geometric loss; without it lambda_geo must be 0.
+TrainReport train(engine::Context& context, const TrainingData& data, const kernels::GaussianModel& initial,
+                  const PlanarMap* planes, const TrainOptions& options, const std::filesystem::path& out_dir,
+                  const std::function<void(const TrainProgress&)>& progress = {});
+
+}  // namespace litgs::host
