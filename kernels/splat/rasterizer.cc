@@ -51,6 +51,10 @@ SplatView make_view(const SplatCamera& c, uint32_t count, uint32_t sh_coeffs) {
 
 }  // namespace
 
+SplatView make_splat_view(const SplatCamera& camera, uint32_t count, uint32_t sh_coeffs) {
+  return make_view(camera, count, sh_coeffs);
+}
+
 struct Rasterizer::Buffers {
   // Per Gaussian.
   std::unique_ptr<DeviceArray<float>> means2d, conics, depths, opacities, colors, grad2d;
@@ -77,6 +81,22 @@ DeviceGaussians::DeviceGaussians(engine::Context& context, const GaussianModel& 
   upload(model);
 }
 
+DeviceGaussians::DeviceGaussians(engine::Context& context, uint32_t channels_in, uint32_t sh_degree_in,
+                                 size_t count_in, size_t capacity_in)
+    : count(count_in),
+      channels(channels_in),
+      sh_degree(sh_degree_in),
+      means(context, "gaussians: means", std::max<size_t>(capacity_in, 1) * 3),
+      log_scales(context, "gaussians: log_scales", std::max<size_t>(capacity_in, 1) * 3),
+      quats(context, "gaussians: quats", std::max<size_t>(capacity_in, 1) * 4),
+      opacity_logits(context, "gaussians: opacity_logits", std::max<size_t>(capacity_in, 1)),
+      sh(context, "gaussians: sh",
+         std::max<size_t>(capacity_in, 1) * (sh_degree_in + 1) * (sh_degree_in + 1) * channels_in) {
+  if (count_in > capacity_in)
+    throw std::invalid_argument("DeviceGaussians: count " + std::to_string(count_in) + " exceeds capacity " +
+                                std::to_string(capacity_in));
+}
+
 void DeviceGaussians::upload(const GaussianModel& model) {
   model.check();
   if (model.size() != count || model.channels != channels || model.sh_degree != sh_degree)
@@ -92,16 +112,20 @@ GaussianModel DeviceGaussians::download() const {
   GaussianModel m;
   m.channels = channels;
   m.sh_degree = sh_degree;
-  m.means = means.download();
-  m.log_scales = log_scales.download();
-  m.quats = quats.download();
-  m.opacity_logits = opacity_logits.download();
-  m.sh = sh.download();
+  m.means = means.download(0, count * 3);
+  m.log_scales = log_scales.download(0, count * 3);
+  m.quats = quats.download(0, count * 4);
+  m.opacity_logits = opacity_logits.download(0, count);
+  m.sh = sh.download(0, count * m.sh_coeffs() * channels);
   return m;
 }
 
 Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOptions options)
-    : context_(&context), channels_(channels), options_(options), sort_(context), scan_(context),
+    : context_(&context),
+      channels_(channels),
+      options_(options),
+      sort_(context),
+      scan_(context),
       buffers_(std::make_unique<Buffers>()) {
   if (channels < 1 || channels > SPLAT_MAX_CHANNELS)
     throw std::invalid_argument("Rasterizer: channels = " + std::to_string(channels) + ", must be 1.." +
@@ -112,8 +136,8 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   ranges_ = make("splat/tile_ranges", 2);
   forward_ = make("splat/rasterize_forward", 13);
   const char* backward = options_.deterministic ? "splat/rasterize_backward_deterministic"
-                         : uses_float_atomics()  ? "splat/rasterize_backward_float_atomics"
-                                                 : "splat/rasterize_backward_cas_atomics";
+                         : uses_float_atomics() ? "splat/rasterize_backward_float_atomics"
+                                                : "splat/rasterize_backward_cas_atomics";
   backward_ = make(backward, 15);
   reduce_ = make("splat/reduce_isect_grads", 5);
   project_backward_ = make("splat/project_backward", 13);
@@ -333,7 +357,8 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
   ensure(ctx, b.g_logits, n, "splat: grad opacity_logits");
   ensure(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
   ensure(ctx, b.g_means2d, 2 * size_t{n}, "splat: grad means2d");
-  if (options_.deterministic) ensure(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
+  if (options_.deterministic)
+    ensure(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
   const engine::Buffer& rows = options_.deterministic ? b.isect_grads->buffer() : b.grad2d->buffer();
   const uint64_t row_values = options_.deterministic ? intersections_ * stride : uint64_t{n} * stride;
   s.fill(rows, 0u, row_values * sizeof(float));
@@ -377,12 +402,13 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
               {PBWD_BINDING_GRAD_SH, &b.g_sh->buffer(), Access::kWrite},
               {PBWD_BINDING_GRAD_MEANS2D, &b.g_means2d->buffer(), Access::kWrite}},
              view);
-  return {&b.g_means->buffer(), &b.g_log_scales->buffer(), &b.g_quats->buffer(), &b.g_logits->buffer(),
-          &b.g_sh->buffer(), &b.g_means2d->buffer()};
+  return {&b.g_means->buffer(),  &b.g_log_scales->buffer(), &b.g_quats->buffer(),
+          &b.g_logits->buffer(), &b.g_sh->buffer(),         &b.g_means2d->buffer()};
 }
 
 GaussianGrads<float> Rasterizer::download_grads() const {
-  if (!last_gaussians_ || !buffers_->g_means) throw std::logic_error("Rasterizer::download_grads before backward");
+  if (!last_gaussians_ || !buffers_->g_means)
+    throw std::logic_error("Rasterizer::download_grads before backward");
   const Buffers& b = *buffers_;
   const size_t n = last_gaussians_->size();
   const size_t K = (last_gaussians_->sh_degree + 1) * (last_gaussians_->sh_degree + 1);
