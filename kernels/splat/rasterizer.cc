@@ -121,11 +121,7 @@ GaussianModel DeviceGaussians::download() const {
 }
 
 Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOptions options)
-    : context_(&context),
-      channels_(channels),
-      options_(options),
-      sort_(context),
-      scan_(context),
+    : context_(&context), channels_(channels), options_(options), sort_(context), scan_(context),
       buffers_(std::make_unique<Buffers>()) {
   if (channels < 1 || channels > SPLAT_MAX_CHANNELS)
     throw std::invalid_argument("Rasterizer: channels = " + std::to_string(channels) + ", must be 1.." +
@@ -136,8 +132,8 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   ranges_ = make("splat/tile_ranges", 2);
   forward_ = make("splat/rasterize_forward", 13);
   const char* backward = options_.deterministic ? "splat/rasterize_backward_deterministic"
-                         : uses_float_atomics() ? "splat/rasterize_backward_float_atomics"
-                                                : "splat/rasterize_backward_cas_atomics";
+                         : uses_float_atomics()  ? "splat/rasterize_backward_float_atomics"
+                                                 : "splat/rasterize_backward_cas_atomics";
   backward_ = make(backward, 15);
   reduce_ = make("splat/reduce_isect_grads", 5);
   project_backward_ = make("splat/project_backward", 13);
@@ -357,8 +353,7 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
   ensure(ctx, b.g_logits, n, "splat: grad opacity_logits");
   ensure(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
   ensure(ctx, b.g_means2d, 2 * size_t{n}, "splat: grad means2d");
-  if (options_.deterministic)
-    ensure(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
+  if (options_.deterministic) ensure(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
   const engine::Buffer& rows = options_.deterministic ? b.isect_grads->buffer() : b.grad2d->buffer();
   const uint64_t row_values = options_.deterministic ? intersections_ * stride : uint64_t{n} * stride;
   s.fill(rows, 0u, row_values * sizeof(float));
@@ -402,13 +397,12 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
               {PBWD_BINDING_GRAD_SH, &b.g_sh->buffer(), Access::kWrite},
               {PBWD_BINDING_GRAD_MEANS2D, &b.g_means2d->buffer(), Access::kWrite}},
              view);
-  return {&b.g_means->buffer(),  &b.g_log_scales->buffer(), &b.g_quats->buffer(),
-          &b.g_logits->buffer(), &b.g_sh->buffer(),         &b.g_means2d->buffer()};
+  return {&b.g_means->buffer(), &b.g_log_scales->buffer(), &b.g_quats->buffer(), &b.g_logits->buffer(),
+          &b.g_sh->buffer(), &b.g_means2d->buffer()};
 }
 
 GaussianGrads<float> Rasterizer::download_grads() const {
-  if (!last_gaussians_ || !buffers_->g_means)
-    throw std::logic_error("Rasterizer::download_grads before backward");
+  if (!last_gaussians_ || !buffers_->g_means) throw std::logic_error("Rasterizer::download_grads before backward");
   const Buffers& b = *buffers_;
   const size_t n = last_gaussians_->size();
   const size_t K = (last_gaussians_->sh_degree + 1) * (last_gaussians_->sh_degree + 1);

@@ -67,10 +67,10 @@ class Rasterizer {
   // gradient buffers to fill, and the parameter gradients the backward writes. Sizes: outputs and upstream
   // gradients hold at least C*H*W (image) or H*W values; parameter gradients at least N rows.
   struct DeviceOutputs {
-    const engine::Buffer* image;  // [C][H][W]
-    const engine::Buffer* depth;  // [H][W]
-    const engine::Buffer* alpha;  // [H][W]
-    const engine::Buffer* rects;  // [N][4] uint tile rectangles; empty (x1 <= x0) when culled
+    const engine::Buffer* image;   // [C][H][W]
+    const engine::Buffer* depth;   // [H][W]
+    const engine::Buffer* alpha;   // [H][W]
+    const engine::Buffer* rects;   // [N][4] uint tile rectangles; empty (x1 <= x0) when culled
   };
   DeviceOutputs device_outputs() const;
   struct DeviceUpstream {
