@@ -346,6 +346,18 @@ void TrainableGaussians::record_reset_opacity(engine::Sequence& sequence, float 
   sequence.fill(s.exp_avg_sq[kOpacityLogits]->buffer(), 0u, uint64_t{n} * 4);
 }
 
+void TrainableGaussians::load_state(const TrainingState& state) {
+  state.check();
+  if (state.model.channels != channels_ || state.model.sh_degree != sh_degree_)
+    throw std::invalid_argument("TrainableGaussians::load_state: the state has " +
+                                std::to_string(state.model.channels) + " channels and SH degree " +
+                                std::to_string(state.model.sh_degree) + ", the model " +
+                                std::to_string(channels_) + " and " + std::to_string(sh_degree_));
+  ensure_capacity(*current_, state.size());
+  current_->params->count = state.size();
+  upload_state(*current_, state);
+}
+
 GaussianModel TrainableGaussians::download() const {
   return current_->params->download();
 }

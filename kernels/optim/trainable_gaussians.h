@@ -54,6 +54,9 @@ class TrainableGaussians {
 
   GaussianModel download() const;
   TrainingState download_state() const;
+  // Replaces parameters, moments and statistics (any size; the same channels and SH degree): a resume, or a
+  // caller's own statistics. Call Rasterizer::forward again after it.
+  void load_state(const TrainingState& state);
   // Elements skipped by Adam since construction because their gradient or update was not finite, per group.
   std::array<uint32_t, kParamGroupCount> nonfinite_grad_counts() const;
   const AdamOptions& adam_options() const { return adam_options_; }
