@@ -51,6 +51,10 @@ SplatView make_view(const SplatCamera& c, uint32_t count, uint32_t sh_coeffs) {
 
 }  // namespace
 
+SplatView make_splat_view(const SplatCamera& camera, uint32_t count, uint32_t sh_coeffs) {
+  return make_view(camera, count, sh_coeffs);
+}
+
 struct Rasterizer::Buffers {
   // Per Gaussian.
   std::unique_ptr<DeviceArray<float>> means2d, conics, depths, opacities, colors, grad2d;
@@ -77,6 +81,22 @@ DeviceGaussians::DeviceGaussians(engine::Context& context, const GaussianModel& 
   upload(model);
 }
 
+DeviceGaussians::DeviceGaussians(engine::Context& context, uint32_t channels_in, uint32_t sh_degree_in,
+                                 size_t count_in, size_t capacity_in)
+    : count(count_in),
+      channels(channels_in),
+      sh_degree(sh_degree_in),
+      means(context, "gaussians: means", std::max<size_t>(capacity_in, 1) * 3),
+      log_scales(context, "gaussians: log_scales", std::max<size_t>(capacity_in, 1) * 3),
+      quats(context, "gaussians: quats", std::max<size_t>(capacity_in, 1) * 4),
+      opacity_logits(context, "gaussians: opacity_logits", std::max<size_t>(capacity_in, 1)),
+      sh(context, "gaussians: sh",
+         std::max<size_t>(capacity_in, 1) * (sh_degree_in + 1) * (sh_degree_in + 1) * channels_in) {
+  if (count_in > capacity_in)
+    throw std::invalid_argument("DeviceGaussians: count " + std::to_string(count_in) + " exceeds capacity " +
+                                std::to_string(capacity_in));
+}
+
 void DeviceGaussians::upload(const GaussianModel& model) {
   model.check();
   if (model.size() != count || model.channels != channels || model.sh_degree != sh_degree)
@@ -92,11 +112,11 @@ GaussianModel DeviceGaussians::download() const {
   GaussianModel m;
   m.channels = channels;
   m.sh_degree = sh_degree;
-  m.means = means.download();
-  m.log_scales = log_scales.download();
-  m.quats = quats.download();
-  m.opacity_logits = opacity_logits.download();
-  m.sh = sh.download();
+  m.means = means.download(0, count * 3);
+  m.log_scales = log_scales.download(0, count * 3);
+  m.quats = quats.download(0, count * 4);
+  m.opacity_logits = opacity_logits.download(0, count);
+  m.sh = sh.download(0, count * m.sh_coeffs() * channels);
   return m;
 }
 

@@ -11,6 +11,7 @@
 #include "engine/kernel.h"
 #include "engine/sequence.h"
 #include "kernels/sort/radix_sort.h"
+#include "kernels/splat/splat_shared.h"
 #include "kernels/splat/splat_types.h"
 
 namespace litgs::kernels {
@@ -24,11 +25,16 @@ struct RasterizerOptions {
 };
 
 // A Gaussian model on the device, one buffer per attribute (structure of arrays, each binding bounded).
+// The arrays may hold more rows than `count` (a training model's spare capacity); kernels use `count`.
 struct DeviceGaussians {
   DeviceGaussians(engine::Context& context, const GaussianModel& model);
+  // Uninitialized arrays of `capacity` rows (at least 1), `count` of them in use.
+  DeviceGaussians(engine::Context& context, uint32_t channels, uint32_t sh_degree, size_t count,
+                  size_t capacity);
   void upload(const GaussianModel& model);  // same size, channels and degree
-  GaussianModel download() const;
+  GaussianModel download() const;           // the first `count` rows
   size_t size() const { return count; }
+  size_t capacity() const { return opacity_logits.size(); }
 
   size_t count;
   uint32_t channels, sh_degree;
@@ -38,6 +44,10 @@ struct DeviceGaussians {
   engine::DeviceArray<float> opacity_logits;  // [N]
   engine::DeviceArray<float> sh;              // [N][K][C]
 };
+
+// The push constants of the splat kernels for `camera` and `count` elements (also used by kernels outside the
+// rasterizer that project Gaussians, e.g. the densification statistics).
+SplatView make_splat_view(const SplatCamera& camera, uint32_t count, uint32_t sh_coeffs);
 
 class Rasterizer {
  public:

@@ -1,0 +1,43 @@
+// Adam on the device: bindings and parameters shared by C++ and GLSL (kernels/optim/adam.comp).
+// One element-wise dispatch per parameter buffer; the learning rate and the bias corrections of the step
+// come in push constants, so one kernel serves every parameter group.
+#ifndef LITGS_KERNELS_OPTIM_SHARED_H
+#define LITGS_KERNELS_OPTIM_SHARED_H
+
+#ifdef __cplusplus
+#include <cstdint>
+namespace litgs::kernels {
+using uint = uint32_t;
+#endif
+
+// ---- adam.comp: one invocation per parameter element (2D grid of ELEMENTWISE_GROUP_SIZE groups) ----
+#define ADAM_BINDING_PARAMS 0      // [count] float, updated in place
+#define ADAM_BINDING_GRADS 1       // [count] float dL/dparam
+#define ADAM_BINDING_EXP_AVG 2     // [count] float first moment m, updated in place
+#define ADAM_BINDING_EXP_AVG_SQ 3  // [count] float second moment v, updated in place
+#define ADAM_BINDING_COUNTERS 4    // [ADAM_COUNTER_SLOTS] uint: [counter_slot] += elements skipped (atomic)
+
+// One counter per parameter group: elements whose gradient (or whose updated value) was not finite. Such an
+// element keeps its parameter and both moments.
+#define ADAM_COUNTER_SLOTS 8
+
+struct AdamParams {
+  uint count;         // elements in the buffer
+  uint period;        // element j uses lr when (j % period) < lead, else lr_rest (SH: period K*C, lead C)
+  uint lead;          //   period = lead = 1 for a group with one learning rate
+  uint counter_slot;  // < ADAM_COUNTER_SLOTS
+  float lr;
+  float lr_rest;
+  float beta1;
+  float beta2;
+  float eps;
+  float bias_correction1;       // 1 - beta1^step (step counted from 1)
+  float sqrt_bias_correction2;  // sqrt(1 - beta2^step)
+  uint reserved;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(AdamParams) <= 128);
+}  // namespace litgs::kernels
+#endif
+#endif

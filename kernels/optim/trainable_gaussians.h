@@ -1,0 +1,84 @@
+// A Gaussian model being trained on the device: its parameters (a DeviceGaussians the rasterizer renders),
+// the Adam moments of every parameter group, and the densification statistics; the Adam step, the
+// statistics, adaptive density control (clone, split, prune, stream compaction) and the opacity reset.
+//
+// A training step records, into one sequence: the loss and Rasterizer::record_backward, then
+// record_accumulate_stats (it reads the parameters the forward used), then record_adam_step.
+// densify_and_prune runs its own two submits with one small readback, and replaces the DeviceGaussians
+// (its buffers are double-buffered with geometric capacity): call Rasterizer::forward again after it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "engine/buffer.h"
+#include "engine/context.h"
+#include "engine/sequence.h"
+#include "kernels/densify/densify.h"
+#include "kernels/optim/adam.h"
+#include "kernels/optim/training_state.h"
+#include "kernels/scan/scan.h"
+#include "kernels/splat/rasterizer.h"
+
+namespace litgs::kernels {
+
+class TrainableGaussians {
+ public:
+  TrainableGaussians(engine::Context& context, const GaussianModel& model, AdamOptions adam = {});
+  TrainableGaussians(engine::Context& context, const TrainingState& state, AdamOptions adam = {});
+  ~TrainableGaussians();
+  TrainableGaussians(const TrainableGaussians&) = delete;
+  TrainableGaussians& operator=(const TrainableGaussians&) = delete;
+
+  // The parameters, for Rasterizer::forward. Replaced (another object) by densify_and_prune.
+  const DeviceGaussians& gaussians() const;
+  size_t size() const;
+  size_t capacity() const;  // rows the current buffers hold
+
+  // Records one Adam step (step counts from 1) of every group from the rasterizer's gradients.
+  void record_adam_step(engine::Sequence& sequence, const Rasterizer::DeviceGrads& grads,
+                        const LearningRates& lr, uint32_t step);
+  // Records the densification statistics of the last backward: for Gaussians whose tile rectangle (the
+  // rasterizer's `rects`) is not empty, grad_accum += |(dL/du W/2, dL/dv H/2)|, denom += 1, and
+  // max_radius = max(max_radius, opacity-aware screen radius in pixels). Record before the Adam step.
+  void record_accumulate_stats(engine::Sequence& sequence, const Rasterizer::DeviceGrads& grads,
+                               const engine::Buffer& rects, const SplatCamera& camera);
+  // Clones, splits and prunes on the device (two submits, one readback of 48 bytes: the report and the new
+  // count). `plane_distance` ([N] float metres, optional) enables the plane prune of the options.
+  DensifyReport densify_and_prune(const DensifyOptions& options, float scene_extent, uint32_t step,
+                                  const engine::Buffer* plane_distance = nullptr);
+  // Records opacity = min(opacity, reset_opacity) and zeroes the opacity moments (3DGS reset_opacity).
+  void record_reset_opacity(engine::Sequence& sequence, float reset_opacity = 0.01f);
+
+  GaussianModel download() const;
+  TrainingState download_state() const;
+  // Replaces parameters, moments and statistics (any size; the same channels and SH degree): a resume, or a
+  // caller's own statistics. Call Rasterizer::forward again after it.
+  void load_state(const TrainingState& state);
+  // Elements skipped by Adam since construction because their gradient or update was not finite, per group.
+  std::array<uint32_t, kParamGroupCount> nonfinite_grad_counts() const;
+  const AdamOptions& adam_options() const { return adam_options_; }
+
+ private:
+  struct Slot;
+  void upload_state(Slot& slot, const TrainingState& state);
+  void ensure_capacity(Slot& slot, size_t rows);
+  uint32_t sh_values() const;
+
+  engine::Context* context_;
+  AdamOptions adam_options_;
+  uint32_t channels_, sh_degree_;
+  AdamKernel adam_;
+  ExclusiveScan scan_;
+  std::unique_ptr<engine::Kernel> stats_, candidates_, decide_, scatter_rows_, scatter_geometry_,
+      reset_opacity_;
+  std::unique_ptr<Slot> current_, spare_;
+  std::unique_ptr<engine::DeviceArray<uint32_t>> adam_counters_;  // [ADAM_COUNTER_SLOTS]
+  // Densification scratch, [N] each, grown geometrically.
+  std::unique_ptr<engine::DeviceArray<uint32_t>> candidate_, rank_, decision_, counts_, offsets_, report_;
+  std::unique_ptr<engine::DeviceArray<float>> no_plane_;  // bound when no plane distances are given
+};
+
+}  // namespace litgs::kernels
