@@ -29,23 +29,25 @@ using uint = uint32_t;
 // ---- ssim_moments_h.comp: one invocation per element, horizontal blur of the five moment maps ----
 #define SSIM_MOMENTS_BINDING_IMAGE 0   // [C][H][W] x
 #define SSIM_MOMENTS_BINDING_TARGET 1  // [C][H][W] y
-#define SSIM_MOMENTS_BINDING_OUT 2     // [5][C][H][W] rows of G*x, G*y, G*x^2, G*y^2, G*xy (out)
+#define SSIM_MOMENTS_BINDING_OUT4 2    // [C][H][W][4] row sums G*x, G*y, G*x^2, G*y^2 (out)
+#define SSIM_MOMENTS_BINDING_OUT1 3    // [C][H][W] row sums G*xy (out)
 
 // ---- ssim_pixel.comp: one invocation per element: vertical blur, SSIM, its partials, the L1 term ----
 #define SSIM_PIXEL_BINDING_IMAGE 0     // [C][H][W] x
 #define SSIM_PIXEL_BINDING_TARGET 1    // [C][H][W] y
-#define SSIM_PIXEL_BINDING_MOMENTS 2   // [5][C][H][W] from ssim_moments_h
-#define SSIM_PIXEL_BINDING_PARTIALS 3  // [3][C][H][W] dL/d(mu_x), dL/d(E[x^2]), dL/d(E[xy]) (out)
-#define SSIM_PIXEL_BINDING_TERMS 4     // [C][H][W][2] (1 - SSIM, |x - y|) (out)
+#define SSIM_PIXEL_BINDING_MOMENTS4 2  // [C][H][W][4] from ssim_moments_h
+#define SSIM_PIXEL_BINDING_MOMENTS1 3  // [C][H][W] from ssim_moments_h
+#define SSIM_PIXEL_BINDING_PARTIALS 4  // [C][H][W][4] dL/d(mu_x), dL/d(E[x^2]), dL/d(E[xy]), 0 (out)
+#define SSIM_PIXEL_BINDING_TERMS 5     // [C][H][W][2] (1 - SSIM, |x - y|) (out)
 
 // ---- ssim_partials_h.comp: one invocation per element, horizontal blur of the three partial maps ----
-#define SSIM_PARTIALS_BINDING_IN 0   // [3][C][H][W]
-#define SSIM_PARTIALS_BINDING_OUT 1  // [3][C][H][W] (out)
+#define SSIM_PARTIALS_BINDING_IN 0   // [C][H][W][4]
+#define SSIM_PARTIALS_BINDING_OUT 1  // [C][H][W][4] (out)
 
 // ---- ssim_backward.comp: one invocation per element: vertical blur of the partials, combine ----
 #define SSIM_BACKWARD_BINDING_IMAGE 0     // [C][H][W] x
 #define SSIM_BACKWARD_BINDING_TARGET 1    // [C][H][W] y
-#define SSIM_BACKWARD_BINDING_PARTIALS 2  // [3][C][H][W] from ssim_partials_h
+#define SSIM_BACKWARD_BINDING_PARTIALS 2  // [C][H][W][4] from ssim_partials_h
 #define SSIM_BACKWARD_BINDING_GRAD 3      // [C][H][W] weight * dL_pho/dx (out, overwritten)
 
 // Push constants of the four photometric kernels.

@@ -23,8 +23,8 @@ PhotometricLoss::PhotometricLoss(engine::Context& context, uint32_t channels, Ph
   if (channels < 1 || channels > SPLAT_MAX_CHANNELS)
     throw std::invalid_argument("PhotometricLoss: channels = " + std::to_string(channels) + ", must be 1.." +
                                 std::to_string(SPLAT_MAX_CHANNELS));
-  moments_ = loss_detail::make_kernel(context, "loss/ssim_moments_h", 3, sizeof(PhotometricParams));
-  pixel_ = loss_detail::make_kernel(context, "loss/ssim_pixel", 5, sizeof(PhotometricParams));
+  moments_ = loss_detail::make_kernel(context, "loss/ssim_moments_h", 4, sizeof(PhotometricParams));
+  pixel_ = loss_detail::make_kernel(context, "loss/ssim_pixel", 6, sizeof(PhotometricParams));
   partials_h_ = loss_detail::make_kernel(context, "loss/ssim_partials_h", 2, sizeof(PhotometricParams));
   backward_ = loss_detail::make_kernel(context, "loss/ssim_backward", 4, sizeof(PhotometricParams));
 }
@@ -33,8 +33,9 @@ PhotometricLoss::~PhotometricLoss() = default;
 
 void PhotometricLoss::reserve(uint32_t width, uint32_t height) {
   const uint64_t n = uint64_t{channels_} * width * height;
-  loss_detail::ensure(*context_, moments_buf_, 5 * n * sizeof(float), "loss: ssim moments");
-  loss_detail::ensure(*context_, partials_buf_, 3 * n * sizeof(float), "loss: ssim partials");
+  loss_detail::ensure(*context_, moments4_buf_, 4 * n * sizeof(float), "loss: ssim moments (4)");
+  loss_detail::ensure(*context_, moments1_buf_, n * sizeof(float), "loss: ssim moments (xy)");
+  loss_detail::ensure(*context_, partials_buf_, 4 * n * sizeof(float), "loss: ssim partials");
   loss_detail::ensure(*context_, terms_buf_, 2 * n * sizeof(float), "loss: photometric terms");
   sum_.reserve(n);
 }
@@ -49,7 +50,7 @@ void PhotometricLoss::record(engine::Sequence& sequence, const engine::Buffer& i
                                 std::to_string(height) + " is empty");
   if (!std::isfinite(weight)) throw std::invalid_argument(std::string(who) + ": weight is not finite");
   const uint64_t n = uint64_t{channels_} * width * height;
-  if (n > 0xFFFFFFFFull / 5) throw std::length_error(std::string(who) + ": image too large");
+  if (n > 0xFFFFFFFFull / 4) throw std::length_error(std::string(who) + ": image too large");
   const uint64_t bytes = n * sizeof(float);
   loss_detail::check_binding(who, "image", image, bytes);
   loss_detail::check_binding(who, "target", target, bytes);
@@ -57,7 +58,7 @@ void PhotometricLoss::record(engine::Sequence& sequence, const engine::Buffer& i
   loss_detail::check_binding(who, "loss_out", loss_out, (uint64_t{loss_slot} + kOutputs) * sizeof(float));
   const engine::Groups groups = loss_detail::elementwise_groups(*context_, who, n);
   reserve(width, height);
-  loss_detail::check_binding(who, "ssim moments (scratch)", *moments_buf_, 5 * bytes);
+  loss_detail::check_binding(who, "ssim moments (scratch)", *moments4_buf_, 4 * bytes);
 
   PhotometricParams p{};
   p.width = width;
@@ -67,30 +68,33 @@ void PhotometricLoss::record(engine::Sequence& sequence, const engine::Buffer& i
   p.inv_count = static_cast<float>(1.0 / static_cast<double>(n));
   p.weight = weight;
 
-  const engine::Buffer& moments = *moments_buf_;
+  const engine::Buffer& moments4 = *moments4_buf_;
+  const engine::Buffer& moments1 = *moments1_buf_;
   const engine::Buffer& partials = *partials_buf_;
   const engine::Buffer& terms = *terms_buf_;
   sequence.dispatch(*moments_, groups,
                     {{SSIM_MOMENTS_BINDING_IMAGE, &image, Access::kRead},
                      {SSIM_MOMENTS_BINDING_TARGET, &target, Access::kRead},
-                     {SSIM_MOMENTS_BINDING_OUT, &moments, Access::kWrite}},
+                     {SSIM_MOMENTS_BINDING_OUT4, &moments4, Access::kWrite},
+                     {SSIM_MOMENTS_BINDING_OUT1, &moments1, Access::kWrite}},
                     p);
   sequence.dispatch(*pixel_, groups,
                     {{SSIM_PIXEL_BINDING_IMAGE, &image, Access::kRead},
                      {SSIM_PIXEL_BINDING_TARGET, &target, Access::kRead},
-                     {SSIM_PIXEL_BINDING_MOMENTS, &moments, Access::kRead},
+                     {SSIM_PIXEL_BINDING_MOMENTS4, &moments4, Access::kRead},
+                     {SSIM_PIXEL_BINDING_MOMENTS1, &moments1, Access::kRead},
                      {SSIM_PIXEL_BINDING_PARTIALS, &partials, Access::kWrite},
                      {SSIM_PIXEL_BINDING_TERMS, &terms, Access::kWrite}},
                     p);
   // The row blurs are dead after ssim_pixel: their buffer takes the blurred partials.
   sequence.dispatch(*partials_h_, groups,
                     {{SSIM_PARTIALS_BINDING_IN, &partials, Access::kRead},
-                     {SSIM_PARTIALS_BINDING_OUT, &moments, Access::kWrite}},
+                     {SSIM_PARTIALS_BINDING_OUT, &moments4, Access::kWrite}},
                     p);
   sequence.dispatch(*backward_, groups,
                     {{SSIM_BACKWARD_BINDING_IMAGE, &image, Access::kRead},
                      {SSIM_BACKWARD_BINDING_TARGET, &target, Access::kRead},
-                     {SSIM_BACKWARD_BINDING_PARTIALS, &moments, Access::kRead},
+                     {SSIM_BACKWARD_BINDING_PARTIALS, &moments4, Access::kRead},
                      {SSIM_BACKWARD_BINDING_GRAD, &grad_image, Access::kWrite}},
                     p);
 

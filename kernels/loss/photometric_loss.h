@@ -43,7 +43,7 @@ class PhotometricLoss {
   //   grad_image = weight * dL_pho/dx, [C][H][W], OVERWRITTEN (not accumulated): the photometric term is the
   //                only one with a gradient w.r.t. the image, so the trainer needs no clear before it.
   // image and target hold C*H*W floats ([C][H][W]), loss_out at least loss_slot + 3 floats; every buffer is
-  // checked. At |x - y| = 0 the L1 term's gradient is 0. Scratch (about 10 * C*H*W floats) belongs to this
+  // checked. At |x - y| = 0 the L1 term's gradient is 0. Scratch (11 * C*H*W floats) belongs to this
   // object and is shared by every record(): a record() that grows it (a larger image than any before; use
   // reserve()) frees the old scratch, so sequences recorded earlier must not be submitted again after it.
   void record(engine::Sequence& sequence, const engine::Buffer& image, const engine::Buffer& target,
@@ -59,8 +59,9 @@ class PhotometricLoss {
   PhotometricLossOptions options_;
   std::unique_ptr<engine::Kernel> moments_, pixel_, partials_h_, backward_;
   loss_detail::LossSum sum_;
-  // moments: [5][N] row blurs, reused for the blurred partials [3][N]; partials [3][N]; terms [N][2].
-  std::unique_ptr<engine::Buffer> moments_buf_, partials_buf_, terms_buf_;
+  // moments4 [N][4] and moments1 [N]: row blurs (moments4 is reused for the blurred partials);
+  // partials [N][4]; terms [N][2]. Vectors per element: one load per tap on CPU drivers, not one per map.
+  std::unique_ptr<engine::Buffer> moments4_buf_, moments1_buf_, partials_buf_, terms_buf_;
 };
 
 }  // namespace litgs::kernels

@@ -9,23 +9,18 @@
 layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = SSIM_BACKWARD_BINDING_IMAGE) readonly buffer Image { float image[]; };
 layout(std430, binding = SSIM_BACKWARD_BINDING_TARGET) readonly buffer Target { float target[]; };
-layout(std430, binding = SSIM_BACKWARD_BINDING_PARTIALS) readonly buffer Partials { float partials[]; };
+layout(std430, binding = SSIM_BACKWARD_BINDING_PARTIALS) readonly buffer Partials { vec4 partials[]; };
 layout(std430, binding = SSIM_BACKWARD_BINDING_GRAD) writeonly buffer Grad { float grad[]; };
 layout(push_constant) uniform Push { PhotometricParams p; };
 
 void main() {
   const uint e = gl_GlobalInvocationID.x;
   if (e >= p.count) return;
-  const uint n = p.count;
   const int y = int((e / p.width) % p.height);
   const int h = int(p.height);
   const int w = int(p.width);
-  vec3 s = vec3(0.0);
-#define TAP(k, wk)                                                        \
-  if (y + (k) >= 0 && y + (k) < h) {                                      \
-    const uint i = uint(int(e) + (k) * w);                                \
-    s += float(wk) * vec3(partials[i], partials[n + i], partials[2u * n + i]); \
-  }
+  vec4 s = vec4(0.0);
+#define TAP(k, wk) s += SSIM_TAP_WEIGHT(y, k, h, wk) * partials[int(e) + SSIM_TAP_OFFSET(y, k, h) * w];
   SSIM_WINDOW(TAP)
 #undef TAP
   const float xv = image[e];

@@ -8,7 +8,8 @@
 layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = SSIM_MOMENTS_BINDING_IMAGE) readonly buffer Image { float image[]; };
 layout(std430, binding = SSIM_MOMENTS_BINDING_TARGET) readonly buffer Target { float target[]; };
-layout(std430, binding = SSIM_MOMENTS_BINDING_OUT) writeonly buffer Moments { float moments[]; };
+layout(std430, binding = SSIM_MOMENTS_BINDING_OUT4) writeonly buffer Moments4 { vec4 moments4[]; };
+layout(std430, binding = SSIM_MOMENTS_BINDING_OUT1) writeonly buffer Moments1 { float moments1[]; };
 layout(push_constant) uniform Push { PhotometricParams p; };
 
 void main() {
@@ -19,17 +20,16 @@ void main() {
   vec4 m = vec4(0.0);  // x, y, x^2, y^2
   float mxy = 0.0;
 #define TAP(k, wk)                                       \
-  if (x + (k) >= 0 && x + (k) < w) {                     \
-    const float a = image[int(e) + (k)];                 \
-    const float b = target[int(e) + (k)];                \
-    m += float(wk) * vec4(a, b, a * a, b * b);           \
-    mxy += float(wk) * (a * b);                          \
+  {                                                      \
+    const int i = int(e) + SSIM_TAP_OFFSET(x, k, w);     \
+    const float wt = SSIM_TAP_WEIGHT(x, k, w, wk);       \
+    const float a = image[i];                            \
+    const float b = target[i];                           \
+    m += wt * vec4(a, b, a * a, b * b);                  \
+    mxy += wt * (a * b);                                 \
   }
   SSIM_WINDOW(TAP)
 #undef TAP
-  moments[e] = m.x;
-  moments[p.count + e] = m.y;
-  moments[2u * p.count + e] = m.z;
-  moments[3u * p.count + e] = m.w;
-  moments[4u * p.count + e] = mxy;
+  moments4[e] = m;
+  moments1[e] = mxy;
 }

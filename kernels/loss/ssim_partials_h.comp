@@ -7,25 +7,18 @@
 #include "loss/ssim_window.glsl"
 
 layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
-layout(std430, binding = SSIM_PARTIALS_BINDING_IN) readonly buffer In { float partials[]; };
-layout(std430, binding = SSIM_PARTIALS_BINDING_OUT) writeonly buffer Out { float blurred[]; };
+layout(std430, binding = SSIM_PARTIALS_BINDING_IN) readonly buffer In { vec4 partials[]; };
+layout(std430, binding = SSIM_PARTIALS_BINDING_OUT) writeonly buffer Out { vec4 blurred[]; };
 layout(push_constant) uniform Push { PhotometricParams p; };
 
 void main() {
   const uint e = gl_GlobalInvocationID.x;
   if (e >= p.count) return;
-  const uint n = p.count;
   const int x = int(e % p.width);
   const int w = int(p.width);
-  vec3 s = vec3(0.0);
-#define TAP(k, wk)                                                        \
-  if (x + (k) >= 0 && x + (k) < w) {                                      \
-    const uint i = uint(int(e) + (k));                                    \
-    s += float(wk) * vec3(partials[i], partials[n + i], partials[2u * n + i]); \
-  }
+  vec4 s = vec4(0.0);
+#define TAP(k, wk) s += SSIM_TAP_WEIGHT(x, k, w, wk) * partials[int(e) + SSIM_TAP_OFFSET(x, k, w)];
   SSIM_WINDOW(TAP)
 #undef TAP
-  blurred[e] = s.x;
-  blurred[n + e] = s.y;
-  blurred[2u * n + e] = s.z;
+  blurred[e] = s;
 }

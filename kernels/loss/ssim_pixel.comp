@@ -9,25 +9,26 @@
 layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = SSIM_PIXEL_BINDING_IMAGE) readonly buffer Image { float image[]; };
 layout(std430, binding = SSIM_PIXEL_BINDING_TARGET) readonly buffer Target { float target[]; };
-layout(std430, binding = SSIM_PIXEL_BINDING_MOMENTS) readonly buffer Moments { float moments[]; };
-layout(std430, binding = SSIM_PIXEL_BINDING_PARTIALS) writeonly buffer Partials { float partials[]; };
+layout(std430, binding = SSIM_PIXEL_BINDING_MOMENTS4) readonly buffer Moments4 { vec4 moments4[]; };
+layout(std430, binding = SSIM_PIXEL_BINDING_MOMENTS1) readonly buffer Moments1 { float moments1[]; };
+layout(std430, binding = SSIM_PIXEL_BINDING_PARTIALS) writeonly buffer Partials { vec4 partials[]; };
 layout(std430, binding = SSIM_PIXEL_BINDING_TERMS) writeonly buffer Terms { vec2 terms[]; };
 layout(push_constant) uniform Push { PhotometricParams p; };
 
 void main() {
   const uint e = gl_GlobalInvocationID.x;
   if (e >= p.count) return;
-  const uint n = p.count;
   const int y = int((e / p.width) % p.height);
   const int h = int(p.height);
   const int w = int(p.width);
   vec4 m = vec4(0.0);  // mu_x, mu_y, E[x^2], E[y^2]
   float exy = 0.0;
-#define TAP(k, wk)                                                                              \
-  if (y + (k) >= 0 && y + (k) < h) {                                                            \
-    const uint i = uint(int(e) + (k) * w);                                                      \
-    m += float(wk) * vec4(moments[i], moments[n + i], moments[2u * n + i], moments[3u * n + i]); \
-    exy += float(wk) * moments[4u * n + i];                                                     \
+#define TAP(k, wk)                                           \
+  {                                                          \
+    const int i = int(e) + SSIM_TAP_OFFSET(y, k, h) * w;     \
+    const float wt = SSIM_TAP_WEIGHT(y, k, h, wk);           \
+    m += wt * moments4[i];                                   \
+    exy += wt * moments1[i];                                 \
   }
   SSIM_WINDOW(TAP)
 #undef TAP
@@ -46,8 +47,6 @@ void main() {
   const float d_ex2 = -ssim / b2;
   const float d_exy = 2.0 * a1 * inv_b;
   const float g = -p.lambda_ssim * p.inv_count;
-  partials[e] = g * d_mux;
-  partials[n + e] = g * d_ex2;
-  partials[2u * n + e] = g * d_exy;
+  partials[e] = vec4(g * d_mux, g * d_ex2, g * d_exy, 0.0);
   terms[e] = vec2(1.0 - ssim, abs(image[e] - target[e]));
 }
