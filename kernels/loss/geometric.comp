@@ -1,0 +1,39 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Per pixel: the LiDAR point-to-plane residual r = n . (P - D K^-1 [u + 0.5, v + 0.5, 1]) and
+// dL/dD = -2 r (n . ray) / N_valid. Pixels without a valid point, or where nothing was rendered (D <= 0 or
+// not finite), count 0 and get a zero gradient (see geometric_loss.h).
+#include "limits.h"
+#include "loss/loss_shared.h"
+
+layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
+layout(std430, binding = GEOMETRIC_BINDING_DEPTH) readonly buffer Depth { float depth[]; };
+layout(std430, binding = GEOMETRIC_BINDING_POINTS) readonly buffer Points { vec4 points[]; };
+layout(std430, binding = GEOMETRIC_BINDING_NORMALS) readonly buffer Normals { vec4 normals[]; };
+layout(std430, binding = GEOMETRIC_BINDING_GRAD) writeonly buffer Grad { float grad[]; };
+layout(std430, binding = GEOMETRIC_BINDING_TERMS) writeonly buffer Terms { vec2 terms[]; };
+layout(push_constant) uniform Push { GeometricParams p; };
+
+// Bitwise, so that fast-math cannot fold it away.
+bool is_finite(float v) { return (floatBitsToUint(v) & 0x7F800000u) != 0x7F800000u; }
+
+void main() {
+  const uint i = gl_GlobalInvocationID.x;
+  if (i >= p.count) return;
+  const float d = depth[i];
+  const vec4 point = points[i];
+  float r2 = 0.0, g = 0.0, counted = 0.0;
+  if (point.w > 0.5 && d > 0.0 && is_finite(d) && p.inv_valid > 0.0) {
+    const vec3 n = normals[i].xyz;
+    const float u = float(i % p.width) + 0.5;
+    const float v = float(i / p.width) + 0.5;
+    const vec3 ray = vec3((u - p.cx) / p.fx, (v - p.cy) / p.fy, 1.0);
+    const float n_ray = dot(n, ray);
+    const float r = dot(n, point.xyz) - d * n_ray;
+    r2 = r * r;
+    g = p.weight * p.inv_valid * (-2.0 * r * n_ray);
+    counted = 1.0;
+  }
+  grad[i] = g;
+  terms[i] = vec2(r2, counted);
+}

@@ -1,0 +1,85 @@
+#include "kernels/loss/geometric_loss.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "kernels/loss/loss_shared.h"
+
+namespace litgs::kernels {
+
+using engine::Access;
+
+GeometricLoss::GeometricLoss(engine::Context& context) : context_(&context), sum_(context) {
+  kernel_ = loss_detail::make_kernel(context, "loss/geometric", 5, sizeof(GeometricParams));
+}
+
+GeometricLoss::~GeometricLoss() = default;
+
+void GeometricLoss::reserve(uint32_t width, uint32_t height) {
+  const uint64_t n = uint64_t{width} * height;
+  loss_detail::ensure(*context_, terms_buf_, 2 * n * sizeof(float), "loss: geometric terms");
+  sum_.reserve(n);
+}
+
+uint32_t GeometricLoss::count_valid(std::span<const float> points) {
+  if (points.size() % 4 != 0)
+    throw std::invalid_argument("GeometricLoss::count_valid: " + std::to_string(points.size()) +
+                                " floats is not a [H][W][4] map");
+  uint32_t count = 0;
+  for (size_t i = 3; i < points.size(); i += 4) count += points[i] > 0.5f ? 1 : 0;
+  return count;
+}
+
+void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& depth,
+                           const engine::Buffer& points, const engine::Buffer& normals, uint32_t width,
+                           uint32_t height, float fx, float fy, float cx, float cy, uint32_t valid_count,
+                           float weight, const engine::Buffer& grad_depth, const engine::Buffer& loss_out,
+                           uint32_t loss_slot) {
+  static const char* who = "GeometricLoss::record";
+  if (width == 0 || height == 0)
+    throw std::invalid_argument(std::string(who) + ": view size " + std::to_string(width) + "x" +
+                                std::to_string(height) + " is empty");
+  if (!(std::isfinite(fx) && std::isfinite(fy) && std::isfinite(cx) && std::isfinite(cy) && fx > 0 && fy > 0))
+    throw std::invalid_argument(std::string(who) + ": intrinsics fx " + std::to_string(fx) + " fy " +
+                                std::to_string(fy) + " cx " + std::to_string(cx) + " cy " +
+                                std::to_string(cy) + " (need finite values, fx and fy > 0)");
+  if (!std::isfinite(weight)) throw std::invalid_argument(std::string(who) + ": weight is not finite");
+  const uint64_t n = uint64_t{width} * height;
+  if (valid_count > n)
+    throw std::invalid_argument(std::string(who) + ": valid_count " + std::to_string(valid_count) +
+                                " exceeds the " + std::to_string(n) + " pixels");
+  loss_detail::check_binding(who, "depth", depth, n * sizeof(float));
+  loss_detail::check_binding(who, "points", points, 4 * n * sizeof(float));
+  loss_detail::check_binding(who, "normals", normals, 4 * n * sizeof(float));
+  loss_detail::check_binding(who, "grad_depth", grad_depth, n * sizeof(float));
+  loss_detail::check_binding(who, "loss_out", loss_out, (uint64_t{loss_slot} + kOutputs) * sizeof(float));
+  const engine::Groups groups = loss_detail::elementwise_groups(*context_, who, n);
+  reserve(width, height);
+
+  GeometricParams p{};
+  p.width = width;
+  p.height = height;
+  p.count = static_cast<uint32_t>(n);
+  p.fx = fx;
+  p.fy = fy;
+  p.cx = cx;
+  p.cy = cy;
+  p.inv_valid = valid_count > 0 ? static_cast<float>(1.0 / valid_count) : 0.0f;
+  p.weight = weight;
+  sequence.dispatch(*kernel_, groups,
+                    {{GEOMETRIC_BINDING_DEPTH, &depth, Access::kRead},
+                     {GEOMETRIC_BINDING_POINTS, &points, Access::kRead},
+                     {GEOMETRIC_BINDING_NORMALS, &normals, Access::kRead},
+                     {GEOMETRIC_BINDING_GRAD, &grad_depth, Access::kWrite},
+                     {GEOMETRIC_BINDING_TERMS, terms_buf_.get(), Access::kWrite}},
+                    p);
+  ReduceParams r{};
+  r.slot = loss_slot;
+  r.outputs = kOutputs;
+  r.w00 = p.inv_valid;  // L_geo = sum r^2 / N_valid
+  r.w11 = 1.0f;         // pixels that counted
+  sum_.record(sequence, *terms_buf_, n, r, loss_out);
+}
+
+}  // namespace litgs::kernels

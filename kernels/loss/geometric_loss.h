@@ -1,0 +1,62 @@
+// The LiDAR point-to-plane training loss on the device (the method's geometric term):
+//   L_geo = (1 / N_valid) * sum_i (n_i . (P_i - D(u_i) K^-1 [u_i + 0.5, v_i + 0.5, 1]))^2      [metres^2]
+// over pixels i that carry a LiDAR point P_i (camera frame, metres) and its unit plane normal n_i; D is the
+// rendered expected depth (metres, camera z). N_valid is the number of pixels with a point (the host counts
+// it once per view: count_valid()), so the loss is a mean over LiDAR pixels and does not jump as rendered
+// coverage changes.
+//
+// Pixels where nothing was rendered (D <= 0 or not finite; the rasterizer writes D = 0 where the
+// accumulated alpha is below SPLAT_MIN_DEPTH_WEIGHT) are SKIPPED: they add 0 to the sum and get a zero
+// gradient, but stay in N_valid. Counting them with D = 0 would add (n . P)^2 -- the plane's distance from
+// the camera centre, metres squared -- a constant that dwarfs the real residuals and carries no gradient
+// (the rasterizer's depth has none where nothing is rendered). The reference does the same.
+// The CPU double reference of the same math is kernels/loss/loss_reference.h.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "engine/buffer.h"
+#include "engine/context.h"
+#include "engine/kernel.h"
+#include "engine/sequence.h"
+#include "kernels/loss/loss_sum.h"
+
+namespace litgs::kernels {
+
+class GeometricLoss {
+ public:
+  // Outputs written from the loss slot: L_geo (m^2), and the number of pixels that counted (a valid point
+  // and a rendered depth), as a float.
+  static constexpr uint32_t kOutputs = 2;
+
+  explicit GeometricLoss(engine::Context& context);
+  ~GeometricLoss();
+
+  // Allocates the scratch for views up to width x height now (record() grows it on demand otherwise).
+  void reserve(uint32_t width, uint32_t height);
+
+  // Records forward and backward into `sequence` (no submit):
+  //   loss_out[loss_slot]     = L_geo (unweighted, metres^2)
+  //   loss_out[loss_slot + 1] = pixels that counted
+  //   grad_depth = weight * dL_geo/dD, [H][W] (metres^2 per metre), OVERWRITTEN (not accumulated).
+  // depth holds H*W floats, points and normals H*W*4 ([H][W][4]: x y z valid / nx ny nz 0), loss_out at
+  // least loss_slot + 2 floats; every buffer is checked. valid_count = 0: loss 0 and a zero gradient.
+  // Intrinsics in pixels; pixel (u, v) has its centre at (u + 0.5, v + 0.5). Scratch as PhotometricLoss.
+  void record(engine::Sequence& sequence, const engine::Buffer& depth, const engine::Buffer& points,
+              const engine::Buffer& normals, uint32_t width, uint32_t height, float fx, float fy, float cx,
+              float cy, uint32_t valid_count, float weight, const engine::Buffer& grad_depth,
+              const engine::Buffer& loss_out, uint32_t loss_slot);
+
+  // N_valid of a point map [H][W][4]: pixels whose valid flag (element 3) is above 0.5.
+  static uint32_t count_valid(std::span<const float> points);
+
+ private:
+  engine::Context* context_;
+  std::unique_ptr<engine::Kernel> kernel_;
+  loss_detail::LossSum sum_;
+  std::unique_ptr<engine::Buffer> terms_buf_;  // [H][W][2]
+};
+
+}  // namespace litgs::kernels

@@ -1,0 +1,88 @@
+#include "kernels/loss/loss_sum.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "kernels/limits.h"
+#include "kernels/spirv_registry.h"
+
+namespace litgs::kernels::loss_detail {
+
+void check_binding(const char* who, const char* what, const engine::Buffer& buffer, uint64_t bytes) {
+  if (buffer.size_bytes() < bytes)
+    throw std::invalid_argument(std::string(who) + ": " + what + " buffer '" + buffer.name() + "' holds " +
+                                std::to_string(buffer.size_bytes()) + " bytes, needs " +
+                                std::to_string(bytes));
+  const uint64_t range = buffer.context().info().max_storage_buffer_range;
+  if (range != 0 && bytes > range)
+    throw std::length_error(std::string(who) + ": " + what + " needs a binding of " + std::to_string(bytes) +
+                            " bytes, over the device's maxStorageBufferRange of " + std::to_string(range));
+}
+
+engine::Groups elementwise_groups(const engine::Context& context, const char* who, uint64_t n) {
+  const uint64_t groups = (n + ELEMENTWISE_GROUP_SIZE - 1) / ELEMENTWISE_GROUP_SIZE;
+  const uint64_t limit = std::min<uint64_t>(context.info().max_compute_workgroup_count[0], 0xFFFFFFFFull);
+  if (groups > limit)
+    throw std::length_error(std::string(who) + ": " + std::to_string(n) + " elements need " +
+                            std::to_string(groups) + " workgroups, the device allows " +
+                            std::to_string(limit));
+  return {static_cast<uint32_t>(groups)};
+}
+
+std::unique_ptr<engine::Kernel> make_kernel(engine::Context& context, const char* name, uint32_t bindings,
+                                            uint32_t push_constant_bytes) {
+  engine::KernelDesc desc;
+  desc.name = name;
+  desc.spirv = spirv(name);
+  desc.binding_count = bindings;
+  desc.push_constant_bytes = push_constant_bytes;
+  return std::make_unique<engine::Kernel>(context, std::move(desc));
+}
+
+void ensure(engine::Context& context, std::unique_ptr<engine::Buffer>& buffer, uint64_t bytes,
+            const char* name) {
+  if (buffer && buffer->size_bytes() >= bytes) return;
+  const uint64_t grown = buffer ? std::max(bytes, buffer->size_bytes() + buffer->size_bytes() / 2) : bytes;
+  buffer.reset();
+  buffer = std::make_unique<engine::Buffer>(context, name, std::max<uint64_t>(grown, 16));
+}
+
+LossSum::LossSum(engine::Context& context) : context_(&context) {
+  blocks_ = make_kernel(context, "loss/reduce_blocks", 2, sizeof(ReduceParams));
+  finish_ = make_kernel(context, "loss/reduce_finish", 2, sizeof(ReduceParams));
+}
+
+namespace {
+uint64_t block_count(uint64_t rows) {
+  return std::max<uint64_t>(1, (rows + LOSS_REDUCE_ROWS_PER_GROUP - 1) / LOSS_REDUCE_ROWS_PER_GROUP);
+}
+}  // namespace
+
+void LossSum::reserve(uint64_t rows) {
+  ensure(*context_, block_sums_, block_count(rows) * 2 * sizeof(float), "loss: block sums");
+}
+
+void LossSum::record(engine::Sequence& sequence, const engine::Buffer& terms, uint64_t rows,
+                     ReduceParams params, const engine::Buffer& out) {
+  if (params.outputs < 1 || params.outputs > 3)
+    throw std::invalid_argument("LossSum: outputs = " + std::to_string(params.outputs) + ", must be 1..3");
+  const uint64_t blocks = block_count(rows);
+  // reduce_finish walks the block sums 256 at a time: stay within lavapipe's loop budget (limits.h).
+  if (blocks > uint64_t{256} * MAX_BATCHES_PER_WORKGROUP || rows > 0xFFFFFFFFull)
+    throw std::length_error("LossSum: " + std::to_string(rows) + " rows exceed the reduction's capacity");
+  check_binding("LossSum", "terms", terms, rows * 2 * sizeof(float));
+  check_binding("LossSum", "loss output", out, (uint64_t{params.slot} + params.outputs) * sizeof(float));
+  reserve(rows);
+  params.count = static_cast<uint32_t>(rows);
+  sequence.dispatch(*blocks_, {static_cast<uint32_t>(blocks)},
+                    {{REDUCE_BLOCKS_BINDING_ROWS, &terms, engine::Access::kRead},
+                     {REDUCE_BLOCKS_BINDING_SUMS, block_sums_.get(), engine::Access::kWrite}},
+                    params);
+  params.count = static_cast<uint32_t>(blocks);
+  sequence.dispatch(*finish_, {1},
+                    {{REDUCE_FINISH_BINDING_SUMS, block_sums_.get(), engine::Access::kRead},
+                     {REDUCE_FINISH_BINDING_OUT, &out, engine::Access::kReadWrite}},
+                    params);
+}
+
+}  // namespace litgs::kernels::loss_detail

@@ -1,0 +1,35 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Per element: horizontal window sums of x, y, x^2, y^2 and xy (the first pass of the separable blur).
+#include "limits.h"
+#include "loss/loss_shared.h"
+#include "loss/ssim_window.glsl"
+
+layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
+layout(std430, binding = SSIM_MOMENTS_BINDING_IMAGE) readonly buffer Image { float image[]; };
+layout(std430, binding = SSIM_MOMENTS_BINDING_TARGET) readonly buffer Target { float target[]; };
+layout(std430, binding = SSIM_MOMENTS_BINDING_OUT4) writeonly buffer Moments4 { vec4 moments4[]; };
+layout(std430, binding = SSIM_MOMENTS_BINDING_OUT1) writeonly buffer Moments1 { float moments1[]; };
+layout(push_constant) uniform Push { PhotometricParams p; };
+
+void main() {
+  const uint e = gl_GlobalInvocationID.x;
+  if (e >= p.count) return;
+  const int x = int(e % p.width);
+  const int w = int(p.width);
+  vec4 m = vec4(0.0);  // x, y, x^2, y^2
+  float mxy = 0.0;
+#define TAP(k, wk)                                       \
+  {                                                      \
+    const int i = int(e) + SSIM_TAP_OFFSET(x, k, w);     \
+    const float wt = SSIM_TAP_WEIGHT(x, k, w, wk);       \
+    const float a = image[i];                            \
+    const float b = target[i];                           \
+    m += wt * vec4(a, b, a * a, b * b);                  \
+    mxy += wt * (a * b);                                 \
+  }
+  SSIM_WINDOW(TAP)
+#undef TAP
+  moments4[e] = m;
+  moments1[e] = mxy;
+}
