@@ -1,6 +1,5 @@
 // litgs-engine: one binary, one subcommand per job.
 #include <CLI/CLI.hpp>
-
 #include <iostream>
 
 #include "engine/vk_check.h"
@@ -12,6 +11,7 @@ int main(int argc, char** argv) {
   litgs::tools::add_info_command(app);
   litgs::tools::add_bench_command(app);
   litgs::tools::add_import_command(app);
+  litgs::tools::add_synth_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
