@@ -1,5 +1,6 @@
 // litgs-engine: one binary, one subcommand per job.
 #include <CLI/CLI.hpp>
+
 #include <iostream>
 
 #include "engine/vk_check.h"

@@ -17,9 +17,9 @@ namespace litgs::host::synth {
 
 struct EstimatorNoiseOptions {
   double drift_m_per_m = 0.01;         // translation drift per metre travelled (one fixed direction)
-  double drift_rad_per_m = 0.0015;     // rotation drift per metre travelled (one fixed axis)
+  double drift_rad_per_m = 0.0003;     // rotation drift per metre travelled (one fixed axis)
   double pose_noise_m = 0.005;         // per-frame position jitter (standard deviation per axis)
-  double pose_noise_rad = 0.001;       // per-frame rotation jitter (standard deviation per axis)
+  double pose_noise_rad = 0.0003;      // per-frame rotation jitter (standard deviation per axis)
   int anchors_per_frame = 20;          // visual map points picked per frame (fewer on textureless views)
   double anchor_pixel_sigma_px = 0.5;  // lateral standard deviation, as a pixel error at the anchor's depth
   double anchor_depth_sigma_m = 0.02;  // standard deviation along the viewing ray

@@ -73,12 +73,15 @@ LidarMaps accumulate_lidar_map(const std::vector<LidarScan>& scans,
   if (!(voxel_m > 0)) throw std::invalid_argument("accumulate_lidar_map: voxel_m must be > 0");
   struct KeyHash {
     size_t operator()(const Eigen::Vector3i& k) const {
-      return static_cast<size_t>((static_cast<uint64_t>(k.x()) * 73856093u) ^
-                                 (static_cast<uint64_t>(k.y()) * 19349663u) ^
-                                 (static_cast<uint64_t>(k.z()) * 83492791u));
+      return static_cast<size_t>(
+          hash_combine(hash_combine(static_cast<uint64_t>(k.x()), static_cast<uint64_t>(k.y())),
+                       static_cast<uint64_t>(k.z())));
     }
   };
+  size_t total = 0;
+  for (const LidarScan& s : scans) total += s.points_lidar.size();
   std::unordered_map<Eigen::Vector3i, int, KeyHash> occupied;
+  occupied.reserve(total / 2);
   LidarMaps maps;
   io::ScalarField plane{"plane_id", {}};
   for (size_t s = 0; s < scans.size(); ++s) {

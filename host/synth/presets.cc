@@ -122,7 +122,7 @@ Preset facade(uint64_t seed) {
   p.trajectory.start_m = Vector3d(0, 0, 1.5);
   p.trajectory.heading_rad = 0;
   Rng rig(seed, Stream::kRig);
-  p.T_imu_cam = camera_mount(90 * kDeg, 12 * kDeg, Vector3d(0.08, 0.06, 0.1), rig);  // looking at the front
+  p.T_imu_cam = camera_mount(90 * kDeg, 5 * kDeg, Vector3d(0.08, 0.06, 0.1), rig);  // looking at the front
   p.T_imu_lidar = lidar_mount(Vector3d(0.0, 0.0, 0.15), rig);
   p.frames = 60;
   return p;

@@ -80,11 +80,11 @@ io::Image render_thermal(const World& world, const ThermalCameraOptions& o,
 }
 
 io::Image auto_gain_8bit(const io::Image& raw, const ThermalCameraOptions& o) {
-  std::vector<uint16_t> sorted = raw.data;
-  std::sort(sorted.begin(), sorted.end());
+  std::vector<uint16_t> values = raw.data;
   auto percentile = [&](double p) {
-    const auto i = static_cast<size_t>(std::lround(p / 100 * static_cast<double>(sorted.size() - 1)));
-    return static_cast<double>(sorted[i]);
+    const auto i = static_cast<size_t>(std::lround(p / 100 * static_cast<double>(values.size() - 1)));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(i), values.end());
+    return static_cast<double>(values[i]);
   };
   const double lo = percentile(o.agc_low_percentile);
   const double hi = std::max(percentile(o.agc_high_percentile), lo + 1);
