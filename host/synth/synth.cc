@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <future>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -190,21 +191,45 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
     for (int k = 0; k < 3; ++k) os << io::format_double(bias.accel_m_s2[k]) << (k < 2 ? " " : "\n");
   });
 
-  // Frames are rendered as write_scene asks for them; a frozen frame repeats the last rendered one.
+  // Frames are rendered as write_scene asks for them (a frozen frame repeats its source frame). While
+  // write_scene encodes frame i, the next source frame renders and frame i's 8-bit view is written beside
+  // it; every frame is a pure function of its index, so this overlap changes no byte.
   fs::create_directories(out / "thermal8");
-  int cached_index = -1;
-  io::Image cached;
+  auto source_of = [&](size_t i) {
+    int f = static_cast<int>(i);
+    while (f > 0 && frozen.count(f)) --f;
+    return f;
+  };
+  auto render = [&](int f) {
+    return render_thermal(p.world, p.camera, T_world_cam[f], options.seed, static_cast<uint64_t>(f), threads);
+  };
+  io::Image current;
+  int current_source = -1, next_source = -1;
+  std::future<io::Image> next;
+  std::future<void> writing8;
   auto frame_image = [&](size_t i) {
-    int source_frame = static_cast<int>(i);
-    while (source_frame > 0 && frozen.count(source_frame)) --source_frame;
-    if (source_frame != cached_index) {
-      cached = render_thermal(p.world, p.camera, T_world_cam[source_frame], options.seed,
-                              static_cast<uint64_t>(source_frame), threads);
-      cached_index = source_frame;
+    const int src = source_of(i);
+    if (src != current_source) {
+      if (next.valid()) {
+        io::Image prefetched = next.get();
+        current = next_source == src ? std::move(prefetched) : render(src);
+      } else {
+        current = render(src);
+      }
+      current_source = src;
     }
-    io::write_image(out / "thermal8" / io::frame_file_name(scene.frames[i].t_s).filename(),
-                    auto_gain_8bit(cached, p.camera));
-    return cached;
+    if (i + 1 < static_cast<size_t>(n) && !next.valid() && source_of(i + 1) != src) {
+      next_source = source_of(i + 1);
+      next = std::async(std::launch::async, render, next_source);
+    }
+    if (writing8.valid()) writing8.get();  // rethrows a failed write
+    const fs::path path8 = out / "thermal8" / io::frame_file_name(scene.frames[i].t_s).filename();
+    auto write8 = [&p, path8](io::Image raw) { io::write_image(path8, auto_gain_8bit(raw, p.camera)); };
+    if (i + 1 < static_cast<size_t>(n))
+      writing8 = std::async(std::launch::async, write8, current);
+    else
+      write8(current);  // the last one before scene.yaml: nothing may still be in flight then
+    return current;
   };
   auto scan_cloud = [&](size_t i) {
     io::PointCloud cloud;
