@@ -29,10 +29,10 @@ const char* const kSceneEntries[] = {"scene.yaml", "thermal", "thermal8",    "po
 
 void prepare_output(const fs::path& out, bool force) {
   if (fs::exists(out) && !fs::is_directory(out))
-    throw std::invalid_argument("--out " + out.string() + " exists and is not a directory");
+    throw std::invalid_argument("synth: --out " + out.string() + " exists and is not a directory");
   if (fs::is_directory(out) && !fs::is_empty(out)) {
     if (!force)
-      throw std::invalid_argument("--out " + out.string() +
+      throw std::invalid_argument("synth: --out " + out.string() +
                                   " exists and is not empty (use --force to replace the scene files in it)");
     for (const char* name : kSceneEntries) fs::remove_all(out / name);
   }

@@ -207,6 +207,35 @@ TEST(SynthImu, AtRestReadsGravityUpPlusBias) {
   EXPECT_GT(bias.gyro_rad_s.norm(), 0);
 }
 
+TEST(SynthImu, IntegratedAccelerationMatchesTheVelocityChange) {
+  // Independent of the closed-form acceleration: velocities from central differences of positions.
+  const Trajectory traj(make_preset("street", 1).trajectory);
+  ImuOptions o;
+  Rng rng(12);
+  ImuBias bias;
+  const auto s = simulate_imu(traj, 0, 2.0, 3.0, o, rng, bias);
+  ASSERT_EQ(s.size(), 201u);
+  const Vector3d g(0, 0, -o.gravity_m_s2);
+  Vector3d dv = Vector3d::Zero();
+  double turned = 0;
+  for (size_t k = 0; k + 1 < s.size(); ++k) {
+    const double dt = s[k + 1].t_s - s[k].t_s;
+    // Trapezoid of the world-frame acceleration R (f - b) + g with the true rotations.
+    const Vector3d a0 = traj.at(s[k].t_s).R_world_body * (s[k].accel_m_s2 - bias.accel_m_s2) + g;
+    const Vector3d a1 = traj.at(s[k + 1].t_s).R_world_body * (s[k + 1].accel_m_s2 - bias.accel_m_s2) + g;
+    dv += 0.5 * (a0 + a1) * dt;
+    turned += (s[k].gyro_rad_s - bias.gyro_rad_s).norm() * dt;
+  }
+  auto velocity = [&](double t) {
+    const double h = 1e-4;
+    return Vector3d((traj.at(t + h).p_world_m - traj.at(t - h).p_world_m) / (2 * h));
+  };
+  const Vector3d expected = velocity(3.0) - velocity(2.0);
+  EXPECT_GT(expected.norm(), 1.0);  // the street rig accelerates hard
+  EXPECT_LT((dv - expected).norm(), 0.03) << dv.transpose() << " vs " << expected.transpose();
+  EXPECT_GT(turned, 0.02);
+}
+
 TEST(SynthEstimator, DriftGrowsWithDistanceAtTheStatedRate) {
   std::vector<io::TumPose> truth(50);
   std::vector<double> dist(50);

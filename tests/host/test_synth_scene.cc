@@ -14,6 +14,7 @@
 #include "host/synth/presets.h"
 #include "host/synth/synth.h"
 #include "io/image.h"
+#include "io/pcd.h"
 #include "io/scene.h"
 #include "io/scene_text.h"
 
@@ -129,6 +130,23 @@ TEST_F(SynthSceneTest, GroundTruthHoldsWhenReadBack) {
   EXPECT_LT(std::sqrt(sum2 / static_cast<double>(on_planes)), sigma);
   EXPECT_GT(std::sqrt(sum2 / static_cast<double>(on_planes)), sigma / 5);  // there is noise
   EXPECT_EQ(outliers, 0u);
+
+  // Scans are in the LiDAR frame: through the true camera pose and T_cam_lidar they land on the true planes
+  // (a wrong or inverted extrinsic would put them centimetres to metres off).
+  for (const size_t f : {size_t{0}, size_t{17}}) {
+    const io::PointCloud scan = io::read_pcd(o.out / s.scans[f].file);
+    ASSERT_GT(scan.size(), 1000u);
+    ASSERT_EQ(s.scans[f].t_s, s.gt->poses[f].t_s);
+    const Eigen::Matrix4d T_world_lidar = to_iso(s.gt->poses[f]).matrix() * s.config.T_cam_lidar;
+    size_t off = 0;
+    for (const Eigen::Vector3d& p : scan.positions) {
+      const Eigen::Vector3d w = (T_world_lidar * p.homogeneous()).head<3>();
+      double nearest = 1e9;
+      for (const io::Plane& pl : s.gt->planes) nearest = std::min(nearest, std::abs(pl.n.dot(w) + pl.d));
+      off += nearest > 5 * sigma ? 1 : 0;
+    }
+    EXPECT_LT(off, scan.size() / 50) << "scan " << f;  // the few returns off planes hit the posts
+  }
 
   // Anchors: each projects into the image with some true pose; their errors against gt/anchors.txt are
   // consistent with their covariances (mean squared Mahalanobis distance ~ 3).
