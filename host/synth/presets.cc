@@ -130,6 +130,7 @@ Preset facade(uint64_t seed) {
   p.T_imu_cam = camera_mount(90 * kDeg, 5 * kDeg, Vector3d(0.08, 0.06, 0.1), rig);  // looking at the front
   p.T_imu_lidar = lidar_mount(Vector3d(0.0, 0.0, 0.15), rig);
   p.frames = 60;
+  p.max_frames = 380;  // 48 m of front at up to 1.8 m/s
   return p;
 }
 
@@ -193,6 +194,7 @@ Preset street(uint64_t seed) {
   p.T_imu_lidar = lidar_mount(Vector3d(0.0, 0.0, 0.25), rig);
   p.lidar.range_max_m = 80;
   p.frames = 80;
+  p.max_frames = 220;  // 140 m of street
   p.map_voxel_m = 0.15;
   return p;
 }
@@ -250,6 +252,7 @@ Preset corridor(uint64_t seed) {
   p.lidar.range_min_m = 0.3;
   p.estimator.anchor_min_gradient_raw = 3;  // indoor contrast is weak
   p.frames = 60;
+  p.max_frames = 350;  // stops short of the end wall 40 m ahead
   p.map_voxel_m = 0.05;
   return p;
 }

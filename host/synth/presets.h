@@ -37,6 +37,7 @@ struct Preset {
   NucOptions nuc;
   double frame_rate_hz = 10;  // camera frames and LiDAR scans (same stamps)
   int frames = 60;            // default frame count
+  int max_frames = 300;       // beyond this the rig would leave the modelled world
   double map_voxel_m = 0.1;   // voxel of the downsampled LiDAR map
 };
 

@@ -96,7 +96,13 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   if (const std::string problem = options.check(); !problem.empty())
     throw std::invalid_argument("synth: " + problem);
   Preset p = make_preset(options.preset, options.seed);
-  if (options.frames) p.frames = *options.frames;
+  if (options.frames) {
+    if (*options.frames > p.max_frames)
+      throw std::invalid_argument(
+          "synth: frames: preset " + p.name + " covers at most " + std::to_string(p.max_frames) +
+          " frames (the rig would leave its world), got " + std::to_string(*options.frames));
+    p.frames = *options.frames;
+  }
   if (options.width) {
     p.camera.width = *options.width;
     p.camera.height = *options.height;

@@ -274,6 +274,9 @@ TEST_F(SynthSceneTest, BadArgumentsAreClearErrors) {
   o.frames = 0;
   expect_invalid([&] { generate_synthetic_scene(o); }, "frames");
   o = small("bad");
+  o.frames = 5000;
+  expect_invalid([&] { generate_synthetic_scene(o); }, "covers at most 380 frames");
+  o = small("bad");
   o.width = 0;
   expect_invalid([&] { generate_synthetic_scene(o); }, "width");
   o = small("bad");
