@@ -1,0 +1,102 @@
+#include "host/synth/lidar_sim.h"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace litgs::host::synth {
+namespace {
+constexpr double kDeg = std::numbers::pi / 180;
+}
+
+std::string LidarOptions::check() const {
+  if (pattern == LidarPattern::kSpinning) {
+    if (beams < 1 || beams > 256) return "beams: must be in [1, 256]";
+    if (columns < 1 || columns > 100000) return "columns: must be in [1, 100000]";
+    if (!(fov_down_deg >= -90 && fov_down_deg < fov_up_deg && fov_up_deg <= 90))
+      return "fov_down_deg/fov_up_deg: need -90 <= down < up <= 90";
+  } else {
+    if (rosette_points < 1 || rosette_points > 10000000) return "rosette_points: must be in [1, 1e7]";
+    if (!(rosette_fov_deg > 0 && rosette_fov_deg < 170)) return "rosette_fov_deg: must be in (0, 170)";
+  }
+  if (!(range_min_m >= 0 && range_max_m > range_min_m)) return "range_min_m/range_max_m: need 0 <= min < max";
+  if (!(range_noise_m >= 0)) return "range_noise_m: must be >= 0";
+  return "";
+}
+
+LidarScan simulate_lidar_scan(const World& world, const Eigen::Isometry3d& T_world_lidar, double t_s,
+                              double t_pattern_s, const LidarOptions& o, Rng& rng) {
+  LidarScan scan;
+  scan.t_s = t_s;
+  const Eigen::Matrix3d R = T_world_lidar.linear();
+  const Eigen::Vector3d origin = T_world_lidar.translation();
+  auto shoot = [&](const Eigen::Vector3d& dir_lidar) {
+    const auto hit = world.cast({origin, R * dir_lidar}, o.range_min_m, o.range_max_m);
+    const double noise = o.range_noise_m * rng.normal();  // drawn for every beam: misses keep streams aligned
+    if (!hit) return;
+    scan.points_lidar.push_back(dir_lidar * (hit->range_m + noise));
+    scan.true_world.push_back(hit->point);
+    scan.plane_id.push_back(hit->plane_id);
+  };
+  if (o.pattern == LidarPattern::kSpinning) {
+    for (int c = 0; c < o.columns; ++c) {
+      const double az = 2 * std::numbers::pi * c / o.columns;
+      for (int b = 0; b < o.beams; ++b) {
+        const double el =
+            (o.beams == 1 ? o.fov_down_deg
+                          : o.fov_down_deg + (o.fov_up_deg - o.fov_down_deg) * b / (o.beams - 1)) *
+            kDeg;
+        shoot({std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el)});
+      }
+    }
+  } else {
+    // Two prisms deflect the beam by a/2 each and turn at incommensurate rates: a rosette that drifts over
+    // time, so the union of scans covers the cone densely.
+    const double a = o.rosette_fov_deg * kDeg / 4;
+    const double w1 = 2 * std::numbers::pi * 73.1, w2 = -2 * std::numbers::pi * 47.3;  // rad/s
+    const double dt = 0.1 / o.rosette_points;
+    for (int i = 0; i < o.rosette_points; ++i) {
+      const double tau = t_pattern_s + i * dt;
+      const double ay = a * (std::cos(w1 * tau) + std::cos(w2 * tau));
+      const double az = a * (std::sin(w1 * tau) + std::sin(w2 * tau));
+      shoot(Eigen::Vector3d(1, std::tan(ay), std::tan(az)).normalized());
+    }
+  }
+  return scan;
+}
+
+LidarMaps accumulate_lidar_map(const std::vector<LidarScan>& scans,
+                               const std::vector<Eigen::Isometry3d>& T_world_lidar, double voxel_m) {
+  if (scans.size() != T_world_lidar.size())
+    throw std::invalid_argument("accumulate_lidar_map: one pose per scan is needed");
+  if (!(voxel_m > 0)) throw std::invalid_argument("accumulate_lidar_map: voxel_m must be > 0");
+  struct KeyHash {
+    size_t operator()(const Eigen::Vector3i& k) const {
+      return static_cast<size_t>(
+          hash_combine(hash_combine(static_cast<uint64_t>(k.x()), static_cast<uint64_t>(k.y())),
+                       static_cast<uint64_t>(k.z())));
+    }
+  };
+  size_t total = 0;
+  for (const LidarScan& s : scans) total += s.points_lidar.size();
+  std::unordered_map<Eigen::Vector3i, int, KeyHash> occupied;
+  occupied.reserve(total / 2);
+  LidarMaps maps;
+  io::ScalarField plane{"plane_id", {}};
+  for (size_t s = 0; s < scans.size(); ++s) {
+    for (size_t i = 0; i < scans[s].points_lidar.size(); ++i) {
+      const Eigen::Vector3d p = T_world_lidar[s] * scans[s].points_lidar[i];
+      // Voxel of the noisy point; the first point in insertion order wins, so the result is deterministic.
+      const Eigen::Vector3i key = (p / voxel_m).array().floor().cast<int>();
+      if (!occupied.emplace(key, 1).second) continue;
+      maps.noisy.positions.push_back(p);
+      maps.truth.positions.push_back(scans[s].true_world[i]);
+      plane.values.push_back(scans[s].plane_id[i]);
+    }
+  }
+  maps.truth.extra.push_back(std::move(plane));
+  return maps;
+}
+
+}  // namespace litgs::host::synth

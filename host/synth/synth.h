@@ -1,0 +1,43 @@
+// `litgs-engine synth`: a complete synthetic scene directory (docs/scene-format.md) with exact ground truth,
+// from a named preset and a seed. The same options give the same bytes.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace litgs::host::synth {
+
+struct SynthOptions {
+  std::string preset = "facade";     // facade (default) | street | corridor
+  uint64_t seed = 1;                 // everything random derives from it
+  std::optional<int> frames;         // thermal frames (= LiDAR scans); default: the preset's (facade 60)
+  std::optional<int> width, height;  // thermal image size, both or neither; default 320 x 256
+  std::filesystem::path out;         // the scene directory to write
+  bool force = false;                // replace the scene files in a non-empty `out`
+  int threads = 0;                   // worker threads; 0: the hardware's (at most 8)
+
+  // Empty if valid, else the first bad field and why (std::invalid_argument from generate_* carries it).
+  std::string check() const;
+};
+
+struct SynthReport {
+  std::string preset;
+  int frames = 0;
+  int frozen_frames = 0;   // frames that repeat the previous one (gt/frozen.txt)
+  size_t scan_points = 0;  // over all scans
+  size_t map_points = 0;   // lidar/map.pcd after voxel downsampling
+  size_t anchors = 0;
+  size_t imu_samples = 0;
+  size_t planes = 0;         // gt/planes.txt
+  double path_length_m = 0;  // travelled between the first and the last frame
+  double final_drift_m = 0;  // |estimated - true| position of the last frame
+  double seconds = 0;        // wall time of the whole generation
+};
+
+// Generates and writes the scene. std::invalid_argument (naming the field) on bad options or a non-empty
+// `out` without `force`; io::IoError on file errors. Files are written atomically, scene.yaml last.
+SynthReport generate_synthetic_scene(const SynthOptions& options);
+
+}  // namespace litgs::host::synth

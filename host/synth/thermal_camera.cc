@@ -1,0 +1,98 @@
+#include "host/synth/thermal_camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <thread>
+#include <vector>
+
+#include "host/synth/rng.h"
+
+namespace litgs::host::synth {
+
+std::string ThermalCameraOptions::check() const {
+  if (width < 16 || width > 8192) return "width: must be in [16, 8192]";
+  if (height < 16 || height > 8192) return "height: must be in [16, 8192]";
+  if (!(hfov_deg > 1 && hfov_deg < 170)) return "hfov_deg: must be in (1, 170)";
+  if (!(temporal_noise_raw >= 0)) return "temporal_noise_raw: must be >= 0";
+  if (!(fixed_pattern_raw >= 0)) return "fixed_pattern_raw: must be >= 0";
+  if (!(vignetting_raw >= 0)) return "vignetting_raw: must be >= 0";
+  if (!(agc_low_percentile >= 0 && agc_low_percentile < agc_high_percentile && agc_high_percentile <= 100))
+    return "agc_low_percentile/agc_high_percentile: need 0 <= low < high <= 100";
+  return "";
+}
+
+io::CameraIntrinsics ThermalCameraOptions::intrinsics() const {
+  io::CameraIntrinsics K;
+  K.width = width;
+  K.height = height;
+  K.fx = K.fy = width / (2 * std::tan(hfov_deg * std::numbers::pi / 360));
+  K.cx = (width - 1) / 2.0;
+  K.cy = (height - 1) / 2.0;
+  K.bit_depth = 16;
+  return K;
+}
+
+double pixel_radiance(const World& world, const io::CameraIntrinsics& K, const Eigen::Isometry3d& T_world_cam,
+                      double x, double y) {
+  const Eigen::Vector3d d_cam((x - K.cx) / K.fx, (y - K.cy) / K.fy, 1);
+  const Eigen::Vector3d dir = T_world_cam.linear() * d_cam.normalized();
+  const auto hit = world.cast({T_world_cam.translation(), dir}, 0.05, 1e4);
+  if (!hit) return world.sky_raw;
+  // The pixel's footprint on the surface, stretched at grazing incidence: what the joints are filtered over.
+  const double cos_incidence = std::max(0.1, std::abs(hit->normal.dot(dir)));
+  const double footprint = hit->range_m / (K.fx * d_cam.normalized().z()) / cos_incidence;
+  return thermal_radiance(world.textures[hit->texture], hit->u_m, hit->v_m, footprint);
+}
+
+io::Image render_thermal(const World& world, const ThermalCameraOptions& o,
+                         const Eigen::Isometry3d& T_world_cam, uint64_t seed, uint64_t frame_index,
+                         int threads) {
+  const io::CameraIntrinsics K = o.intrinsics();
+  io::Image image;
+  image.width = o.width;
+  image.height = o.height;
+  image.bit_depth = 16;
+  image.data.assign(static_cast<size_t>(o.width) * o.height, 0);
+  const uint64_t frame_key =
+      hash_combine(hash_combine(seed, static_cast<uint64_t>(Stream::kThermal)), frame_index);
+  const uint64_t pattern_key =
+      hash_combine(hash_combine(seed, static_cast<uint64_t>(Stream::kThermal)), ~0ull);
+  const double r2_corner = K.cx * K.cx + K.cy * K.cy;
+  auto render_rows = [&](int y0, int step) {
+    for (int y = y0; y < o.height; y += step)
+      for (int x = 0; x < o.width; ++x) {
+        const uint64_t pixel = static_cast<uint64_t>(y) * o.width + x;
+        double raw = pixel_radiance(world, K, T_world_cam, x, y);
+        const double r2 = ((x - K.cx) * (x - K.cx) + (y - K.cy) * (y - K.cy)) / r2_corner;
+        raw -= o.vignetting_raw * r2;
+        raw += o.fixed_pattern_raw * hash_normal(hash_combine(pattern_key, pixel));
+        raw += o.temporal_noise_raw * hash_normal(hash_combine(frame_key, pixel));
+        image.data[pixel] = static_cast<uint16_t>(std::clamp(std::lround(raw), 0l, 65535l));
+      }
+  };
+  threads = std::clamp(threads, 1, 64);
+  std::vector<std::thread> pool;
+  for (int i = 1; i < threads; ++i) pool.emplace_back(render_rows, i, threads);
+  render_rows(0, threads);
+  for (auto& t : pool) t.join();
+  return image;
+}
+
+io::Image auto_gain_8bit(const io::Image& raw, const ThermalCameraOptions& o) {
+  std::vector<uint16_t> values = raw.data;
+  auto percentile = [&](double p) {
+    const auto i = static_cast<size_t>(std::lround(p / 100 * static_cast<double>(values.size() - 1)));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(i), values.end());
+    return static_cast<double>(values[i]);
+  };
+  const double lo = percentile(o.agc_low_percentile);
+  const double hi = std::max(percentile(o.agc_high_percentile), lo + 1);
+  io::Image out = raw;
+  out.bit_depth = 8;
+  for (auto& v : out.data)
+    v = static_cast<uint16_t>(std::clamp(std::lround((v - lo) / (hi - lo) * 255), 0l, 255l));
+  return out;
+}
+
+}  // namespace litgs::host::synth

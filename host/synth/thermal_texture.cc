@@ -1,0 +1,71 @@
+#include "host/synth/thermal_texture.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "host/synth/rng.h"
+
+namespace litgs::host::synth {
+namespace {
+
+double smooth(double t) {
+  return t * t * (3 - 2 * t);
+}
+
+// Value noise in [-1, 1] on a unit lattice: smooth, deterministic, a pure function of (x, y, seed).
+double value_noise(double x, double y, uint64_t seed) {
+  const double fx = std::floor(x), fy = std::floor(y);
+  const auto ix = static_cast<int64_t>(fx), iy = static_cast<int64_t>(fy);
+  auto corner = [&](int64_t a, int64_t b) {
+    return 2 * hash_uniform(
+                   hash_combine(hash_combine(seed, static_cast<uint64_t>(a)), static_cast<uint64_t>(b))) -
+           1;
+  };
+  const double tx = smooth(x - fx), ty = smooth(y - fy);
+  const double c00 = corner(ix, iy), c10 = corner(ix + 1, iy), c01 = corner(ix, iy + 1),
+               c11 = corner(ix + 1, iy + 1);
+  return (c00 * (1 - tx) + c10 * tx) * (1 - ty) + (c01 * (1 - tx) + c11 * tx) * ty;
+}
+
+// The integral over [0, x] of a pulse train of period p with pulses [0, w): lets a joint be box-filtered.
+double pulse_integral(double x, double p, double w) {
+  const double n = std::floor(x / p);
+  return n * w + std::min(x - n * p, w);
+}
+
+// Fraction of [x - h/2, x + h/2] covered by the joints (width w, period p, centred on the cell borders).
+double joint_coverage(double x, double p, double w, double h) {
+  const double shifted = x + w / 2;  // joints straddle the cell borders
+  if (h <= 1e-9) {
+    const double r = shifted - std::floor(shifted / p) * p;
+    return r < w ? 1.0 : 0.0;
+  }
+  return (pulse_integral(shifted + h / 2, p, w) - pulse_integral(shifted - h / 2, p, w)) / h;
+}
+
+}  // namespace
+
+double thermal_radiance(const ThermalTexture& t, double u, double v, double footprint_m) {
+  double raw = t.base_raw + t.gradient_v_raw_per_m * v;
+  raw += t.noise_raw * value_noise(u / t.noise_scale_m, v / t.noise_scale_m, t.seed);
+  if (t.pattern != ThermalPattern::kUniform) {
+    const double row = std::floor(v / t.cell_v_m);
+    // Running bond: every other brick row is shifted by half a brick.
+    const double shift =
+        (t.pattern == ThermalPattern::kBrick && std::fmod(std::abs(row), 2.0) == 1.0) ? t.cell_u_m / 2 : 0.0;
+    const double col = std::floor((u + shift) / t.cell_u_m);
+    const uint64_t cell = hash_combine(hash_combine(t.seed ^ 0x5eedull, static_cast<uint64_t>(row)),
+                                       static_cast<uint64_t>(col));
+    raw += t.cell_jitter_raw * (2 * hash_uniform(cell) - 1);
+    const double cu = joint_coverage(u + shift, t.cell_u_m, t.joint_m, footprint_m);
+    const double cv = joint_coverage(v, t.cell_v_m, t.joint_m, footprint_m);
+    raw += t.joint_raw * (cu + cv - cu * cv);
+  }
+  if (t.spot_raw != 0) {
+    const double du = u - t.spot_u_m, dv = v - t.spot_v_m;
+    raw += t.spot_raw * std::exp(-(du * du + dv * dv) / (2 * t.spot_radius_m * t.spot_radius_m));
+  }
+  return raw;
+}
+
+}  // namespace litgs::host::synth
