@@ -1,5 +1,6 @@
 #include "engine/buffer.h"
 
+#include <atomic>
 #include <cstring>
 #include <sstream>
 #include <stdexcept>
@@ -26,7 +27,20 @@ void check_limit(const std::string& name, uint64_t size, uint64_t limit, const c
                             "; split it (structure of arrays) or use fewer elements");
 }
 
+std::atomic<uint64_t> g_live_bytes{0};
+std::atomic<uint64_t> g_peak_bytes{0};
+
+void count_allocation(uint64_t bytes) {
+  const uint64_t live = g_live_bytes.fetch_add(bytes) + bytes;
+  uint64_t peak = g_peak_bytes.load();
+  while (live > peak && !g_peak_bytes.compare_exchange_weak(peak, live)) {
+  }
+}
+
 }  // namespace
+
+uint64_t Buffer::live_bytes() { return g_live_bytes.load(); }
+uint64_t Buffer::peak_bytes() { return g_peak_bytes.load(); }
 
 Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKind kind)
     : context_(&context), name_(std::move(name)), size_bytes_(size_bytes) {
@@ -60,6 +74,8 @@ Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKi
       throw std::length_error("out of memory allocating buffer '" + name_ + "' of " + mib(req.size) + " on " +
                               context.info().name);
     LITGS_VK_CHECK(r);
+    allocated_bytes_ = req.size;
+    count_allocation(allocated_bytes_);
     LITGS_VK_CHECK(vkBindBufferMemory(dev, buffer_, memory_, 0));
     if ((context.memory_type_flags(type) & host) == host)
       LITGS_VK_CHECK(vkMapMemory(dev, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
@@ -77,7 +93,8 @@ Buffer::Buffer(Buffer&& other) noexcept
       size_bytes_(other.size_bytes_),
       buffer_(std::exchange(other.buffer_, VK_NULL_HANDLE)),
       memory_(std::exchange(other.memory_, VK_NULL_HANDLE)),
-      mapped_(std::exchange(other.mapped_, nullptr)) {}
+      mapped_(std::exchange(other.mapped_, nullptr)),
+      allocated_bytes_(std::exchange(other.allocated_bytes_, 0)) {}
 
 Buffer& Buffer::operator=(Buffer&& other) noexcept {
   if (this != &other) {
@@ -88,6 +105,7 @@ Buffer& Buffer::operator=(Buffer&& other) noexcept {
     buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
     memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
     mapped_ = std::exchange(other.mapped_, nullptr);
+    allocated_bytes_ = std::exchange(other.allocated_bytes_, 0);
   }
   return *this;
 }
@@ -98,6 +116,8 @@ void Buffer::release() {
   if (mapped_) vkUnmapMemory(dev, memory_);
   if (buffer_) vkDestroyBuffer(dev, buffer_, nullptr);
   if (memory_) vkFreeMemory(dev, memory_, nullptr);
+  g_live_bytes.fetch_sub(allocated_bytes_);
+  allocated_bytes_ = 0;
   mapped_ = nullptr;
   buffer_ = VK_NULL_HANDLE;
   memory_ = VK_NULL_HANDLE;

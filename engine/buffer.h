@@ -31,6 +31,10 @@ class Buffer {
   Buffer(const Buffer&) = delete;
   Buffer& operator=(const Buffer&) = delete;
 
+  // Bytes of device memory held by all live buffers of the process, and the most ever held at once.
+  static uint64_t live_bytes();
+  static uint64_t peak_bytes();
+
   const std::string& name() const { return name_; }
   VkBuffer handle() const { return buffer_; }
   uint64_t size_bytes() const { return size_bytes_; }  // as requested; 0 is allowed
@@ -52,6 +56,7 @@ class Buffer {
   VkBuffer buffer_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   void* mapped_ = nullptr;
+  uint64_t allocated_bytes_ = 0;
 };
 
 // A typed array on the device: `count` elements of T (trivially copyable).

@@ -15,5 +15,6 @@ void add_bench_loss_command(CLI::App& bench);
 void add_import_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
+void add_train_command(CLI::App& app);
 
 }  // namespace litgs::tools

@@ -1,0 +1,273 @@
+#include "host/train/trainer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "engine/buffer.h"
+#include "engine/sequence.h"
+#include "host/train/checkpoint.h"
+#include "io/atomic_file.h"
+#include "io/gaussian_ply.h"
+#include "kernels/loss/geometric_loss.h"
+#include "kernels/loss/loss_reference.h"
+#include "kernels/loss/photometric_loss.h"
+#include "kernels/optim/trainable_gaussians.h"
+#include "kernels/splat/rasterizer.h"
+
+namespace litgs::host {
+namespace {
+
+using engine::DeviceArray;
+namespace fs = std::filesystem;
+
+// Loss slots of the small readback buffer.
+constexpr uint32_t kSlotPhotometric = 0;  // loss, mean SSIM, mean L1
+constexpr uint32_t kSlotGeometric = 3;    // loss, pixels that counted
+constexpr uint32_t kLossSlots = 5;
+
+// Per-view device data that never changes: the target and, with the geometric loss, the LiDAR maps.
+struct ViewBuffers {
+  std::unique_ptr<DeviceArray<float>> target;   // [H][W]
+  std::unique_ptr<DeviceArray<float>> points;   // [H][W][4]
+  std::unique_ptr<DeviceArray<float>> normals;  // [H][W][4]
+  uint32_t valid = 0;
+};
+
+// Views of one epoch in a random order, without replacement; a new order each epoch.
+class ViewSampler {
+ public:
+  ViewSampler(std::vector<uint32_t> pool, uint32_t seed) : pool_(std::move(pool)), rng_(seed) { reshuffle(); }
+  uint32_t next() {
+    if (position_ >= order_.size()) reshuffle();
+    return order_[position_++];
+  }
+  void save(Checkpoint& c) const {
+    c.view_order = order_;
+    c.order_position = static_cast<uint32_t>(position_);
+    std::ostringstream s;
+    s << rng_;
+    c.rng_state = s.str();
+  }
+  void restore(const Checkpoint& c) {
+    order_ = c.view_order;
+    position_ = c.order_position;
+    std::istringstream s(c.rng_state);
+    s >> rng_;
+  }
+
+ private:
+  void reshuffle() {
+    order_ = pool_;
+    std::shuffle(order_.begin(), order_.end(), rng_);
+    position_ = 0;
+  }
+  std::vector<uint32_t> pool_, order_;
+  size_t position_ = 0;
+  std::mt19937 rng_;
+};
+
+fs::path newest_checkpoint(const fs::path& dir) {
+  fs::path best;
+  uint32_t best_it = 0;
+  if (!fs::is_directory(dir / "checkpoints")) return best;
+  for (const auto& e : fs::directory_iterator(dir / "checkpoints")) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("iter_", 0) != 0 || e.path().extension() != ".ckpt") continue;
+    const uint32_t it = static_cast<uint32_t>(std::stoul(name.substr(5)));
+    if (best.empty() || it > best_it) best = e.path(), best_it = it;
+  }
+  return best;
+}
+
+nlohmann::json eval_json(const EvalResult& e) {
+  nlohmann::json j = {{"iteration", e.iteration}, {"psnr_db", e.psnr_db}, {"ssim", e.ssim}};
+  if (e.depth_plane_rmse_m >= 0) j["depth_plane_rmse_m"] = e.depth_plane_rmse_m;
+  return j;
+}
+
+}  // namespace
+
+void TrainOptions::check() const {
+  auto bad = [](const std::string& what) { throw std::invalid_argument("TrainOptions." + what); };
+  if (iterations == 0) bad("iterations must be positive");
+  if (!(lambda_geo >= 0 && lambda_geo <= 1)) bad("lambda_geo must be in [0, 1]");
+  if (!(lambda_ssim >= 0 && lambda_ssim <= 1)) bad("lambda_ssim must be in [0, 1]");
+  if (sh_degree > 3) bad("sh_degree must be 0..3");
+  if (sh_degree_every == 0) bad("sh_degree_every must be positive");
+  if (densify_every == 0) bad("densify_every must be positive");
+  if (opacity_reset_every == 0) bad("opacity_reset_every must be positive");
+  if (!(densify_grad_threshold > 0)) bad("densify_grad_threshold must be positive");
+  if (max_gaussians == 0) bad("max_gaussians must be positive");
+}
+
+TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels::GaussianModel& initial,
+                  const PlanarMap* planes, const TrainOptions& o, const fs::path& out_dir,
+                  const std::function<void(const TrainProgress&)>& progress) {
+  o.check();
+  if (o.lambda_geo > 0 && !planes)
+    throw std::invalid_argument("lambda_geo > 0 needs a LiDAR map (the scene has none); use --lambda-geo 0");
+  std::vector<uint32_t> train_views, eval_views;
+  for (uint32_t i = 0; i < data.views.size(); ++i) (data.views[i].heldout ? eval_views : train_views).push_back(i);
+  if (train_views.empty()) throw std::invalid_argument("no training views (all held out)");
+  fs::create_directories(out_dir);
+  const uint32_t W = data.width, H = data.height;
+  const bool geometric = o.lambda_geo > 0;
+
+  // Device state.
+  kernels::RasterizerOptions ropt;
+  ropt.deterministic = o.deterministic;
+  kernels::Rasterizer rasterizer(ctx, 1, ropt);
+  kernels::PhotometricLossOptions popt;
+  popt.lambda_ssim = static_cast<float>(o.lambda_ssim);
+  kernels::PhotometricLoss photometric(ctx, 1, popt);
+  photometric.reserve(W, H);
+  kernels::GeometricLoss geometric_loss(ctx);
+  geometric_loss.reserve(W, H);
+  DeviceArray<float> losses(ctx, "train: losses", kLossSlots, engine::MemoryKind::kHostVisible);
+  std::vector<ViewBuffers> views(data.views.size());
+  for (uint32_t i = 0; i < data.views.size(); ++i) {
+    views[i].target = std::make_unique<DeviceArray<float>>(ctx, "train: target " + data.views[i].name, size_t{W} * H);
+    views[i].target->upload(data.views[i].image);
+    if (geometric && !data.views[i].heldout) {
+      const ViewPlaneMaps maps = project_planes(*planes, data.views[i].camera);
+      views[i].points = std::make_unique<DeviceArray<float>>(ctx, "train: lidar points", maps.points.size());
+      views[i].normals = std::make_unique<DeviceArray<float>>(ctx, "train: lidar normals", maps.normals.size());
+      views[i].points->upload(maps.points);
+      views[i].normals->upload(maps.normals);
+      views[i].valid = maps.valid_count;
+    }
+  }
+
+  std::unique_ptr<kernels::TrainableGaussians> model;
+  ViewSampler sampler(train_views, o.seed);
+  uint32_t start = 0;
+  if (o.resume) {
+    const fs::path ckpt = newest_checkpoint(out_dir);
+    if (ckpt.empty()) throw std::invalid_argument("--resume: no checkpoint in " + (out_dir / "checkpoints").string());
+    const Checkpoint c = read_checkpoint(ckpt);
+    model = std::make_unique<kernels::TrainableGaussians>(ctx, c.state);
+    sampler.restore(c);
+    start = c.iteration;
+  } else {
+    model = std::make_unique<kernels::TrainableGaussians>(ctx, initial);
+  }
+  const kernels::AdamOptions adam = model->adam_options();
+  kernels::DensifyOptions dopt;
+  dopt.grad_threshold = o.densify_grad_threshold;
+  dopt.max_gaussians = o.max_gaussians;
+  dopt.opacity_reset_interval = o.opacity_reset_every;
+  dopt.seed = o.seed;
+  const uint32_t densify_until = std::min(o.densify_until, o.iterations);
+  const float extent = static_cast<float>(data.scene_extent_m);
+
+  TrainReport report;
+  auto evaluate = [&](uint32_t iteration) {
+    EvalResult e;
+    e.iteration = iteration;
+    if (eval_views.empty()) return e;
+    for (uint32_t i : eval_views) {
+      kernels::SplatCamera cam = data.views[i].camera;
+      cam.sh_degree = std::min(o.sh_degree, iteration / o.sh_degree_every);
+      rasterizer.forward(model->gaussians(), cam);
+      const auto img = rasterizer.download_images();
+      e.psnr_db += kernels::psnr(img.image, data.views[i].image);
+      e.ssim += kernels::ssim_reference(img.image, data.views[i].image, 1, W, H);
+    }
+    e.psnr_db /= static_cast<double>(eval_views.size());
+    e.ssim /= static_cast<double>(eval_views.size());
+    return e;
+  };
+
+  double last_loss = std::numeric_limits<double>::quiet_NaN(), last_psnr = last_loss;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (uint32_t it = start; it < o.iterations; ++it) {
+    const uint32_t step = it + 1;
+    const uint32_t v = sampler.next();
+    kernels::SplatCamera cam = data.views[v].camera;
+    cam.sh_degree = std::min(o.sh_degree, it / o.sh_degree_every);
+    rasterizer.forward(model->gaussians(), cam);  // the iteration's one readback: the intersection count
+    const auto out = rasterizer.device_outputs();
+    const auto up = rasterizer.upstream_buffers();
+
+    engine::Sequence s(ctx);
+    photometric.record(s, *out.image, views[v].target->buffer(), W, H, static_cast<float>(1.0 - o.lambda_geo),
+                       *up.image, losses.buffer(), kSlotPhotometric);
+    if (geometric)
+      geometric_loss.record(s, *out.depth, views[v].points->buffer(), views[v].normals->buffer(), W, H,
+                            static_cast<float>(cam.fx), static_cast<float>(cam.fy), static_cast<float>(cam.cx),
+                            static_cast<float>(cam.cy), views[v].valid, static_cast<float>(o.lambda_geo), *up.depth,
+                            losses.buffer(), kSlotGeometric);
+    else
+      s.fill(*up.depth, 0u, uint64_t{W} * H * sizeof(float));
+    s.fill(*up.alpha, 0u, uint64_t{W} * H * sizeof(float));
+    const auto grads = rasterizer.record_backward(s);
+    if (step <= densify_until) model->record_accumulate_stats(s, grads, *out.rects, cam);
+    model->record_adam_step(s, grads, adam.rates(it, o.iterations, extent), step);
+    s.submit_and_wait();
+
+    if (step > o.densify_from && step <= densify_until && step % o.densify_every == 0) {
+      const kernels::DensifyReport d = model->densify_and_prune(dopt, extent, step);
+      report.nonfinite_pruned += d.pruned_nonfinite;
+    }
+    if (step <= densify_until && step % o.opacity_reset_every == 0) {
+      engine::Sequence r(ctx);
+      model->record_reset_opacity(r);
+      r.submit_and_wait();
+    }
+    const bool last = step == o.iterations;
+    if (o.eval_every > 0 && (step % o.eval_every == 0) && !last) {
+      report.evals.push_back(evaluate(step));
+      last_psnr = report.evals.back().psnr_db;
+    }
+    if (o.checkpoint_every > 0 && step % o.checkpoint_every == 0) {
+      Checkpoint c;
+      c.iteration = step;
+      sampler.save(c);
+      c.state = model->download_state();
+      write_checkpoint(out_dir / "checkpoints" / ("iter_" + std::to_string(step) + ".ckpt"), c);
+    }
+    if (progress && (step % o.progress_every == 0 || last || step == start + 1)) {
+      const auto l = losses.download();  // host-visible: written by this iteration's submit
+      last_loss = (1.0 - o.lambda_geo) * l[kSlotPhotometric] + (geometric ? o.lambda_geo * l[kSlotGeometric] : 0.0);
+      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      progress({step, o.iterations, last_loss, last_psnr, model->size(), (step - start) / std::max(secs, 1e-9)});
+    }
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  report.final_eval = evaluate(o.iterations);
+  report.evals.push_back(report.final_eval);
+  report.iterations = o.iterations;
+  report.wall_s = wall;
+  report.ms_per_iteration = o.iterations > start ? 1000.0 * wall / (o.iterations - start) : 0.0;
+  report.gaussians = model->size();
+  report.peak_device_bytes = engine::Buffer::peak_bytes();
+
+  io::write_gaussian_ply(out_dir / "point_cloud.ply", model->download());
+  nlohmann::json metrics = {{"iterations", report.iterations},
+                            {"wall_s", report.wall_s},
+                            {"ms_per_iteration", report.ms_per_iteration},
+                            {"gaussians", report.gaussians},
+                            {"peak_device_bytes", report.peak_device_bytes},
+                            {"heldout_psnr", report.final_eval.psnr_db},
+                            {"heldout_ssim", report.final_eval.ssim},
+                            {"heldout_views", eval_views.size()},
+                            {"training_views", train_views.size()},
+                            {"width", W},
+                            {"height", H},
+                            {"lambda_geo", o.lambda_geo},
+                            {"nonfinite_pruned", report.nonfinite_pruned},
+                            {"evaluations", nlohmann::json::array()}};
+  if (report.final_eval.depth_plane_rmse_m >= 0) metrics["heldout_depth_plane_rmse_m"] = report.final_eval.depth_plane_rmse_m;
+  for (const auto& e : report.evals) metrics["evaluations"].push_back(eval_json(e));
+  io::write_file_atomic(out_dir / "metrics.json", [&](std::ostream& out) { out << metrics.dump(2) << "\n"; });
+  return report;
+}
+
+}  // namespace litgs::host

@@ -1,0 +1,136 @@
+// `litgs-engine train SCENE --out DIR ...`: a Gaussian map of a scene directory, on the Vulkan device.
+#include <CLI/CLI.hpp>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <random>
+
+#include "engine/context.h"
+#include "host/train/init_gaussians.h"
+#include "host/train/lidar_planes.h"
+#include "host/train/trainer.h"
+#include "host/train/training_data.h"
+#include "io/scene.h"
+#include "tools/commands.h"
+
+namespace litgs::tools {
+namespace {
+
+struct TrainCliOptions {
+  std::string scene, out;
+  std::string init = "auto";       // auto | random | a .ply/.pcd file (in the scene's original world frame)
+  uint32_t random_count = 20000;   // Gaussians of --init random
+  uint32_t max_init_points = 200000;  // LiDAR-map initialization keeps at most this many points
+  std::string intensity = "auto";  // auto | percentile | linear
+  host::TrainingDataOptions data;
+  host::TrainOptions train;
+};
+
+std::string format_eta(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%d:%02d", static_cast<int>(s) / 60, static_cast<int>(s) % 60);
+  return buf;
+}
+
+void run_train(TrainCliOptions o) {
+  if (o.intensity == "percentile")
+    o.data.mapping = host::IntensityMapping::kPercentile;
+  else if (o.intensity == "linear")
+    o.data.mapping = host::IntensityMapping::kLinear;
+  else if (o.intensity != "auto")
+    throw std::invalid_argument("--intensity must be auto, percentile or linear, not '" + o.intensity + "'");
+  o.train.check();
+  const host::TrainingData data = host::load_training_data(o.scene, o.data);
+
+  // The LiDAR map, when the scene has one: the geometric loss's planes and the default initialization.
+  std::vector<Eigen::Vector3d> map_points;
+  io::SceneReadOptions read;
+  read.check_images = false;
+  const io::Scene scene = io::read_scene(o.scene, read);
+  if (scene.map) map_points = scene.map->positions;
+  std::unique_ptr<host::PlanarMap> planes;
+  if (o.train.lambda_geo > 0 && !map_points.empty())
+    planes = std::make_unique<host::PlanarMap>(host::fit_planes(map_points, host::PlaneFitOptions{}));
+  if (o.train.lambda_geo > 0 && !planes) {
+    std::cerr << "train: the scene has no LiDAR map; training photometric only (lambda_geo 0)\n";
+    o.train.lambda_geo = 0;
+  }
+
+  host::InitOptions init;
+  init.sh_degree = o.train.sh_degree;
+  kernels::GaussianModel model;
+  std::string init_what;
+  if (o.init == "random" || (o.init == "auto" && map_points.empty())) {
+    model = host::init_random(data, o.random_count, o.train.seed, init);
+    init_what = std::to_string(o.random_count) + " random points";
+  } else if (o.init == "auto") {
+    std::vector<Eigen::Vector3d> pts = map_points;
+    if (pts.size() > o.max_init_points) {
+      std::mt19937 rng(o.train.seed);
+      std::shuffle(pts.begin(), pts.end(), rng);
+      pts.resize(o.max_init_points);
+    }
+    model = host::init_from_points(pts, data, init);
+    init_what = std::to_string(pts.size()) + " LiDAR map points";
+  } else {
+    model = host::init_from_points(host::load_points(o.init, data.world_offset_m), data, init);
+    init_what = o.init;
+  }
+
+  engine::Context context;
+  const bool tty = ::isatty(STDOUT_FILENO);
+  std::cout << "train: " << data.views.size() << " views (" << data.width << "x" << data.height << ", "
+            << data.frozen_skipped << " frozen skipped), init " << model.size() << " Gaussians from " << init_what
+            << ", lambda_geo " << o.train.lambda_geo << ", on " << context.info().name << "\n";
+  auto progress = [&](const host::TrainProgress& p) {
+    const double eta = (p.total - p.iteration) / std::max(p.iterations_per_s, 1e-9);
+    char line[256];
+    std::snprintf(line, sizeof line, "[%6u/%u] loss %.4f  psnr %s  gaussians %zu  %.2f it/s  eta %s", p.iteration,
+                  p.total, p.loss, std::isfinite(p.psnr_db) ? std::to_string(p.psnr_db).substr(0, 5).c_str() : "-",
+                  p.gaussians, p.iterations_per_s, format_eta(eta).c_str());
+    std::cout << (tty ? "\r" : "") << line << (tty ? "" : "\n") << std::flush;
+  };
+  const host::TrainReport r = host::train(context, data, model, planes.get(), o.train, o.out, progress);
+  if (tty) std::cout << "\n";
+  std::cout << "train: " << r.iterations << " iterations in " << r.wall_s << " s (" << r.ms_per_iteration
+            << " ms/iteration), " << r.gaussians << " Gaussians; held-out PSNR " << r.final_eval.psnr_db
+            << " dB, SSIM " << r.final_eval.ssim << "; wrote " << o.out << "/point_cloud.ply and metrics.json\n";
+}
+
+}  // namespace
+
+void add_train_command(CLI::App& app) {
+  auto o = std::make_shared<TrainCliOptions>();
+  CLI::App* cmd = app.add_subcommand("train", "Train a Gaussian map of a scene directory on the device");
+  cmd->add_option("scene", o->scene, "Scene directory (docs/scene-format.md)")->required()->check(CLI::ExistingDirectory);
+  cmd->add_option("--out", o->out, "Output directory (point_cloud.ply, metrics.json, checkpoints/)")->required();
+  cmd->add_option("--iterations", o->train.iterations, "Training iterations")->capture_default_str();
+  cmd->add_option("--downscale", o->data.downscale, "Divide image size and intrinsics by this")->capture_default_str();
+  cmd->add_option("--lambda-geo", o->train.lambda_geo, "Weight of the LiDAR point-to-plane loss")->capture_default_str();
+  cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")->capture_default_str();
+  cmd->add_option("--init", o->init, "auto (LiDAR map, else random), random, or a .ply/.pcd point file")
+      ->capture_default_str();
+  cmd->add_option("--random-count", o->random_count, "Gaussians of --init random")->capture_default_str();
+  cmd->add_option("--eval-every", o->train.eval_every, "Evaluate held-out views every K iterations (0: at the end)");
+  cmd->add_option("--checkpoint-every", o->train.checkpoint_every, "Checkpoint every K iterations (0: none)");
+  cmd->add_flag("--resume", o->train.resume, "Continue from the newest checkpoint in --out");
+  cmd->add_option("--max-gaussians", o->train.max_gaussians, "Cap of the model size")->capture_default_str();
+  cmd->add_flag("--deterministic", o->train.deterministic, "Bit-identical gradients (slower)");
+  cmd->add_option("--sh-degree", o->train.sh_degree, "Final SH degree")->capture_default_str();
+  cmd->add_option("--seed", o->train.seed, "Seed of view order and densification")->capture_default_str();
+  cmd->add_option("--holdout-every", o->data.holdout_every, "Hold out every Nth frame (0: none)")->capture_default_str();
+  cmd->add_option("--intensity", o->intensity, "auto | percentile | linear")->capture_default_str();
+  cmd->add_option("--densify-from", o->train.densify_from, "First densification iteration")->capture_default_str();
+  cmd->add_option("--densify-until", o->train.densify_until, "Last densification iteration")->capture_default_str();
+  cmd->add_option("--densify-every", o->train.densify_every, "Densification cadence")->capture_default_str();
+  cmd->add_option("--opacity-reset-every", o->train.opacity_reset_every, "Opacity reset cadence")->capture_default_str();
+  cmd->add_option("--progress-every", o->train.progress_every, "Progress cadence")->capture_default_str();
+  cmd->callback([o] { run_train(*o); });
+}
+
+}  // namespace litgs::tools
