@@ -1,13 +1,51 @@
-// `litgs-engine import metashape --xml FILE --images DIR --out SCENE`: other tools' outputs into a scene
-// directory (docs/scene-format.md). CPU only: no Vulkan device is created.
+// `litgs-engine import metashape|colmap|livo2 ... --out SCENE`: other tools' outputs into a scene directory
+// (docs/scene-format.md). CPU only: no Vulkan device is created.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <memory>
 
+#include "io/import_colmap.h"
 #include "io/import_metashape.h"
 #include "tools/commands.h"
 
 namespace litgs::tools {
+namespace {
+
+void print_offset(const Eigen::Vector3d& v) {
+  std::cout << "world offset [" << v.x() << ", " << v.y() << ", " << v.z() << "] m\n";
+}
+
+void add_import_colmap(CLI::App* import) {
+  auto o = std::make_shared<io::ColmapImportOptions>();
+  auto offset = std::make_shared<std::vector<double>>();
+  CLI::App* c = import->add_subcommand("colmap", "COLMAP sparse model (text or binary) plus its images");
+  c->add_option("--model", o->model, "Model folder: cameras/images/points3D as .bin or .txt")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  c->add_option("--images", o->images, "Folder the image names are relative to")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  c->add_option("--out", o->out, "Scene directory to write")->required();
+  c->add_option("--world-offset", *offset,
+                "Recentring offset X Y Z in metres (default: mean camera centre, rounded to metres)")
+      ->expected(3);
+  c->add_option("--image-format", o->image_extension, "Extension of the written frames: .png or .tiff")
+      ->capture_default_str();
+  c->add_flag("!--no-anchors", o->points_as_anchors, "Do not write points3D as anchors.txt");
+  c->add_option("--anchor-min-error", o->anchor_min_error_px,
+                "Floor of the reprojection error (px) behind an anchor's covariance")
+      ->capture_default_str();
+  c->callback([o, offset] {
+    if (!offset->empty()) o->world_offset_m = Eigen::Vector3d((*offset)[0], (*offset)[1], (*offset)[2]);
+    const io::ColmapImportReport r = io::import_colmap(*o);
+    std::cout << "import colmap: " << r.frames << " frames, " << r.anchors << " anchors into "
+              << o->out.string() << ", ";
+    print_offset(r.world_offset_m);
+    for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
+  });
+}
+
+}  // namespace
 
 void add_import_command(CLI::App& app) {
   CLI::App* import = app.add_subcommand("import", "Convert another tool's output into a scene directory");
@@ -38,6 +76,7 @@ void add_import_command(CLI::App& app) {
               << ", " << r.world_offset_m.y() << ", " << r.world_offset_m.z() << "] m\n";
     for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
   });
+  add_import_colmap(import);
 }
 
 }  // namespace litgs::tools

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   litgs::tools::add_info_command(app);
   litgs::tools::add_bench_command(app);
   litgs::tools::add_import_command(app);
+  litgs::tools::add_export_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
