@@ -14,35 +14,11 @@ namespace litgs::io {
 namespace fs = std::filesystem;
 namespace {
 
-Eigen::Matrix4d to_matrix(const Eigen::Quaterniond& q, const Eigen::Vector3d& p) {
-  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  T.topLeftCorner<3, 3>() = q.toRotationMatrix();
-  T.topRightCorner<3, 1>() = p;
-  return T;
-}
-
 Eigen::Matrix4d rigid_inverse(const Eigen::Matrix4d& T) {
   Eigen::Matrix4d inv = Eigen::Matrix4d::Identity();
   inv.topLeftCorner<3, 3>() = T.topLeftCorner<3, 3>().transpose();
   inv.topRightCorner<3, 1>() = -T.topLeftCorner<3, 3>().transpose() * T.topRightCorner<3, 1>();
   return inv;
-}
-
-// The pose of `poses` (sorted by time) at t: exact, interpolated, or none.
-std::optional<Eigen::Matrix4d> pose_at(const std::vector<TumPose>& poses, double t) {
-  const auto it =
-      std::lower_bound(poses.begin(), poses.end(), t, [](const TumPose& p, double x) { return p.t_s < x; });
-  if (it == poses.end()) return std::nullopt;
-  if (it->t_s == t) {
-    if (!it->has_rotation) return std::nullopt;
-    return to_matrix(it->q_world_body, it->p_world);
-  }
-  if (it == poses.begin()) return std::nullopt;
-  const TumPose& a = *(it - 1);
-  const TumPose& b = *it;
-  if (!a.has_rotation || !b.has_rotation) return std::nullopt;
-  const double s = (t - a.t_s) / (b.t_s - a.t_s);
-  return to_matrix(a.q_world_body.slerp(s, b.q_world_body), (1 - s) * a.p_world + s * b.p_world);
 }
 
 // Copies a file byte for byte through a temporary name.
@@ -62,7 +38,8 @@ std::vector<std::optional<Eigen::Matrix4d>> camera_poses_at_frames(const Scene& 
   const Eigen::Matrix4d T_imu_cam = c.T_imu_lidar * rigid_inverse(c.T_cam_lidar);
   std::vector<std::optional<Eigen::Matrix4d>> out;
   for (const auto& f : scene.frames) {
-    std::optional<Eigen::Matrix4d> T = pose_at(scene.poses, imu ? f.t_s + c.time_offset_cam_lidar_s : f.t_s);
+    std::optional<Eigen::Matrix4d> T =
+        tum_pose_at(scene.poses, imu ? f.t_s + c.time_offset_cam_lidar_s : f.t_s);
     if (T && imu) T = *T * T_imu_cam;
     out.push_back(T);
   }

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "io/import_colmap.h"
+#include "io/import_livo2.h"
 #include "io/import_metashape.h"
 #include "tools/commands.h"
 
@@ -45,6 +46,35 @@ void add_import_colmap(CLI::App* import) {
   });
 }
 
+void add_import_livo2(CLI::App* import) {
+  auto o = std::make_shared<io::Livo2ImportOptions>();
+  auto offset = std::make_shared<std::vector<double>>();
+  CLI::App* c = import->add_subcommand("livo2", "FAST-LIVO2 Log/ folder plus its configuration YAML(s)");
+  c->add_option("--log", o->log, "FAST-LIVO2's Log folder (result/, pcd/, image/)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  c->add_option("--config", o->config,
+                "YAML file(s) holding cam_* keys, extrinsic_R/T and Rcl/Pcl (main and camera config)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  c->add_option("--out", o->out, "Scene directory to write")->required();
+  c->add_option("--trajectory", o->trajectory, "TUM file of IMU poses (default: the one .txt in LOG/result)")
+      ->check(CLI::ExistingFile);
+  c->add_option("--map", o->map,
+                "PCD map (default: LOG/pcd/all_downsampled_points.pcd, all_raw_points.pcd, or all merged)")
+      ->check(CLI::ExistingFile);
+  c->add_option("--world-offset", *offset, "Recentring offset X Y Z in metres (default 0)")->expected(3);
+  c->add_option("--image-format", o->image_extension, "Extension of the written frames: .png or .tiff")
+      ->capture_default_str();
+  c->callback([o, offset] {
+    if (!offset->empty()) o->world_offset_m = Eigen::Vector3d((*offset)[0], (*offset)[1], (*offset)[2]);
+    const io::Livo2ImportReport r = io::import_livo2(*o);
+    std::cout << "import livo2: " << r.frames << " frames (" << r.skipped_no_pose << " without a pose), "
+              << r.map_points << " map points into " << o->out.string() << "\n";
+    for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
+  });
+}
+
 }  // namespace
 
 void add_import_command(CLI::App& app) {
@@ -77,6 +107,7 @@ void add_import_command(CLI::App& app) {
     for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
   });
   add_import_colmap(import);
+  add_import_livo2(import);
 }
 
 }  // namespace litgs::tools
