@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "io/import_bag.h"
 #include "io/import_colmap.h"
 #include "io/import_livo2.h"
 #include "io/import_metashape.h"
@@ -75,6 +76,37 @@ void add_import_livo2(CLI::App* import) {
   });
 }
 
+void add_import_bag(CLI::App* import) {
+  auto o = std::make_shared<io::BagImportOptions>();
+  auto frame = std::make_shared<std::string>("imu");
+  CLI::App* c = import->add_subcommand(
+      "bag", "ROS 1 bag (thermal images, LiDAR, IMU, odometry) plus M2DGR calibration");
+  c->add_option("--bag", o->bag, "ROS 1 bag")->required()->check(CLI::ExistingFile);
+  c->add_option("--calib", o->calib, "M2DGR calibration_results.txt")->required()->check(CLI::ExistingFile);
+  c->add_option("--calib-block", o->calib_block, "Camera block of the calibration")->capture_default_str();
+  c->add_option("--out", o->out, "Scene directory to write")->required();
+  c->add_option("--thermal-topic", o->topics.thermal, "sensor_msgs/Image topic")->capture_default_str();
+  c->add_option("--lidar-topic", o->topics.lidar, "sensor_msgs/PointCloud2 topic")->capture_default_str();
+  c->add_option("--imu-topic", o->topics.imu, "sensor_msgs/Imu topic")->capture_default_str();
+  c->add_option("--odom-topic", o->topics.odom, "nav_msgs/Odometry topic for poses.txt (default: none)");
+  c->add_option("--poses", o->poses, "TUM trajectory for poses.txt when the bag has no odometry")
+      ->check(CLI::ExistingFile);
+  c->add_option("--poses-frame", *frame, "Frame of the poses: imu or camera")
+      ->check(CLI::IsMember({"imu", "camera"}))
+      ->capture_default_str();
+  c->add_option("--gt", o->ground_truth, "TUM ground truth for gt/poses.txt")->check(CLI::ExistingFile);
+  c->add_flag("!--no-scans", o->scans, "Do not write the LiDAR scans");
+  c->add_option("--image-format", o->image_extension, "Extension of the written frames: .png or .tiff")
+      ->capture_default_str();
+  c->callback([o, frame] {
+    o->poses_frame = *frame == "camera" ? io::PoseFrame::kCamera : io::PoseFrame::kImu;
+    const io::BagImportReport r = io::import_bag(*o);
+    std::cout << "import bag: " << r.frames << " frames, " << r.scans << " scans, " << r.imu
+              << " IMU samples, " << r.poses << " poses into " << o->out.string() << "\n";
+    for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
+  });
+}
+
 }  // namespace
 
 void add_import_command(CLI::App& app) {
@@ -108,6 +140,7 @@ void add_import_command(CLI::App& app) {
   });
   add_import_colmap(import);
   add_import_livo2(import);
+  add_import_bag(import);
 }
 
 }  // namespace litgs::tools
