@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <fstream>
+#include <random>
 
 #include "io/file_bytes.h"
 #include "io/import_bag.h"
@@ -122,6 +123,31 @@ TEST_F(ImportBagTest, BadBagsAreNamed) {
     testing::expect_io_error([&] { import_bag(o); }, {"cut.bag"});
   }
   EXPECT_FALSE(std::filesystem::exists(o.out / "scene.yaml"));
+}
+
+// Truncations and byte flips of a valid bag: read_ros_bag reads something or throws IoError, never another
+// exception (rosbag_storage's own exceptions are translated).
+TEST_F(ImportBagTest, CorruptBagsThrowIoErrorOnly) {
+  const std::string good = read_file_bytes(write_bag());
+  RosBagTopics topics;
+  topics.odom = "/odom";
+  std::mt19937 rng(7);
+  int other = 0;
+  for (int i = 0; i < 120; ++i) {
+    std::string m = good;
+    if (i % 2 == 0) {
+      m.resize(rng() % m.size());
+    } else {
+      for (int e = 0; e < 4; ++e) m[rng() % m.size()] = static_cast<char>(rng() & 0xff);
+    }
+    std::ofstream(dir_ / "m.bag", std::ios::binary | std::ios::trunc) << m;
+    try {
+      read_ros_bag(dir_ / "m.bag", topics, {});
+    } catch (const IoError&) {
+    } catch (const std::exception& e) {
+      if (++other <= 5) ADD_FAILURE() << "mutant " << i << ": non-IoError exception: " << e.what();
+    }
+  }
 }
 
 }  // namespace
