@@ -8,10 +8,10 @@ class App;
 namespace litgs::tools {
 
 void add_info_command(CLI::App& app);
-void add_bench_command(CLI::App& app);       // bench sort | render
+void add_bench_command(CLI::App& app);  // bench sort | render
 void add_bench_sort_command(CLI::App& bench);
 void add_bench_render_command(CLI::App& bench);
-void add_import_command(CLI::App& app);  // import metashape | colmap | livo2
+void add_import_command(CLI::App& app);  // import metashape | colmap | livo2 | bag
 void add_export_command(CLI::App& app);  // export colmap | tum
 
 }  // namespace litgs::tools
