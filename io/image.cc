@@ -50,4 +50,26 @@ void write_image(const std::filesystem::path& path, const Image& image) {
     write_tiff(path, image);
 }
 
+Image single_channel(Image im, const std::filesystem::path& path) {
+  if (im.channels == 1) return im;
+  const int colour = im.channels >= 3 ? 3 : 1;  // gray+alpha: the gray channel; RGB(A): R = G = B
+  Image out;
+  out.width = im.width;
+  out.height = im.height;
+  out.bit_depth = im.bit_depth;
+  out.channels = 1;
+  out.data.resize(static_cast<size_t>(im.width) * im.height);
+  for (size_t i = 0; i < out.data.size(); ++i) {
+    const uint16_t* px = &im.data[i * static_cast<size_t>(im.channels)];
+    for (int c = 1; c < colour; ++c)
+      if (px[c] != px[0])
+        fail(path, 0,
+             "colour image (channel " + std::to_string(c) + " differs from channel 0 at pixel " +
+                 std::to_string(i % static_cast<size_t>(im.width)) + ", " +
+                 std::to_string(i / static_cast<size_t>(im.width)) + "): scene frames are single-channel");
+    out.data[i] = px[0];
+  }
+  return out;
+}
+
 }  // namespace litgs::io

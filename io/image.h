@@ -39,6 +39,11 @@ ImageInfo read_image_info(const std::filesystem::path& path);
 // By extension (.png, .tif/.tiff), atomically. PNG: 8/16-bit; TIFF: 8/16-bit, deflate-compressed.
 void write_image(const std::filesystem::path& path, const Image& image);
 
+// One channel of a frame read for a thermal scene: a 1-channel image as it is; gray+alpha as its gray
+// channel; RGB(A) whose colour channels are equal at every pixel (an 8-bit thermal frame saved as colour)
+// as its first channel. IoError naming `path` and the first pixel where the colour channels differ.
+Image single_channel(Image image, const std::filesystem::path& path);
+
 // The format-specific entry points behind the above.
 Image read_png(const std::filesystem::path& path);
 ImageInfo read_png_info(const std::filesystem::path& path);

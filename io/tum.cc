@@ -1,5 +1,6 @@
 #include "io/tum.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "io/atomic_file.h"
@@ -41,6 +42,29 @@ std::vector<TumPose> read_tum(const std::filesystem::path& path, const TumReadOp
     poses.push_back(pose);
   }
   return poses;
+}
+
+std::optional<Eigen::Matrix4d> tum_pose_at(const std::vector<TumPose>& poses, double t, double snap_s) {
+  const auto matrix = [](const Eigen::Quaterniond& q, const Eigen::Vector3d& p) {
+    Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+    T.topLeftCorner<3, 3>() = q.toRotationMatrix();
+    T.topRightCorner<3, 1>() = p;
+    return T;
+  };
+  const auto it =
+      std::lower_bound(poses.begin(), poses.end(), t, [](const TumPose& p, double x) { return p.t_s < x; });
+  // The nearest pose within snap_s (it, or the one before it).
+  for (auto c : {it, it == poses.begin() ? poses.end() : it - 1})
+    if (c != poses.end() && std::abs(c->t_s - t) <= snap_s) {
+      if (!c->has_rotation) return std::nullopt;
+      return matrix(c->q_world_body, c->p_world);
+    }
+  if (it == poses.end() || it == poses.begin()) return std::nullopt;
+  const TumPose& a = *(it - 1);
+  const TumPose& b = *it;
+  if (!a.has_rotation || !b.has_rotation) return std::nullopt;
+  const double s = (t - a.t_s) / (b.t_s - a.t_s);
+  return matrix(a.q_world_body.slerp(s, b.q_world_body), (1 - s) * a.p_world + s * b.p_world);
 }
 
 void write_tum(const std::filesystem::path& path, const std::vector<TumPose>& poses) {

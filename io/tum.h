@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 namespace litgs::io {
@@ -29,6 +30,11 @@ struct TumReadOptions {
 // file, a field count other than 8, a non-finite or unparsable value, a bad quaternion norm, or a
 // timestamp not greater than the previous one.
 std::vector<TumPose> read_tum(const std::filesystem::path& path, const TumReadOptions& options = {});
+
+// T_world_body at time t of a trajectory sorted by time (4x4). A pose within snap_s of t is used as it is;
+// otherwise the two poses around t are interpolated (translation linearly, rotation by slerp). nullopt
+// before the first or after the last pose, or where a pose needed has an unknown rotation.
+std::optional<Eigen::Matrix4d> tum_pose_at(const std::vector<TumPose>& poses, double t, double snap_s = 0);
 
 // Writes atomically with round-trip exact numbers; unknown rotations as "0 0 0 0".
 void write_tum(const std::filesystem::path& path, const std::vector<TumPose>& poses);

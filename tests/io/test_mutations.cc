@@ -8,6 +8,7 @@
 #include <functional>
 #include <random>
 
+#include "io/colmap.h"
 #include "io/file_bytes.h"
 #include "io/image.h"
 #include "io/m2dgr_calib.h"
@@ -116,6 +117,35 @@ TEST_F(MutationTest, ImagesAndXml) {
       read_file_bytes(testing::data_dir() / "thermitage-dunr/metashape/DUNR-ImgCoords-TIR.xml");
   run(
       "m.xml", xml, [](const auto& p) { read_metashape_xml(p); }, 150);
+}
+
+TEST_F(MutationTest, ColmapModels) {
+  // A consistent model: one mutated file at a time, the other two intact beside it.
+  ColmapModel m;
+  m.cameras[1] = {1, ColmapCameraModel::kOpenCv, 8, 6, {500, 501, 4, 3, 0.1, -0.01, 1e-3, 0}};
+  ColmapImage a;
+  a.id = 1;
+  a.camera_id = 1;
+  a.name = "1.5.png";
+  a.t_cam_world = {1, 2, 3};
+  a.points2d = {{{1.5, 2.5}, 1}, {{3, 4}, -1}};
+  ColmapImage b = a;
+  b.id = 2;
+  b.name = "2.png";
+  b.q_cam_world = Eigen::Quaterniond(0.6, 0, 0.8, 0);
+  m.images = {a, b};
+  m.points = {{1, {0.5, 1, 2}, {1, 2, 3}, 0.25, {{1, 0}, {2, 0}}}};
+  for (bool binary : {false, true}) {
+    const auto dir = dir_ / (binary ? "bin" : "txt");
+    write_colmap_model(dir, m, binary);
+    for (const char* stem : {"cameras", "images", "points3D"}) {
+      const std::string name = std::string(binary ? "bin/" : "txt/") + stem + (binary ? ".bin" : ".txt");
+      const std::string good = read_file_bytes(dir_ / name);
+      run(
+          name, good, [&](const auto&) { read_colmap_model(dir); }, 200);
+      write_text(name, good);
+    }
+  }
 }
 
 }  // namespace
