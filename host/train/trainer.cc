@@ -1,6 +1,7 @@
 #include "host/train/trainer.h"
 
 #include <algorithm>
+#include <map>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -186,6 +187,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   };
 
   double last_loss = std::numeric_limits<double>::quiet_NaN(), last_psnr = last_loss;
+  std::map<std::string, double> kernel_ms;  // GPU time per kernel over the run (timestamps)
   const auto t0 = std::chrono::steady_clock::now();
   for (uint32_t it = start; it < o.iterations; ++it) {
     const uint32_t step = it + 1;
@@ -193,6 +195,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     kernels::SplatCamera cam = data.views[v].camera;
     cam.sh_degree = std::min(o.sh_degree, it / o.sh_degree_every);
     rasterizer.forward(model->gaussians(), cam);  // the iteration's one readback: the intersection count
+    for (const auto& k : rasterizer.profile()) kernel_ms[k.name] += k.ms;
     const auto out = rasterizer.device_outputs();
     const auto up = rasterizer.upstream_buffers();
 
@@ -211,6 +214,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     if (step <= densify_until) model->record_accumulate_stats(s, grads, *out.rects, cam);
     model->record_adam_step(s, grads, adam.rates(it, o.iterations, extent), step);
     s.submit_and_wait();
+    for (const auto& k : s.profile()) kernel_ms[k.name] += k.ms;
 
     if (step > o.densify_from && step <= densify_until && step % o.densify_every == 0) {
       const kernels::DensifyReport d = model->densify_and_prune(dopt, extent, step);
@@ -241,6 +245,8 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     }
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double done_iterations = std::max(1.0, static_cast<double>(o.iterations - start));
+  for (const auto& [name, ms] : kernel_ms) report.kernel_ms_per_iteration.emplace_back(name, ms / done_iterations);
   report.final_eval = evaluate(o.iterations);
   report.evals.push_back(report.final_eval);
   report.iterations = o.iterations;
@@ -263,7 +269,9 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
                             {"height", H},
                             {"lambda_geo", o.lambda_geo},
                             {"nonfinite_pruned", report.nonfinite_pruned},
-                            {"evaluations", nlohmann::json::array()}};
+                            {"evaluations", nlohmann::json::array()},
+                            {"kernel_ms_per_iteration", nlohmann::json::object()}};
+  for (const auto& [name, ms] : report.kernel_ms_per_iteration) metrics["kernel_ms_per_iteration"][name] = ms;
   if (report.final_eval.depth_plane_rmse_m >= 0) metrics["heldout_depth_plane_rmse_m"] = report.final_eval.depth_plane_rmse_m;
   for (const auto& e : report.evals) metrics["evaluations"].push_back(eval_json(e));
   io::write_file_atomic(out_dir / "metrics.json", [&](std::ostream& out) { out << metrics.dump(2) << "\n"; });

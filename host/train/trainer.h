@@ -7,6 +7,8 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "engine/context.h"
 #include "host/train/lidar_planes.h"
@@ -32,6 +34,7 @@ struct TrainReport {
   EvalResult final_eval;
   std::vector<EvalResult> evals;
   size_t nonfinite_pruned = 0;
+  std::vector<std::pair<std::string, double>> kernel_ms_per_iteration;  // GPU timestamps, training steps only
 };
 
 struct TrainProgress {

@@ -88,6 +88,16 @@ void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity
   depth = depths[g];
 }
 
+// Sums of three vectors over the subgroup, as a butterfly of XOR shuffles: on CPU drivers a shuffle with a
+// uniform mask is a register permute, several times cheaper than subgroupAdd.
+void subgroup_sum3(inout vec4 a, inout vec4 b, inout vec4 c) {
+  for (uint mask = 1u; mask < gl_SubgroupSize; mask <<= 1u) {
+    a += subgroupShuffleXor(a, mask);
+    b += subgroupShuffleXor(b, mask);
+    c += subgroupShuffleXor(c, mask);
+  }
+}
+
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
 const uint MAX_SUBGROUPS = SPLAT_TILE_SIZE * SPLAT_TILE_SIZE;  // subgroups of one lane at worst
 shared vec4 s_partial[MAX_SUBGROUPS][3];
@@ -155,7 +165,8 @@ void main() {
     const uint e = isect_ids[range.x + j - 1u];
     const EntryGrad r = entry_backward(centre, mean_extent, conic_opacity, color, depth, j <= my_last, T_final,
                                        dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
-    const vec4 s0 = subgroupAdd(r.g0), s1 = subgroupAdd(r.g1), s2 = subgroupAdd(r.g2);
+    vec4 s0 = r.g0, s1 = r.g1, s2 = r.g2;
+    subgroup_sum3(s0, s1, s2);
     if (subgroupElect()) {
       s_partial[gl_SubgroupID][0] = s0;
       s_partial[gl_SubgroupID][1] = s1;
@@ -203,7 +214,8 @@ void main() {
         const EntryGrad r = entry_backward(centre, subgroupShuffle(mean_extent, k), subgroupShuffle(conic_opacity, k),
                                            subgroupShuffle(color, k), subgroupShuffle(depth, k),
                                            chunk_start + k < my_last, T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
-        const vec4 s0 = subgroupAdd(r.g0), s1 = subgroupAdd(r.g1), s2 = subgroupAdd(r.g2);
+        vec4 s0 = r.g0, s1 = r.g1, s2 = r.g2;
+        subgroup_sum3(s0, s1, s2);
         if (gl_SubgroupInvocationID == k) {
           a0 += s0;
           a1 += s1;
