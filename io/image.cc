@@ -9,14 +9,15 @@
 namespace litgs::io {
 namespace {
 
-enum class Kind { kPng, kTiff };
+enum class Kind { kPng, kTiff, kJpeg };
 
 Kind kind_of(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   if (ext == ".png") return Kind::kPng;
   if (ext == ".tif" || ext == ".tiff") return Kind::kTiff;
-  fail(path, 0, "unknown image extension '" + ext + "' (expected .png, .tif or .tiff)");
+  if (ext == ".jpg" || ext == ".jpeg") return Kind::kJpeg;
+  fail(path, 0, "unknown image extension '" + ext + "' (expected .png, .tif, .tiff, .jpg or .jpeg)");
 }
 
 }  // namespace
@@ -36,18 +37,36 @@ void Image::check() const {
 }
 
 Image read_image(const std::filesystem::path& path) {
-  return kind_of(path) == Kind::kPng ? read_png(path) : read_tiff(path);
+  switch (kind_of(path)) {
+    case Kind::kPng:
+      return read_png(path);
+    case Kind::kTiff:
+      return read_tiff(path);
+    default:
+      return read_jpeg(path);
+  }
 }
 
 ImageInfo read_image_info(const std::filesystem::path& path) {
-  return kind_of(path) == Kind::kPng ? read_png_info(path) : read_tiff_info(path);
+  switch (kind_of(path)) {
+    case Kind::kPng:
+      return read_png_info(path);
+    case Kind::kTiff:
+      return read_tiff_info(path);
+    default:
+      return read_jpeg_info(path);
+  }
 }
 
 void write_image(const std::filesystem::path& path, const Image& image) {
-  if (kind_of(path) == Kind::kPng)
-    write_png(path, image);
-  else
-    write_tiff(path, image);
+  switch (kind_of(path)) {
+    case Kind::kPng:
+      return write_png(path, image);
+    case Kind::kTiff:
+      return write_tiff(path, image);
+    default:
+      fail(path, 0, "writing JPEG is not supported (lossy): write .png or .tiff");
+  }
 }
 
 Image single_channel(Image im, const std::filesystem::path& path) {

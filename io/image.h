@@ -51,5 +51,8 @@ void write_png(const std::filesystem::path& path, const Image& image);
 Image read_tiff(const std::filesystem::path& path);
 ImageInfo read_tiff_info(const std::filesystem::path& path);
 void write_tiff(const std::filesystem::path& path, const Image& image);
+// JPEG (read only): 8-bit gray or RGB, through libjpeg.
+Image read_jpeg(const std::filesystem::path& path);
+ImageInfo read_jpeg_info(const std::filesystem::path& path);
 
 }  // namespace litgs::io

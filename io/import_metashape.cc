@@ -29,11 +29,11 @@ bool label_time(const std::string& label, double& t_s) {
 }
 
 fs::path find_image(const fs::path& dir, const std::string& label) {
-  for (const char* ext : {".tiff", ".tif", ".png", ".TIFF", ".TIF", ".PNG"}) {
+  for (const char* ext : {".tiff", ".tif", ".png", ".jpg", ".jpeg", ".TIFF", ".TIF", ".PNG", ".JPG", ".JPEG"}) {
     const fs::path p = dir / (label + ext);
     if (fs::exists(p)) return p;
   }
-  fail(dir / label, 0, "no image for camera '" + label + "' (looked for .tiff, .tif, .png)");
+  fail(dir / label, 0, "no image for camera '" + label + "' (looked for .tiff, .tif, .png, .jpg, .jpeg)");
 }
 
 }  // namespace
