@@ -61,6 +61,23 @@ void run_train(TrainCliOptions o) {
     o.train.lambda_geo = 0;
   }
 
+  // Ground truth planes (synthetic scenes): the true map's points with their plane's normal.
+  std::unique_ptr<host::PlanarMap> gt_planes;
+  if (scene.gt && scene.gt->map && !scene.gt->planes.empty()) {
+    const io::PointCloud& m = *scene.gt->map;
+    const io::ScalarField* id = m.field("plane_id");
+    if (id) {
+      gt_planes = std::make_unique<host::PlanarMap>();
+      for (size_t i = 0; i < m.size(); ++i) {
+        const double pid = id->values[i];
+        if (pid < 0 || pid >= static_cast<double>(scene.gt->planes.size())) continue;
+        gt_planes->points.push_back(m.positions[i].cast<float>());
+        gt_planes->normals.push_back(scene.gt->planes[static_cast<size_t>(pid)].n.cast<float>());
+        gt_planes->planar.push_back(1);
+      }
+    }
+  }
+
   host::InitOptions init;
   init.sh_degree = o.train.sh_degree;
   kernels::GaussianModel model;
@@ -95,7 +112,8 @@ void run_train(TrainCliOptions o) {
                   p.gaussians, p.iterations_per_s, format_eta(eta).c_str());
     std::cout << (tty ? "\r" : "") << line << (tty ? "" : "\n") << std::flush;
   };
-  const host::TrainReport r = host::train(context, data, model, planes.get(), o.train, o.out, progress);
+  const host::TrainReport r =
+      host::train(context, data, model, planes.get(), o.train, o.out, progress, gt_planes.get());
   if (tty) std::cout << "\n";
   std::cout << "train: " << r.iterations << " iterations in " << r.wall_s << " s (" << r.ms_per_iteration
             << " ms/iteration), " << r.gaussians << " Gaussians; held-out PSNR " << r.final_eval.psnr_db

@@ -110,7 +110,7 @@ void TrainOptions::check() const {
 
 TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels::GaussianModel& initial,
                   const PlanarMap* planes, const TrainOptions& o, const fs::path& out_dir,
-                  const std::function<void(const TrainProgress&)>& progress) {
+                  const std::function<void(const TrainProgress&)>& progress, const PlanarMap* gt_planes) {
   o.check();
   if (o.lambda_geo > 0 && !planes)
     throw std::invalid_argument("lambda_geo > 0 needs a LiDAR map (the scene has none); use --lambda-geo 0");
@@ -173,6 +173,8 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     EvalResult e;
     e.iteration = iteration;
     if (eval_views.empty()) return e;
+    double plane_sq = 0;
+    size_t plane_n = 0;
     for (uint32_t i : eval_views) {
       kernels::SplatCamera cam = data.views[i].camera;
       cam.sh_degree = std::min(o.sh_degree, iteration / o.sh_degree_every);
@@ -180,9 +182,26 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
       const auto img = rasterizer.download_images();
       e.psnr_db += kernels::psnr(img.image, data.views[i].image);
       e.ssim += kernels::ssim_reference(img.image, data.views[i].image, 1, W, H);
+      if (gt_planes) {
+        // Point-to-plane residual of the rendered depth along each pixel's ray, where a true plane is seen
+        // and the render is opaque enough to have a depth.
+        const ViewPlaneMaps truth = project_planes(*gt_planes, cam);
+        for (uint32_t y = 0; y < H; ++y)
+          for (uint32_t x = 0; x < W; ++x) {
+            const size_t p = size_t{y} * W + x;
+            if (truth.points[4 * p + 3] != 1.0f || img.alpha[p] < 0.5f) continue;
+            const double rx = (x + 0.5 - cam.cx) / cam.fx, ry = (y + 0.5 - cam.cy) / cam.fy, D = img.depth[p];
+            const double r = truth.normals[4 * p] * (truth.points[4 * p] - D * rx) +
+                             truth.normals[4 * p + 1] * (truth.points[4 * p + 1] - D * ry) +
+                             truth.normals[4 * p + 2] * (truth.points[4 * p + 2] - D);
+            plane_sq += r * r;
+            ++plane_n;
+          }
+      }
     }
     e.psnr_db /= static_cast<double>(eval_views.size());
     e.ssim /= static_cast<double>(eval_views.size());
+    if (gt_planes && plane_n > 0) e.depth_plane_rmse_m = std::sqrt(plane_sq / static_cast<double>(plane_n));
     return e;
   };
 

@@ -47,8 +47,11 @@ struct TrainProgress {
 
 // Trains `initial` on `data` and writes `out_dir/point_cloud.ply` and `out_dir/metrics.json` (atomically).
 // `planes` (optional) drives the geometric loss; without it lambda_geo must be 0.
+// `gt_planes` (optional): the scene's true planes, sampled as points with their plane's normal; evaluation
+// then also reports the RMSE of the rendered depth's point-to-plane residual against them.
 TrainReport train(engine::Context& context, const TrainingData& data, const kernels::GaussianModel& initial,
                   const PlanarMap* planes, const TrainOptions& options, const std::filesystem::path& out_dir,
-                  const std::function<void(const TrainProgress&)>& progress = {});
+                  const std::function<void(const TrainProgress&)>& progress = {},
+                  const PlanarMap* gt_planes = nullptr);
 
 }  // namespace litgs::host
