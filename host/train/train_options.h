@@ -20,6 +20,7 @@ struct TrainOptions {
   uint32_t opacity_reset_every = 3000;
   float densify_grad_threshold = 0.0002f;  // of the averaged screen-space mean gradient, 3DGS units
   uint32_t max_gaussians = 2000000;        // cap of the model size
+  float lr_scale = 1.0f;                   // multiplies every learning rate (stability tests, tuning)
   // Evaluation, checkpoints, reproducibility.
   uint32_t eval_every = 0;         // 0: only at the end
   uint32_t checkpoint_every = 0;   // 0: none

@@ -106,6 +106,7 @@ void TrainOptions::check() const {
   if (opacity_reset_every == 0) bad("opacity_reset_every must be positive");
   if (!(densify_grad_threshold > 0)) bad("densify_grad_threshold must be positive");
   if (max_gaussians == 0) bad("max_gaussians must be positive");
+  if (!(lr_scale > 0) || !std::isfinite(lr_scale)) bad("lr_scale must be positive");
 }
 
 TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels::GaussianModel& initial,
@@ -118,6 +119,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   for (uint32_t i = 0; i < data.views.size(); ++i) (data.views[i].heldout ? eval_views : train_views).push_back(i);
   if (train_views.empty()) throw std::invalid_argument("no training views (all held out)");
   fs::create_directories(out_dir);
+  if (o.checkpoint_every > 0) fs::create_directories(out_dir / "checkpoints");
   const uint32_t W = data.width, H = data.height;
   const bool geometric = o.lambda_geo > 0;
 
@@ -231,7 +233,9 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     s.fill(*up.alpha, 0u, uint64_t{W} * H * sizeof(float));
     const auto grads = rasterizer.record_backward(s);
     if (step <= densify_until) model->record_accumulate_stats(s, grads, *out.rects, cam);
-    model->record_adam_step(s, grads, adam.rates(it, o.iterations, extent), step);
+    kernels::LearningRates lr = adam.rates(it, o.iterations, extent);
+    for (float* r : {&lr.means, &lr.log_scales, &lr.quats, &lr.opacity_logits, &lr.sh_dc, &lr.sh_rest}) *r *= o.lr_scale;
+    model->record_adam_step(s, grads, lr, step);
     s.submit_and_wait();
     for (const auto& k : s.profile()) kernel_ms[k.name] += k.ms;
 
