@@ -1,6 +1,7 @@
 #include "host/train/lidar_planes.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <nanoflann.hpp>
 
 #include <cmath>
@@ -105,6 +106,74 @@ ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& c
     ++out.valid_count;
   }
   return out;
+}
+
+}  // namespace litgs::host
+
+namespace litgs::host {
+namespace {
+
+struct FloatAdaptor {
+  const std::vector<Eigen::Vector3f>* pts;
+  size_t kdtree_get_point_count() const { return pts->size(); }
+  float kdtree_get_pt(size_t i, size_t d) const { return (*pts)[i][static_cast<int>(d)]; }
+  template <class B>
+  bool kdtree_get_bbox(B&) const {
+    return false;
+  }
+};
+using FloatTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, FloatAdaptor>, FloatAdaptor, 3>;
+
+}  // namespace
+
+struct PlaneDistance::Index {
+  std::vector<Eigen::Vector3f> points, normals;
+  FloatAdaptor adaptor{&points};
+  std::unique_ptr<FloatTree> tree;
+  float max_d2 = 0;
+};
+
+PlaneDistance::PlaneDistance(const PlanarMap& map, double max_radius_m) : index_(std::make_unique<Index>()) {
+  for (size_t i = 0; i < map.points.size(); ++i)
+    if (map.planar[i]) {
+      index_->points.push_back(map.points[i]);
+      index_->normals.push_back(map.normals[i]);
+    }
+  index_->max_d2 = static_cast<float>(max_radius_m * max_radius_m);
+  index_->tree = std::make_unique<FloatTree>(3, index_->adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  if (!index_->points.empty()) index_->tree->buildIndex();
+}
+
+PlaneDistance::~PlaneDistance() = default;
+
+std::vector<float> PlaneDistance::distances(const std::vector<float>& means) const {
+  const size_t n = means.size() / 3;
+  std::vector<float> out(n, std::numeric_limits<float>::quiet_NaN());
+  if (index_->points.empty()) return out;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3f x(means[3 * i], means[3 * i + 1], means[3 * i + 2]);
+    if (!x.allFinite()) continue;
+    uint32_t idx = 0;
+    float d2 = 0;
+    if (index_->tree->knnSearch(x.data(), 1, &idx, &d2) == 1 && d2 <= index_->max_d2)
+      out[i] = std::abs(index_->normals[idx].dot(x - index_->points[idx]));
+  }
+  return out;
+}
+
+float PlaneDistance::robust_bound(const std::vector<float>& d, double k, double floor_m) {
+  std::vector<float> v;
+  for (float x : d)
+    if (std::isfinite(x)) v.push_back(x);
+  if (v.empty()) return std::numeric_limits<float>::infinity();
+  auto median = [](std::vector<float> a) {
+    std::nth_element(a.begin(), a.begin() + static_cast<long>(a.size() / 2), a.end());
+    return a[a.size() / 2];
+  };
+  const float med = median(v);
+  for (float& x : v) x = std::abs(x - med);
+  const float mad = median(v);
+  return static_cast<float>(std::max(floor_m, med + k * 1.4826 * mad));
 }
 
 }  // namespace litgs::host

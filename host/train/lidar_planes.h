@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "kernels/splat/splat_types.h"
@@ -37,5 +38,24 @@ struct ViewPlaneMaps {
 
 // Nearest planar map point per pixel by a z-buffer (pixel centres at +0.5, the rasterizer's convention).
 ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& camera);
+
+}  // namespace litgs::host
+
+namespace litgs::host {
+
+// Distances of points to the LiDAR planes: for each query, |n . (x - p)| with p the nearest planar map point
+// (within max_radius_m; NaN when there is none), for the densifier's geometric outlier prune.
+class PlaneDistance {
+ public:
+  explicit PlaneDistance(const PlanarMap& map, double max_radius_m = 0.5);
+  ~PlaneDistance();
+  std::vector<float> distances(const std::vector<float>& means_xyz) const;  // means: [N][3]
+  // A robust bound on distances: median + k * 1.4826 * MAD of the finite ones, at least floor_m.
+  static float robust_bound(const std::vector<float>& distances, double k = 5.0, double floor_m = 0.1);
+
+ private:
+  struct Index;
+  std::unique_ptr<Index> index_;
+};
 
 }  // namespace litgs::host

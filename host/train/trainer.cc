@@ -169,6 +169,9 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   dopt.seed = o.seed;
   const uint32_t densify_until = std::min(o.densify_until, o.iterations);
   const float extent = static_cast<float>(data.scene_extent_m);
+  std::unique_ptr<PlaneDistance> plane_index;
+  if (geometric) plane_index = std::make_unique<PlaneDistance>(*planes);
+  std::unique_ptr<DeviceArray<float>> plane_distances;
 
   TrainReport report;
   auto evaluate = [&](uint32_t iteration) {
@@ -240,7 +243,19 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     for (const auto& k : s.profile()) kernel_ms[k.name] += k.ms;
 
     if (step > o.densify_from && step <= densify_until && step % o.densify_every == 0) {
-      const kernels::DensifyReport d = model->densify_and_prune(dopt, extent, step);
+      // The method's geometric outlier removal: Gaussians far from their LiDAR plane, beyond a robust
+      // bound of all distances, are pruned with the others.
+      const engine::Buffer* plane_distance = nullptr;
+      kernels::DensifyOptions step_options = dopt;
+      if (plane_index) {
+        const std::vector<float> d = plane_index->distances(model->download().means);
+        plane_distances = std::make_unique<DeviceArray<float>>(ctx, "train: plane distances", std::max<size_t>(d.size(), 1));
+        plane_distances->upload(d);
+        plane_distance = &plane_distances->buffer();
+        step_options.max_plane_distance_m = PlaneDistance::robust_bound(d);
+      }
+      const kernels::DensifyReport d = model->densify_and_prune(step_options, extent, step, plane_distance);
+      report.plane_pruned += d.pruned_plane;
       report.nonfinite_pruned += d.pruned_nonfinite;
     }
     if (step <= densify_until && step % o.opacity_reset_every == 0) {
@@ -292,6 +307,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
                             {"height", H},
                             {"lambda_geo", o.lambda_geo},
                             {"nonfinite_pruned", report.nonfinite_pruned},
+                            {"plane_pruned", report.plane_pruned},
                             {"evaluations", nlohmann::json::array()},
                             {"kernel_ms_per_iteration", nlohmann::json::object()}};
   for (const auto& [name, ms] : report.kernel_ms_per_iteration) metrics["kernel_ms_per_iteration"][name] = ms;

@@ -34,6 +34,7 @@ struct TrainReport {
   EvalResult final_eval;
   std::vector<EvalResult> evals;
   size_t nonfinite_pruned = 0;
+  size_t plane_pruned = 0;  // Gaussians pruned for their distance to the LiDAR plane
   std::vector<std::pair<std::string, double>> kernel_ms_per_iteration;  // GPU timestamps, training steps only
 };
 

@@ -100,13 +100,16 @@ bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
 TEST_F(TrainTest, TrainsAndWritesOutputs) {
   std::vector<double> losses;
   auto o = small_run(60);
-  o.opacity_reset_every = 1000;  // a reset raises the loss on purpose; not in this window
+  // Densification and opacity resets raise the loss on purpose (new, unfitted Gaussians); they have their own
+  // tests. Here the optimizer alone must bring it down.
+  o.opacity_reset_every = 1000;
+  o.densify_from = 1000;
   const auto m = run(o, "basic", nullptr, nullptr, planes_, &losses);
   expect_finite(m);
   ASSERT_EQ(losses.size(), 60u);
   double first = 0, last = 0;
   for (int i = 0; i < 10; ++i) first += losses[i], last += losses[losses.size() - 1 - i];
-  EXPECT_LT(last, first) << "the loss falls";
+  EXPECT_LT(last, first) << "the loss falls: " << ::testing::PrintToString(losses);
   std::ifstream in(root_ / "basic" / "metrics.json");
   const auto j = nlohmann::json::parse(in);
   for (const char* key : {"iterations", "wall_s", "ms_per_iteration", "gaussians", "peak_device_bytes",

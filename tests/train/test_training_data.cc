@@ -127,3 +127,34 @@ TEST(LidarPlanes, PlaneAndCornerPoints) {
 
 }  // namespace
 }  // namespace litgs::host
+
+namespace litgs::host {
+namespace {
+
+TEST(PlaneDistanceTest, DistancesAndRobustBound) {
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = -10; i <= 10; ++i)
+    for (int j = -10; j <= 10; ++j) pts.emplace_back(0.05 * i, 0.05 * j, 2.0);
+  const PlanarMap map = fit_planes(pts, PlaneFitOptions{});
+  const PlaneDistance index(map);
+  // On the plane, 3 cm off it, 40 cm off it (near enough to have a plane point), and far from any point.
+  const std::vector<float> means = {0.1f, 0.1f, 2.0f, 0.1f, 0.1f, 2.03f, 0.0f, 0.0f, 2.4f, 5.0f, 5.0f, 5.0f};
+  const auto d = index.distances(means);
+  ASSERT_EQ(d.size(), 4u);
+  EXPECT_NEAR(d[0], 0.0f, 1e-5f);
+  EXPECT_NEAR(d[1], 0.03f, 1e-5f);
+  EXPECT_NEAR(d[2], 0.4f, 1e-5f);
+  EXPECT_TRUE(std::isnan(d[3])) << "no plane within reach: never pruned";
+  // 1000 inliers around 1 cm and 3 outliers: the bound keeps the inliers and cuts the outliers.
+  std::vector<float> many(1000);
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<float> u(0.0f, 0.02f);
+  for (auto& x : many) x = u(rng);
+  many.insert(many.end(), {0.5f, 0.8f, 2.0f});
+  const float bound = PlaneDistance::robust_bound(many);
+  EXPECT_GE(bound, 0.1f) << "never below the floor";
+  EXPECT_LT(bound, 0.5f);
+}
+
+}  // namespace
+}  // namespace litgs::host
