@@ -42,7 +42,7 @@ struct Reader {
       io::fail_at_byte(path, at, "array of " + std::to_string(n) + " values, expected " + std::to_string(expected));
     if (n > (bytes.size() - at) / sizeof(T)) io::fail_at_byte(path, at, "checkpoint truncated (array of " + std::to_string(n) + ")");
     std::vector<T> v(n);
-    std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));
+    if (n > 0) std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));  // data() may be null when empty
     at += n * sizeof(T);
     return v;
   }

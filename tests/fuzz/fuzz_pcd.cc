@@ -1,0 +1,8 @@
+// libFuzzer target: io::read_pcd (PCD point clouds: ascii, binary, binary_compressed).
+#include "tests/fuzz/fuzz_util.h"
+#include "io/pcd.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  const auto path = litgs::fuzz::write_temp("cloud.pcd", data, size);
+  return litgs::fuzz::expect_only_io_error([&] { litgs::io::read_pcd(path); });
+}
