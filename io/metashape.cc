@@ -64,8 +64,16 @@ MetashapeCalibration parse_calibration(const Xml& xml, const XMLElement* c) {
     const XMLElement* w = c->FirstChildElement("width");
     const XMLElement* h = c->FirstChildElement("height");
     if (!w || !h) xml.bad(c, "<calibration> has neither <resolution> nor <width>/<height>");
-    cal.width = static_cast<int>(xml.number(w));
-    cal.height = static_cast<int>(xml.number(h));
+    // Range-checked before the cast: an out-of-range double -> int conversion is undefined behaviour
+    // (found by the fuzzer with a 100-digit height).
+    auto pixels = [&](const XMLElement* e, const char* what) {
+      const double v = xml.number(e);
+      if (!(v >= 1 && v <= 1e6) || v != std::floor(v))
+        xml.bad(e, std::string("<") + what + "> must be a whole number of pixels in 1..1000000");
+      return static_cast<int>(v);
+    };
+    cal.width = pixels(w, "width");
+    cal.height = pixels(h, "height");
   }
   const XMLElement* f = c->FirstChildElement("f");
   if (!f) xml.bad(c, "<calibration> lacks <f>");
