@@ -248,8 +248,12 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
       const engine::Buffer* plane_distance = nullptr;
       kernels::DensifyOptions step_options = dopt;
       if (plane_index) {
-        const std::vector<float> d = plane_index->distances(model->download().means);
-        plane_distances = std::make_unique<DeviceArray<float>>(ctx, "train: plane distances", std::max<size_t>(d.size(), 1));
+        // Only the means come back to the host, and the distance buffer is reused while it is large enough.
+        const DeviceArray<float>& means = model->gaussians().means;
+        const std::vector<float> d = plane_index->distances(means.download(0, 3 * model->size()));
+        if (!plane_distances || plane_distances->size() < d.size())
+          plane_distances = std::make_unique<DeviceArray<float>>(ctx, "train: plane distances",
+                                                                 std::max<size_t>(d.size() + d.size() / 2, 1));
         plane_distances->upload(d);
         plane_distance = &plane_distances->buffer();
         step_options.max_plane_distance_m = PlaneDistance::robust_bound(d);

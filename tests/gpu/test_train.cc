@@ -113,8 +113,10 @@ TEST_F(TrainTest, TrainsAndWritesOutputs) {
   std::ifstream in(root_ / "basic" / "metrics.json");
   const auto j = nlohmann::json::parse(in);
   for (const char* key : {"iterations", "wall_s", "ms_per_iteration", "gaussians", "peak_device_bytes",
-                          "heldout_psnr", "heldout_ssim", "heldout_depth_plane_rmse_m"})
-    EXPECT_TRUE(j.contains(key) || std::string(key) == "heldout_depth_plane_rmse_m") << key;
+                          "heldout_psnr", "heldout_ssim"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  // No true planes were given to this run, so no plane RMSE may be claimed.
+  EXPECT_FALSE(j.contains("heldout_depth_plane_rmse_m"));
   EXPECT_EQ(j["iterations"], 60);
   EXPECT_EQ(j["gaussians"], m.size());
   EXPECT_GT(j["peak_device_bytes"].get<uint64_t>(), 0u);

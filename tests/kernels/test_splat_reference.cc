@@ -131,9 +131,10 @@ INSTANTIATE_TEST_SUITE_P(ChannelsAndDegrees, SplatReferenceFd,
                          ::testing::Values(std::make_pair(1u, 3u), std::make_pair(3u, 1u), std::make_pair(1u, 0u),
                                            std::make_pair(2u, 2u)));
 
-TEST(SplatReference, Mean2dGradientMatchesFdOfPixelShift) {
-  // dL/dmean2d is what densification reads: check it against moving the projected mean, which for a
-  // Gaussian seen head-on at depth z is moving the world mean by dz/fx per pixel.
+TEST(SplatReference, MeanGradientWithIdentityPoseMatchesFd) {
+  // The camera at the origin without rotation (the other FD tests use a rotated, offset camera); the
+  // screen-space mean gradient densification reads must be non-zero there. Its values are checked against
+  // the device in tests/gpu/test_rasterizer_backward.cc.
   auto m = smooth_scene(1, 0);
   auto c = small_camera();
   c.R_cam_world = glm::dmat3(1.0);
@@ -141,8 +142,6 @@ TEST(SplatReference, Mean2dGradientMatchesFdOfPixelShift) {
   c.sh_degree = 0;
   const auto g = random_grad(1, c.width, c.height, 9);
   const auto grads = reference_backward(m, c, g);
-  // Only the projected position moves with x when the Jacobian's x-dependence is removed: compare the
-  // x-gradient of the world mean with fx/z * dL/du plus the Jacobian term, i.e. the full means gradient.
   const double fd = central_difference(m, c, g, &GaussianModel::means, 0, 1e-3f);
   EXPECT_NEAR(grads.means[0], fd, 2e-4 + 2e-3 * std::abs(fd));
   EXPECT_NE(grads.means2d[0], 0.0);
