@@ -14,6 +14,16 @@ uint32_t subgroup_width(const engine::Context& context) {
   return s;
 }
 
+std::unique_ptr<engine::Kernel> make_kernel(engine::Context& context, const std::string& name,
+                                            uint32_t binding_count, uint32_t push_constant_bytes) {
+  engine::KernelDesc desc;
+  desc.name = name;
+  desc.spirv = spirv(name);
+  desc.binding_count = binding_count;
+  desc.push_constant_bytes = push_constant_bytes;
+  return std::make_unique<engine::Kernel>(context, std::move(desc));
+}
+
 std::unique_ptr<engine::Kernel> make_subgroup_kernel(engine::Context& context, const std::string& name,
                                                      uint32_t binding_count, uint32_t push_constant_bytes) {
   engine::KernelDesc desc;

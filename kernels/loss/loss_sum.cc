@@ -29,16 +29,6 @@ engine::Groups elementwise_groups(const engine::Context& context, const char* wh
   return {static_cast<uint32_t>(groups)};
 }
 
-std::unique_ptr<engine::Kernel> make_kernel(engine::Context& context, const char* name, uint32_t bindings,
-                                            uint32_t push_constant_bytes) {
-  engine::KernelDesc desc;
-  desc.name = name;
-  desc.spirv = spirv(name);
-  desc.binding_count = bindings;
-  desc.push_constant_bytes = push_constant_bytes;
-  return std::make_unique<engine::Kernel>(context, std::move(desc));
-}
-
 void ensure(engine::Context& context, std::unique_ptr<engine::Buffer>& buffer, uint64_t bytes,
             const char* name) {
   if (buffer && buffer->size_bytes() >= bytes) return;

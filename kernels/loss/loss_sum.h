@@ -11,6 +11,7 @@
 #include "engine/context.h"
 #include "engine/kernel.h"
 #include "engine/sequence.h"
+#include "kernels/subgroup_kernel.h"
 #include "kernels/loss/loss_shared.h"
 
 namespace litgs::kernels::loss_detail {
@@ -21,9 +22,7 @@ void check_binding(const char* who, const char* what, const engine::Buffer& buff
 // Element-wise groups for n invocations; throws std::length_error naming `who` beyond the device's limit.
 engine::Groups elementwise_groups(const engine::Context& context, const char* who, uint64_t n);
 
-// An element-wise loss kernel (no specialization constants, no subgroup operations).
-std::unique_ptr<engine::Kernel> make_kernel(engine::Context& context, const char* name, uint32_t bindings,
-                                            uint32_t push_constant_bytes);
+using kernels::make_kernel;  // kernels/subgroup_kernel.h
 
 // Grows `buffer` to at least `bytes` (by 1.5x steps).
 void ensure(engine::Context& context, std::unique_ptr<engine::Buffer>& buffer, uint64_t bytes,

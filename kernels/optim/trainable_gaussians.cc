@@ -7,7 +7,7 @@
 
 #include "kernels/densify/densify_shared.h"
 #include "kernels/optim/optim_shared.h"
-#include "kernels/spirv_registry.h"
+#include "kernels/subgroup_kernel.h"
 
 namespace litgs::kernels {
 
@@ -56,16 +56,6 @@ void grow(engine::Context& ctx, std::unique_ptr<DeviceArray<T>>& array, size_t c
   const size_t grown = array ? std::max(count, array->size() + array->size() / 2) : count;
   array.reset();
   array = std::make_unique<DeviceArray<T>>(ctx, name, std::max<size_t>(grown, 1));
-}
-
-std::unique_ptr<engine::Kernel> make_kernel(engine::Context& ctx, const char* name, uint32_t bindings,
-                                            uint32_t push_bytes) {
-  engine::KernelDesc desc;
-  desc.name = name;
-  desc.spirv = spirv(name);
-  desc.binding_count = bindings;
-  desc.push_constant_bytes = push_bytes;
-  return std::make_unique<engine::Kernel>(ctx, std::move(desc));
 }
 
 }  // namespace
@@ -356,6 +346,48 @@ void TrainableGaussians::load_state(const TrainingState& state) {
   ensure_capacity(*current_, state.size());
   current_->params->count = state.size();
   upload_state(*current_, state);
+}
+
+std::vector<TrainableGaussians::RowArray> TrainableGaussians::row_arrays() const {
+  const Slot& s = *current_;
+  const auto widths = group_widths(sh_values());
+  std::vector<RowArray> out;
+  for (uint32_t g = 0; g < kParamGroupCount; ++g)
+    out.push_back({&param_buffer(*s.params, g), widths[g], RowArray::kParameter});
+  for (uint32_t g = 0; g < kParamGroupCount; ++g) {
+    out.push_back({&s.exp_avg[g]->buffer(), widths[g], RowArray::kMoment});
+    out.push_back({&s.exp_avg_sq[g]->buffer(), widths[g], RowArray::kMoment});
+  }
+  out.push_back({&s.grad_accum->buffer(), 1, RowArray::kStatistic});
+  out.push_back({&s.denom->buffer(), 1, RowArray::kStatistic});
+  out.push_back({&s.max_radius->buffer(), 1, RowArray::kStatistic});
+  return out;
+}
+
+void TrainableGaussians::grow_rows(size_t rows, size_t capacity_cap) {
+  const size_t n = size();
+  if (rows < n)
+    throw std::invalid_argument("TrainableGaussians::grow_rows: " + std::to_string(rows) + " rows < " +
+                                std::to_string(n) + " in use");
+  if (rows == n) return;
+  if (rows > current_->capacity) {
+    size_t capacity = std::max(rows, current_->capacity + current_->capacity / 2);
+    if (capacity_cap > 0) capacity = std::max(rows, std::min(capacity, capacity_cap));
+    if (!spare_) spare_ = std::make_unique<Slot>();
+    spare_->params.reset();  // free the old spare first
+    ensure_capacity(*spare_, capacity);
+    const std::vector<RowArray> from = row_arrays();
+    std::swap(current_, spare_);
+    const std::vector<RowArray> to = row_arrays();
+    engine::Sequence copy(*context_);
+    for (size_t a = 0; a < from.size(); ++a) copy.copy(*from[a].buffer, *to[a].buffer, uint64_t{n} * from[a].stride * 4);
+    copy.submit_and_wait();
+  }
+  engine::Sequence zero(*context_);
+  for (const RowArray& a : row_arrays())
+    zero.fill(*a.buffer, 0u, uint64_t{rows - n} * a.stride * 4, uint64_t{n} * a.stride * 4);
+  zero.submit_and_wait();
+  current_->params->count = rows;
 }
 
 GaussianModel TrainableGaussians::download() const {

@@ -52,6 +52,19 @@ class TrainableGaussians {
   // Records opacity = min(opacity, reset_opacity) and zeroes the opacity moments (3DGS reset_opacity).
   void record_reset_opacity(engine::Sequence& sequence, float reset_opacity = 0.01f);
 
+  // Every per-row array (parameters, Adam moments, densification statistics) with its 32-bit words per
+  // row, for strategies that move rows themselves (kernels/mcmc/).
+  struct RowArray {
+    enum Kind { kParameter, kMoment, kStatistic };
+    const engine::Buffer* buffer;
+    uint32_t stride;
+    Kind kind;
+  };
+  std::vector<RowArray> row_arrays() const;
+  // Sets the row count to `rows` (>= size()); new rows are zero. Grows the buffers (keeping the rows) by
+  // at least 1.5x when they are too small, to at most `capacity_cap` rows (0: no cap) or `rows` if more.
+  void grow_rows(size_t rows, size_t capacity_cap);
+
   GaussianModel download() const;
   TrainingState download_state() const;
   // Replaces parameters, moments and statistics (any size; the same channels and SH degree): a resume, or a
