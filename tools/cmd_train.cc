@@ -137,7 +137,13 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--eval-every", o->train.eval_every, "Evaluate held-out views every K iterations (0: at the end)");
   cmd->add_option("--checkpoint-every", o->train.checkpoint_every, "Checkpoint every K iterations (0: none)");
   cmd->add_flag("--resume", o->train.resume, "Continue from the newest checkpoint in --out");
-  cmd->add_option("--max-gaussians", o->train.max_gaussians, "Cap of the model size")->capture_default_str();
+  cmd->add_option("--max-gaussians", o->train.max_gaussians, "Cap of the model size (the MCMC budget)")->capture_default_str();
+  cmd->add_option("--strategy", o->train.strategy, "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")
+      ->check(CLI::IsMember({"adc", "mcmc"}))
+      ->capture_default_str();
+  cmd->add_option("--mcmc-growth", o->train.mcmc_growth, "MCMC: growth per refinement (fraction)")->capture_default_str();
+  cmd->add_option("--mcmc-noise-lr", o->train.mcmc_noise_lr, "MCMC: position noise x means learning rate")
+      ->capture_default_str();
   cmd->add_flag("--deterministic", o->train.deterministic, "Bit-identical gradients (slower)");
   cmd->add_option("--sh-degree", o->train.sh_degree, "Final SH degree")->capture_default_str();
   cmd->add_option("--seed", o->train.seed, "Seed of view order and densification")->capture_default_str();

@@ -128,17 +128,18 @@ using FloatTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adapt
 
 struct PlaneDistance::Index {
   std::vector<Eigen::Vector3f> points, normals;
+  std::vector<bool> planar;
   FloatAdaptor adaptor{&points};
   std::unique_ptr<FloatTree> tree;
   float max_d2 = 0;
 };
 
 PlaneDistance::PlaneDistance(const PlanarMap& map, double max_radius_m) : index_(std::make_unique<Index>()) {
-  for (size_t i = 0; i < map.points.size(); ++i)
-    if (map.planar[i]) {
-      index_->points.push_back(map.points[i]);
-      index_->normals.push_back(map.normals[i]);
-    }
+  for (size_t i = 0; i < map.points.size(); ++i) {
+    index_->points.push_back(map.points[i]);
+    index_->normals.push_back(map.normals[i]);
+    index_->planar.push_back(map.planar[i]);
+  }
   index_->max_d2 = static_cast<float>(max_radius_m * max_radius_m);
   index_->tree = std::make_unique<FloatTree>(3, index_->adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
   if (!index_->points.empty()) index_->tree->buildIndex();
@@ -155,7 +156,7 @@ std::vector<float> PlaneDistance::distances(const std::vector<float>& means) con
     if (!x.allFinite()) continue;
     uint32_t idx = 0;
     float d2 = 0;
-    if (index_->tree->knnSearch(x.data(), 1, &idx, &d2) == 1 && d2 <= index_->max_d2)
+    if (index_->tree->knnSearch(x.data(), 1, &idx, &d2) == 1 && d2 <= index_->max_d2 && index_->planar[idx])
       out[i] = std::abs(index_->normals[idx].dot(x - index_->points[idx]));
   }
   return out;

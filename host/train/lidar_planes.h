@@ -43,8 +43,10 @@ ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& c
 
 namespace litgs::host {
 
-// Distances of points to the LiDAR planes: for each query, |n . (x - p)| with p the nearest planar map point
-// (within max_radius_m; NaN when there is none), for the densifier's geometric outlier prune.
+// Distances of points to the LiDAR planes, for the densifier's geometric outlier prune: for each query, the
+// nearest map point p (within max_radius_m) is its association; where p lies on a plane the distance is
+// |n . (x - p)|, where p is not planar (foliage, edges, clutter) or there is no point in reach it is NaN (no
+// plane claims the query, so it is never pruned by distance).
 class PlaneDistance {
  public:
   explicit PlaneDistance(const PlanarMap& map, double max_radius_m = 0.5);

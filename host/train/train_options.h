@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <string>
 
+#include "kernels/mcmc/mcmc.h"
+
 namespace litgs::host {
 
 struct TrainOptions {
@@ -19,7 +21,15 @@ struct TrainOptions {
   uint32_t densify_every = 100;
   uint32_t opacity_reset_every = 3000;
   float densify_grad_threshold = 0.0002f;  // of the averaged screen-space mean gradient, 3DGS units
-  uint32_t max_gaussians = 2000000;        // cap of the model size
+  uint32_t max_gaussians = 2000000;        // cap of the model size (the budget of the MCMC strategy)
+  // Densification strategy: "adc" (3DGS adaptive density control: clone, split, prune, opacity resets) or
+  // "mcmc" (3DGS-MCMC: a fixed budget, relocation of dead Gaussians, position noise, regularizers; the same
+  // window and cadence).
+  std::string strategy = "adc";
+  float mcmc_growth = 0.05f;    // MCMC: rows added per refinement, as a fraction of the model
+  float mcmc_noise_lr = 5e5f;   // MCMC: position noise, times the means' learning rate
+  float mcmc_opacity_reg = 0.01f;
+  float mcmc_scale_reg = 0.01f;
   float lr_scale = 1.0f;                   // multiplies every learning rate (stability tests, tuning)
   // Evaluation, checkpoints, reproducibility.
   uint32_t eval_every = 0;         // 0: only at the end
@@ -29,6 +39,7 @@ struct TrainOptions {
   uint32_t seed = 0;               // view order and densification noise
   uint32_t progress_every = 50;    // log cadence when stdout is not a terminal
   void check() const;              // throws std::invalid_argument naming the bad field
+  kernels::McmcOptions mcmc_options() const;
 };
 
 }  // namespace litgs::host

@@ -19,6 +19,7 @@
 #include "kernels/loss/geometric_loss.h"
 #include "kernels/loss/loss_reference.h"
 #include "kernels/loss/photometric_loss.h"
+#include "kernels/mcmc/mcmc.h"
 #include "kernels/optim/trainable_gaussians.h"
 #include "kernels/splat/rasterizer.h"
 
@@ -107,6 +108,19 @@ void TrainOptions::check() const {
   if (!(densify_grad_threshold > 0)) bad("densify_grad_threshold must be positive");
   if (max_gaussians == 0) bad("max_gaussians must be positive");
   if (!(lr_scale > 0) || !std::isfinite(lr_scale)) bad("lr_scale must be positive");
+  if (strategy != "adc" && strategy != "mcmc") bad("strategy must be adc or mcmc, not '" + strategy + "'");
+  if (strategy == "mcmc") mcmc_options().check();
+}
+
+kernels::McmcOptions TrainOptions::mcmc_options() const {
+  kernels::McmcOptions m;
+  m.max_gaussians = max_gaussians;
+  m.growth = mcmc_growth;
+  m.noise_lr = mcmc_noise_lr;
+  m.opacity_reg = mcmc_opacity_reg;
+  m.scale_reg = mcmc_scale_reg;
+  m.seed = seed;
+  return m;
 }
 
 TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels::GaussianModel& initial,
@@ -167,6 +181,10 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   dopt.max_gaussians = o.max_gaussians;
   dopt.opacity_reset_interval = o.opacity_reset_every;
   dopt.seed = o.seed;
+  const bool mcmc = o.strategy == "mcmc";
+  const kernels::McmcOptions mopt = o.mcmc_options();
+  std::unique_ptr<kernels::McmcStrategy> mcmc_strategy;
+  if (mcmc) mcmc_strategy = std::make_unique<kernels::McmcStrategy>(ctx);
   const uint32_t densify_until = std::min(o.densify_until, o.iterations);
   const float extent = static_cast<float>(data.scene_extent_m);
   std::unique_ptr<PlaneDistance> plane_index;
@@ -235,10 +253,12 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
       s.fill(*up.depth, 0u, uint64_t{W} * H * sizeof(float));
     s.fill(*up.alpha, 0u, uint64_t{W} * H * sizeof(float));
     const auto grads = rasterizer.record_backward(s);
-    if (step <= densify_until) model->record_accumulate_stats(s, grads, *out.rects, cam);
+    if (mcmc) mcmc_strategy->record_regularization(s, *model, grads, mopt);
+    else if (step <= densify_until) model->record_accumulate_stats(s, grads, *out.rects, cam);
     kernels::LearningRates lr = adam.rates(it, o.iterations, extent);
     for (float* r : {&lr.means, &lr.log_scales, &lr.quats, &lr.opacity_logits, &lr.sh_dc, &lr.sh_rest}) *r *= o.lr_scale;
     model->record_adam_step(s, grads, lr, step);
+    if (mcmc) mcmc_strategy->record_noise(s, *model, mopt, lr.means, step);
     s.submit_and_wait();
     for (const auto& k : s.profile()) kernel_ms[k.name] += k.ms;
 
@@ -258,11 +278,19 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
         plane_distance = &plane_distances->buffer();
         step_options.max_plane_distance_m = PlaneDistance::robust_bound(d);
       }
-      const kernels::DensifyReport d = model->densify_and_prune(step_options, extent, step, plane_distance);
-      report.plane_pruned += d.pruned_plane;
-      report.nonfinite_pruned += d.pruned_nonfinite;
+      if (mcmc) {
+        kernels::McmcOptions step_mcmc = mopt;
+        step_mcmc.max_plane_distance_m = step_options.max_plane_distance_m;
+        const kernels::McmcReport m = mcmc_strategy->relocate_and_grow(*model, step_mcmc, step, plane_distance);
+        report.plane_pruned += m.dead_plane;
+        report.nonfinite_pruned += m.dead_nonfinite;
+      } else {
+        const kernels::DensifyReport d = model->densify_and_prune(step_options, extent, step, plane_distance);
+        report.plane_pruned += d.pruned_plane;
+        report.nonfinite_pruned += d.pruned_nonfinite;
+      }
     }
-    if (step <= densify_until && step % o.opacity_reset_every == 0) {
+    if (!mcmc && step <= densify_until && step % o.opacity_reset_every == 0) {
       engine::Sequence r(ctx);
       model->record_reset_opacity(r);
       r.submit_and_wait();

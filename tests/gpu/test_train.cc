@@ -200,3 +200,46 @@ TEST_F(TrainTest, DensificationHitsTheCap) {
 
 }  // namespace
 }  // namespace litgs
+
+namespace litgs {
+namespace {
+
+// The MCMC strategy end to end: the model grows to its budget and never beyond, the loss falls, nothing
+// becomes non-finite, and a resume continues exactly (relocation and noise depend only on seed, step, row).
+class TrainMcmcTest : public TrainTest {};
+
+TEST_F(TrainMcmcTest, StaysWithinTheBudgetAndLearns) {
+  std::vector<double> losses;
+  auto o = small_run(60);
+  o.strategy = "mcmc";
+  o.max_gaussians = static_cast<uint32_t>(initial_->size() + 400);
+  o.mcmc_growth = 0.1f;
+  const auto m = run(o, "mcmc", nullptr, nullptr, planes_, &losses);
+  expect_finite(m);
+  EXPECT_EQ(m.size(), initial_->size() + 400) << "5 refinements of +10% reach the budget and stop there";
+  double first = 0, last = 0;
+  for (int i = 0; i < 10; ++i) first += losses[i], last += losses[losses.size() - 1 - i];
+  EXPECT_LT(last, first) << ::testing::PrintToString(losses);
+}
+
+TEST_F(TrainMcmcTest, ResumeContinuesExactly) {
+  auto o = small_run(40);
+  o.strategy = "mcmc";
+  o.deterministic = true;
+  o.checkpoint_every = 20;
+  o.max_gaussians = static_cast<uint32_t>(initial_->size() + 300);
+  const auto straight = run(o, "mcmc_straight");
+  fs::create_directories(root_ / "mcmc_resumed" / "checkpoints");
+  fs::copy_file(root_ / "mcmc_straight" / "checkpoints" / "iter_20.ckpt",
+                root_ / "mcmc_resumed" / "checkpoints" / "iter_20.ckpt");
+  auto rest = o;
+  rest.resume = true;
+  const auto resumed = run(rest, "mcmc_resumed");
+  ASSERT_EQ(resumed.size(), straight.size());
+  EXPECT_TRUE(same_bits(resumed.means, straight.means));
+  EXPECT_TRUE(same_bits(resumed.log_scales, straight.log_scales));
+  EXPECT_TRUE(same_bits(resumed.opacity_logits, straight.opacity_logits));
+}
+
+}  // namespace
+}  // namespace litgs

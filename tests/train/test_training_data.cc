@@ -156,5 +156,21 @@ TEST(PlaneDistanceTest, DistancesAndRobustBound) {
   EXPECT_LT(bound, 0.5f);
 }
 
+TEST(PlaneDistanceTest, AQueryNearestToNonPlanarPointsHasNoPlane) {
+  // A wall (z = 2) and, 30 cm in front of it, a random clump (a bush): the clump's points are not planar.
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = -20; i <= 20; ++i)
+    for (int j = -20; j <= 20; ++j) pts.emplace_back(0.05 * i, 0.05 * j, 2.0);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-0.1, 0.1);
+  for (int k = 0; k < 300; ++k) pts.emplace_back(0.5 + u(rng), 0.5 + u(rng), 1.7 + u(rng));
+  const PlanarMap map = fit_planes(pts, PlaneFitOptions{});
+  const PlaneDistance index(map);
+  // Inside the clump (nearest point: the clump) and beside it on the wall.
+  const auto d = index.distances({0.5f, 0.5f, 1.7f, -0.5f, -0.5f, 2.01f});
+  EXPECT_TRUE(std::isnan(d[0])) << "a Gaussian on the bush is measured against the wall: " << d[0];
+  EXPECT_NEAR(d[1], 0.01f, 1e-4f);
+}
+
 }  // namespace
 }  // namespace litgs::host
