@@ -14,23 +14,25 @@ uint32_t subgroup_width(const engine::Context& context) {
   return s;
 }
 
-std::unique_ptr<engine::Kernel> make_kernel(engine::Context& context, const std::string& name,
-                                            uint32_t binding_count, uint32_t push_constant_bytes) {
+namespace {
+engine::KernelDesc kernel_desc(const std::string& name, uint32_t binding_count, uint32_t push_constant_bytes) {
   engine::KernelDesc desc;
   desc.name = name;
   desc.spirv = spirv(name);
   desc.binding_count = binding_count;
   desc.push_constant_bytes = push_constant_bytes;
-  return std::make_unique<engine::Kernel>(context, std::move(desc));
+  return desc;
+}
+}  // namespace
+
+std::unique_ptr<engine::Kernel> make_kernel(engine::Context& context, const std::string& name,
+                                            uint32_t binding_count, uint32_t push_constant_bytes) {
+  return std::make_unique<engine::Kernel>(context, kernel_desc(name, binding_count, push_constant_bytes));
 }
 
 std::unique_ptr<engine::Kernel> make_subgroup_kernel(engine::Context& context, const std::string& name,
                                                      uint32_t binding_count, uint32_t push_constant_bytes) {
-  engine::KernelDesc desc;
-  desc.name = name;
-  desc.spirv = spirv(name);
-  desc.binding_count = binding_count;
-  desc.push_constant_bytes = push_constant_bytes;
+  engine::KernelDesc desc = kernel_desc(name, binding_count, push_constant_bytes);
   const uint32_t width = subgroup_width(context);
   desc.spec_constants = {{0, width}};
   desc.required_subgroup_size = width;

@@ -152,6 +152,9 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--densify-from", o->train.densify_from, "First densification iteration")->capture_default_str();
   cmd->add_option("--densify-until", o->train.densify_until, "Last densification iteration")->capture_default_str();
   cmd->add_option("--densify-every", o->train.densify_every, "Densification cadence")->capture_default_str();
+  cmd->add_option("--densify-grad-threshold", o->train.densify_grad_threshold,
+                  "Screen-space gradient threshold, for the photometric loss at unit weight (3DGS units)")
+      ->capture_default_str();
   cmd->add_option("--opacity-reset-every", o->train.opacity_reset_every, "Opacity reset cadence")->capture_default_str();
   cmd->add_option("--progress-every", o->train.progress_every, "Progress cadence")->capture_default_str();
   cmd->callback([o] { run_train(*o); });

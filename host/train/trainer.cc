@@ -117,8 +117,8 @@ kernels::McmcOptions TrainOptions::mcmc_options() const {
   m.max_gaussians = max_gaussians;
   m.growth = mcmc_growth;
   m.noise_lr = mcmc_noise_lr;
-  m.opacity_reg = mcmc_opacity_reg;
-  m.scale_reg = mcmc_scale_reg;
+  m.opacity_reg = static_cast<float>(mcmc_opacity_reg * photometric_weight());
+  m.scale_reg = static_cast<float>(mcmc_scale_reg * photometric_weight());
   m.seed = seed;
   return m;
 }
@@ -177,7 +177,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   }
   const kernels::AdamOptions adam = model->adam_options();
   kernels::DensifyOptions dopt;
-  dopt.grad_threshold = o.densify_grad_threshold;
+  dopt.grad_threshold = static_cast<float>(o.densify_grad_threshold * o.photometric_weight());
   dopt.max_gaussians = o.max_gaussians;
   dopt.opacity_reset_interval = o.opacity_reset_every;
   dopt.seed = o.seed;

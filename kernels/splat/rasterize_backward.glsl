@@ -39,6 +39,7 @@ layout(std430, binding = BWD_BINDING_GRAD2D) buffer Grad2d { float grad2d[]; };
 #endif
 
 #include "splat/footprint.glsl"
+#include "splat/channels.glsl"
 
 // The gradient values of one entry for one pixel, as three vectors (no arrays: CPU drivers spill them):
 // g0 = dL/d(mean2d.x, mean2d.y, conic.a, conic.b), g1 = dL/d(conic.c, opacity, depth, -), g2 = dL/d(colour).
@@ -60,7 +61,7 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
   const float one_minus = 1.0 - alpha;
   const float Ti = T / one_minus;
   const float w = hit ? alpha * Ti : 0.0;
-  float dL_dalpha = dot(dL_dC, color * Ti - acc_c / one_minus) + dL_dN * (depth * Ti - acc_z / one_minus) +
+  float dL_dalpha = channels_dot(dL_dC, channels_fma(channels_scale(-1.0 / one_minus, acc_c), Ti, color)) + dL_dN * (depth * Ti - acc_z / one_minus) +
                     dL_dA * T_final / one_minus;
   dL_dalpha = hit && raw <= float(SPLAT_ALPHA_MAX) ? dL_dalpha : 0.0;  // the 0.99 clamp has no gradient
   const float dL_dsigma = -dL_dalpha * alpha;
@@ -69,8 +70,8 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
               -dL_dsigma * (conic_opacity.y * d.x + conic_opacity.z * d.y), dL_dsigma * 0.5 * d.x * d.x,
               dL_dsigma * d.x * d.y);
   r.g1 = vec4(dL_dsigma * 0.5 * d.y * d.y, dL_dalpha * vis, w * dL_dN, 0.0);
-  r.g2 = w * dL_dC;
-  acc_c += w * color;
+  r.g2 = channels_scale(w, dL_dC);
+  acc_c = channels_fma(acc_c, w, color);
   acc_z += w * depth;
   T = hit ? Ti : T;
   return r;
@@ -90,7 +91,18 @@ void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity
 
 // Sums of three vectors over the subgroup, as a butterfly of XOR shuffles: on CPU drivers a shuffle with a
 // uniform mask is a register permute, several times cheaper than subgroupAdd.
+// With one channel the colour gradient rides in b.w (unused otherwise): two vectors instead of three.
 void subgroup_sum3(inout vec4 a, inout vec4 b, inout vec4 c) {
+  if (CHANNELS == 1u) {
+    b.w = c.x;
+    for (uint mask = 1u; mask < gl_SubgroupSize; mask <<= 1u) {
+      a += subgroupShuffleXor(a, mask);
+      b += subgroupShuffleXor(b, mask);
+    }
+    c = vec4(b.w, 0.0, 0.0, 0.0);
+    b.w = 0.0;
+    return;
+  }
   for (uint mask = 1u; mask < gl_SubgroupSize; mask <<= 1u) {
     a += subgroupShuffleXor(a, mask);
     b += subgroupShuffleXor(b, mask);
@@ -212,7 +224,7 @@ void main() {
         todo[word] &= ~(1u << bit);
         const uint k = 32u * uint(word) + bit;
         const EntryGrad r = entry_backward(centre, subgroupShuffle(mean_extent, k), subgroupShuffle(conic_opacity, k),
-                                           subgroupShuffle(color, k), subgroupShuffle(depth, k),
+                                           channels_shuffle(color, k), subgroupShuffle(depth, k),
                                            chunk_start + k < my_last, T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
         vec4 s0 = r.g0, s1 = r.g1, s2 = r.g2;
         subgroup_sum3(s0, s1, s2);

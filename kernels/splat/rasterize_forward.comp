@@ -10,6 +10,7 @@
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
 #include "splat/footprint.glsl"
+#include "splat/channels.glsl"
 
 layout(local_size_x = SPLAT_TILE_SIZE, local_size_y = SPLAT_TILE_SIZE) in;
 
@@ -79,7 +80,7 @@ void main() {
         const bool stop = hit && next_T < float(SPLAT_T_MIN);
         done = done || stop;
         const float w = hit && !stop ? alpha * T : 0.0;
-        accum += w * subgroupShuffle(color, k);
+        accum = channels_fma(accum, w, channels_shuffle(color, k));
         depth_sum += w * subgroupShuffle(depth, k);
         T = hit && !stop ? next_T : T;
         last = hit && !stop ? chunk + k - range.x + 1u : last;

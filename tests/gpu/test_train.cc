@@ -25,6 +25,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
+bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
 class TrainTest : public testing::GpuTest {
  protected:
   static void SetUpTestSuite() {
@@ -87,15 +91,28 @@ class TrainTest : public testing::GpuTest {
     return io::read_gaussian_ply(out / "point_cloud.ply");
   }
 
+  // Trains `o` (deterministic, a checkpoint at 20) straight through, and again resumed from the straight run's
+  // checkpoint at 20 as if it had been killed there: every parameter must come out with the same bits.
+  void expect_resume_continues_exactly(const host::TrainOptions& o, const std::string& name) {
+    const auto straight = run(o, name + "_straight");
+    fs::create_directories(root_ / (name + "_resumed") / "checkpoints");
+    fs::copy_file(root_ / (name + "_straight") / "checkpoints" / "iter_20.ckpt",
+                  root_ / (name + "_resumed") / "checkpoints" / "iter_20.ckpt");
+    auto rest = o;
+    rest.resume = true;
+    const auto resumed = run(rest, name + "_resumed");
+    ASSERT_EQ(resumed.size(), straight.size());
+    for (const auto member : {&kernels::GaussianModel::means, &kernels::GaussianModel::log_scales,
+                              &kernels::GaussianModel::quats, &kernels::GaussianModel::opacity_logits,
+                              &kernels::GaussianModel::sh})
+      EXPECT_TRUE(same_bits(resumed.*member, straight.*member));
+  }
+
   static inline fs::path root_;
   static inline host::TrainingData* data_ = nullptr;
   static inline host::PlanarMap* planes_ = nullptr;
   static inline kernels::GaussianModel* initial_ = nullptr;
 };
-
-bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
 
 TEST_F(TrainTest, TrainsAndWritesOutputs) {
   std::vector<double> losses;
@@ -126,18 +143,7 @@ TEST_F(TrainTest, ResumeContinuesExactly) {
   auto o = small_run(40);
   o.deterministic = true;
   o.checkpoint_every = 20;
-  const auto straight = run(o, "straight");
-  // As if the run had been killed after iteration 20: only its first checkpoint remains. Resume with the
-  // same options.
-  fs::create_directories(root_ / "resumed" / "checkpoints");
-  fs::copy_file(root_ / "straight" / "checkpoints" / "iter_20.ckpt", root_ / "resumed" / "checkpoints" / "iter_20.ckpt");
-  auto rest = o;
-  rest.resume = true;
-  const auto resumed = run(rest, "resumed");
-  ASSERT_EQ(resumed.size(), straight.size());
-  EXPECT_TRUE(same_bits(resumed.means, straight.means));
-  EXPECT_TRUE(same_bits(resumed.sh, straight.sh));
-  EXPECT_TRUE(same_bits(resumed.opacity_logits, straight.opacity_logits));
+  expect_resume_continues_exactly(o, "adc");
 }
 
 TEST_F(TrainTest, LambdaZeroIsPhotometricOnly) {
@@ -228,17 +234,7 @@ TEST_F(TrainMcmcTest, ResumeContinuesExactly) {
   o.deterministic = true;
   o.checkpoint_every = 20;
   o.max_gaussians = static_cast<uint32_t>(initial_->size() + 300);
-  const auto straight = run(o, "mcmc_straight");
-  fs::create_directories(root_ / "mcmc_resumed" / "checkpoints");
-  fs::copy_file(root_ / "mcmc_straight" / "checkpoints" / "iter_20.ckpt",
-                root_ / "mcmc_resumed" / "checkpoints" / "iter_20.ckpt");
-  auto rest = o;
-  rest.resume = true;
-  const auto resumed = run(rest, "mcmc_resumed");
-  ASSERT_EQ(resumed.size(), straight.size());
-  EXPECT_TRUE(same_bits(resumed.means, straight.means));
-  EXPECT_TRUE(same_bits(resumed.log_scales, straight.log_scales));
-  EXPECT_TRUE(same_bits(resumed.opacity_logits, straight.opacity_logits));
+  expect_resume_continues_exactly(o, "mcmc");
 }
 
 }  // namespace
