@@ -26,6 +26,7 @@ struct TrainCliOptions {
   uint32_t random_count = 20000;   // Gaussians of --init random
   uint32_t max_init_points = 200000;  // LiDAR-map initialization keeps at most this many points
   std::string intensity = "auto";  // auto | percentile | linear
+  std::string poses = "estimated";  // estimated (poses.txt) | truth (gt/poses.txt)
   host::TrainingDataOptions data;
   host::TrainOptions train;
 };
@@ -44,6 +45,9 @@ void run_train(TrainCliOptions o) {
     o.data.mapping = host::IntensityMapping::kLinear;
   else if (o.intensity != "auto")
     throw std::invalid_argument("--intensity must be auto, percentile or linear, not '" + o.intensity + "'");
+  if (o.poses != "estimated" && o.poses != "truth")
+    throw std::invalid_argument("--poses must be estimated or truth, not '" + o.poses + "'");
+  o.data.true_poses = o.poses == "truth";
   o.train.check();
   const host::TrainingData data = host::load_training_data(o.scene, o.data);
 
@@ -149,6 +153,8 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--seed", o->train.seed, "Seed of view order and densification")->capture_default_str();
   cmd->add_option("--holdout-every", o->data.holdout_every, "Hold out every Nth frame (0: none)")->capture_default_str();
   cmd->add_option("--intensity", o->intensity, "auto | percentile | linear")->capture_default_str();
+  cmd->add_option("--poses", o->poses, "estimated (poses.txt) or truth (gt/poses.txt of synthetic scenes)")
+      ->capture_default_str();
   cmd->add_option("--densify-from", o->train.densify_from, "First densification iteration")->capture_default_str();
   cmd->add_option("--densify-until", o->train.densify_until, "Last densification iteration")->capture_default_str();
   cmd->add_option("--densify-every", o->train.densify_every, "Densification cadence")->capture_default_str();

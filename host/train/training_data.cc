@@ -10,10 +10,9 @@
 namespace litgs::host {
 namespace {
 
-// T_world_cam of every frame: the pose at the frame's time (matched, else interpolated), moved from the
-// IMU to the camera if poses.txt describes the IMU.
-Eigen::Isometry3d pose_at(const io::Scene& scene, double t, double tolerance) {
-  const auto& poses = scene.poses;
+// T_world_cam of every frame: the pose at the frame's time in `poses` (matched, else interpolated), moved from
+// the IMU to the camera if the scene's poses describe the IMU.
+Eigen::Isometry3d pose_at(const io::Scene& scene, const std::vector<io::TumPose>& poses, double t, double tolerance) {
   if (poses.empty()) throw std::invalid_argument("poses.txt has no poses");
   auto it = std::lower_bound(poses.begin(), poses.end(), t, [](const io::TumPose& p, double x) { return p.t_s < x; });
   auto rotation_of = [&](const io::TumPose& p) {
@@ -90,6 +89,9 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
   const io::Scene scene = io::read_scene(dir, read);
   const io::CameraIntrinsics& k = scene.config.camera;
   if (scene.frames.empty()) throw std::invalid_argument(dir.string() + ": the scene has no thermal frames");
+  if (o.true_poses && (!scene.gt || scene.gt->poses.empty()))
+    throw std::invalid_argument(dir.string() + ": training on true poses needs gt/poses.txt, which the scene lacks");
+  const std::vector<io::TumPose>& poses = o.true_poses ? scene.gt->poses : scene.poses;
 
   // Raw frames, and the intensity mapping shared by all of them.
   std::vector<std::vector<float>> raw(scene.frames.size());
@@ -156,7 +158,7 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
     view.name = scene.frames[i].image.filename().string();
     view.t_s = scene.frames[i].t_s;
     view.heldout = o.holdout_every > 0 && i % o.holdout_every == 0;
-    const Eigen::Isometry3d T_world_cam = pose_at(scene, view.t_s, o.pose_match_tolerance_s);
+    const Eigen::Isometry3d T_world_cam = pose_at(scene, poses, view.t_s, o.pose_match_tolerance_s);
     const Eigen::Matrix3d R = T_world_cam.linear().transpose();
     const Eigen::Vector3d t = -R * T_world_cam.translation();
     for (int c = 0; c < 3; ++c) {

@@ -29,6 +29,9 @@ struct TrainingDataOptions {
   // Poses are matched to frames by timestamp; farther than this they are interpolated, and outside the
   // trajectory an error.
   double pose_match_tolerance_s = 1e-3;
+  // Train on the scene's ground-truth poses (gt/poses.txt) instead of poses.txt: synthetic experiments that
+  // separate a loss's effect from the estimator's pose drift. An error if the scene has none.
+  bool true_poses = false;
   void check() const;  // throws std::invalid_argument naming the bad field
 };
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -113,6 +114,28 @@ class TrainTest : public testing::GpuTest {
   static inline host::PlanarMap* planes_ = nullptr;
   static inline kernels::GaussianModel* initial_ = nullptr;
 };
+
+TEST_F(TrainTest, TruePosesPlaceTheCamerasAtTheGroundTruth) {
+  host::TrainingDataOptions d;
+  d.holdout_every = 4;
+  d.true_poses = true;
+  const host::TrainingData truth = host::load_training_data(root_ / "scene", d);
+  const io::Scene scene = io::read_scene(root_ / "scene");
+  ASSERT_EQ(truth.views.size(), data_->views.size());
+  double moved = 0;
+  for (size_t i = 0; i < truth.views.size(); ++i) {
+    const auto& c = truth.views[i].camera;
+    const glm::dvec3 centre = -glm::transpose(c.R_cam_world) * c.t_cam_world;  // camera centre in the world
+    // The synthetic camera's true pose at the frame's time (frozen frames are skipped, so match by time).
+    const auto gt = std::find_if(scene.gt->poses.begin(), scene.gt->poses.end(),
+                                 [&](const io::TumPose& p) { return std::abs(p.t_s - truth.views[i].t_s) < 1e-6; });
+    ASSERT_NE(gt, scene.gt->poses.end());
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(centre[k], gt->p_world[k], 1e-4);
+    const auto& e = data_->views[i].camera;
+    moved = std::max(moved, glm::length(glm::dvec3(c.t_cam_world) - glm::dvec3(e.t_cam_world)));
+  }
+  EXPECT_GT(moved, 1e-3) << "the estimated poses drift from the truth, so the two loads differ";
+}
 
 TEST_F(TrainTest, TrainsAndWritesOutputs) {
   std::vector<double> losses;

@@ -73,6 +73,18 @@ TEST_F(DunrScene, ViewsHeldOutAndCameras) {
   EXPECT_LT(data_->scene_extent_m, 100.0);
 }
 
+TEST_F(DunrScene, TruePosesOnASceneWithoutGroundTruthIsAnError) {
+  TrainingDataOptions t;
+  t.downscale = 2.0;
+  t.true_poses = true;
+  try {
+    load_training_data(dir_, t);
+    FAIL() << "expected an error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("gt/poses.txt"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(DunrScene, ColmapPointsLandInFrontOfTheCamerasAfterRecentring) {
   const auto pts = load_points(kDunr / "colmap-triangulated-points.ply", data_->world_offset_m);
   ASSERT_EQ(pts.size(), 3988u);
