@@ -76,6 +76,7 @@ void run_train(TrainCliOptions o) {
         const double pid = id->values[i];
         if (pid < 0 || pid >= static_cast<double>(scene.gt->planes.size())) continue;
         gt_planes->points.push_back(m.positions[i].cast<float>());
+        gt_planes->centres.push_back(m.positions[i].cast<float>());  // a true point lies on its plane
         gt_planes->normals.push_back(scene.gt->planes[static_cast<size_t>(pid)].n.cast<float>());
         gt_planes->planar.push_back(1);
       }

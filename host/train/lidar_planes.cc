@@ -42,6 +42,7 @@ PlanarMap fit_planes(const std::vector<Eigen::Vector3d>& points, const PlaneFitO
   map.points.reserve(points.size());
   for (const auto& p : points) map.points.push_back(p.cast<float>());
   map.normals.assign(points.size(), Eigen::Vector3f::Zero());
+  map.centres.assign(points.size(), Eigen::Vector3f::Zero());
   map.planar.assign(points.size(), 0);
   if (points.size() < o.neighbours) return map;
   Adaptor adaptor{points};
@@ -65,6 +66,7 @@ PlanarMap fit_planes(const std::vector<Eigen::Vector3d>& points, const PlaneFitO
     const Eigen::Vector3d ev = eig.eigenvalues();  // ascending
     if (!(ev[1] > 0) || ev[0] / ev[1] > o.max_flatness) continue;
     map.normals[i] = eig.eigenvectors().col(0).cast<float>().normalized();
+    map.centres[i] = mean.cast<float>();
     map.planar[i] = 1;
   }
   return map;
@@ -94,9 +96,9 @@ ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& c
   for (size_t pix = 0; pix < W * H; ++pix) {
     if (owner[pix] < 0 || !map.planar[static_cast<size_t>(owner[pix])]) continue;
     const size_t i = static_cast<size_t>(owner[pix]);
-    const Eigen::Vector3f& p = map.points[i];
-    const glm::dvec3 q = c.R_cam_world * glm::dvec3(p.x(), p.y(), p.z()) + c.t_cam_world;
     const Eigen::Vector3f& n = map.normals[i];
+    const Eigen::Vector3f p = map.points[i] - n * n.dot(map.points[i] - map.centres[i]);  // onto its plane
+    const glm::dvec3 q = c.R_cam_world * glm::dvec3(p.x(), p.y(), p.z()) + c.t_cam_world;
     const glm::dvec3 nc = c.R_cam_world * glm::dvec3(n.x(), n.y(), n.z());
     for (int a = 0; a < 3; ++a) {
       out.points[4 * pix + a] = static_cast<float>(q[a]);
@@ -127,7 +129,7 @@ using FloatTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adapt
 }  // namespace
 
 struct PlaneDistance::Index {
-  std::vector<Eigen::Vector3f> points, normals;
+  std::vector<Eigen::Vector3f> points, normals, centres;
   std::vector<bool> planar;
   FloatAdaptor adaptor{&points};
   std::unique_ptr<FloatTree> tree;
@@ -138,6 +140,7 @@ PlaneDistance::PlaneDistance(const PlanarMap& map, double max_radius_m) : index_
   for (size_t i = 0; i < map.points.size(); ++i) {
     index_->points.push_back(map.points[i]);
     index_->normals.push_back(map.normals[i]);
+    index_->centres.push_back(map.centres[i]);
     index_->planar.push_back(map.planar[i]);
   }
   index_->max_d2 = static_cast<float>(max_radius_m * max_radius_m);
@@ -157,7 +160,7 @@ std::vector<float> PlaneDistance::distances(const std::vector<float>& means) con
     uint32_t idx = 0;
     float d2 = 0;
     if (index_->tree->knnSearch(x.data(), 1, &idx, &d2) == 1 && d2 <= index_->max_d2 && index_->planar[idx])
-      out[i] = std::abs(index_->normals[idx].dot(x - index_->points[idx]));
+      out[i] = std::abs(index_->normals[idx].dot(x - index_->centres[idx]));
   }
   return out;
 }

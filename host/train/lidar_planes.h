@@ -18,10 +18,13 @@ struct PlaneFitOptions {
   void check() const;            // throws std::invalid_argument naming the bad field
 };
 
-// A LiDAR map with a unit normal per point where its neighbourhood is planar.
+// A LiDAR map with a local plane (a point on it and a unit normal) per point where its neighbourhood is
+// planar. The plane point is the neighbourhood's centroid: the range noise along the normal averages down
+// over the fit, where the raw point keeps all of it.
 struct PlanarMap {
   std::vector<Eigen::Vector3f> points;   // world, metres (the scene's recentred frame)
-  std::vector<Eigen::Vector3f> normals;  // unit, sign towards... arbitrary (the loss squares the residual)
+  std::vector<Eigen::Vector3f> normals;  // unit, sign arbitrary (the loss squares the residual)
+  std::vector<Eigen::Vector3f> centres;  // the local plane's point (centroid of the fit); zero where not planar
   std::vector<uint8_t> planar;           // 1 where the fit is valid
   size_t planar_count() const;
 };
@@ -36,7 +39,8 @@ struct ViewPlaneMaps {
   uint32_t valid_count = 0;
 };
 
-// Nearest planar map point per pixel by a z-buffer (pixel centres at +0.5, the rasterizer's convention).
+// Nearest map point per pixel by a z-buffer (pixel centres at +0.5, the rasterizer's convention); where it is
+// planar, the pixel carries that point moved onto its local plane, and the plane's normal.
 ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& camera);
 
 }  // namespace litgs::host
@@ -45,7 +49,7 @@ namespace litgs::host {
 
 // Distances of points to the LiDAR planes, for the densifier's geometric outlier prune: for each query, the
 // nearest map point p (within max_radius_m) is its association; where p lies on a plane the distance is
-// |n . (x - p)|, where p is not planar (foliage, edges, clutter) or there is no point in reach it is NaN (no
+// |n . (x - c)| to p's local plane (centroid c, normal n), where p is not planar (foliage, edges, clutter) or there is no point in reach it is NaN (no
 // plane claims the query, so it is never pruned by distance).
 class PlaneDistance {
  public:
