@@ -111,9 +111,12 @@ void run_train(TrainCliOptions o) {
             << ", lambda_geo " << o.train.lambda_geo << ", on " << context.info().name << "\n";
   auto progress = [&](const host::TrainProgress& p) {
     const double eta = (p.total - p.iteration) / std::max(p.iterations_per_s, 1e-9);
-    char line[256];
-    std::snprintf(line, sizeof line, "[%6u/%u] loss %.4f  psnr %s  gaussians %zu  %.2f it/s  eta %s", p.iteration,
-                  p.total, p.loss, std::isfinite(p.psnr_db) ? std::to_string(p.psnr_db).substr(0, 5).c_str() : "-",
+    char terms[64] = "";
+    if (std::isfinite(p.geometric_rms_m))
+      std::snprintf(terms, sizeof terms, " (pho %.4f, plane rms %.1f cm)", p.photometric_loss, 100 * p.geometric_rms_m);
+    char line[320];
+    std::snprintf(line, sizeof line, "[%6u/%u] loss %.4f%s  psnr %s  gaussians %zu  %.2f it/s  eta %s", p.iteration,
+                  p.total, p.loss, terms, std::isfinite(p.psnr_db) ? std::to_string(p.psnr_db).substr(0, 5).c_str() : "-",
                   p.gaussians, p.iterations_per_s, format_eta(eta).c_str());
     std::cout << (tty ? "\r" : "") << line << (tty ? "" : "\n") << std::flush;
   };
@@ -154,6 +157,9 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--seed", o->train.seed, "Seed of view order and densification")->capture_default_str();
   cmd->add_option("--holdout-every", o->data.holdout_every, "Hold out every Nth frame (0: none)")->capture_default_str();
   cmd->add_option("--intensity", o->intensity, "auto | percentile | linear")->capture_default_str();
+  cmd->add_option("--plane-prune-k", o->train.plane_prune_k,
+                  "Prune Gaussians beyond median + k MAD of their LiDAR-plane distances (0: off)")
+      ->capture_default_str();
   cmd->add_option("--poses", o->poses, "estimated (poses.txt) or truth (gt/poses.txt of synthetic scenes)")
       ->capture_default_str();
   cmd->add_option("--densify-from", o->train.densify_from, "First densification iteration")->capture_default_str();

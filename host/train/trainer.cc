@@ -102,6 +102,7 @@ void TrainOptions::check() const {
   if (!(lambda_geo >= 0 && lambda_geo <= 1)) bad("lambda_geo must be in [0, 1]");
   if (!(lambda_ssim >= 0 && lambda_ssim <= 1)) bad("lambda_ssim must be in [0, 1]");
   if (sh_degree > 3) bad("sh_degree must be 0..3");
+  if (!(plane_prune_k >= 0) || !std::isfinite(plane_prune_k)) bad("plane_prune_k must be >= 0 (0: no plane prune)");
   if (sh_degree_every == 0) bad("sh_degree_every must be positive");
   if (densify_every == 0) bad("densify_every must be positive");
   if (opacity_reset_every == 0) bad("opacity_reset_every must be positive");
@@ -177,7 +178,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   }
   const kernels::AdamOptions adam = model->adam_options();
   kernels::DensifyOptions dopt;
-  dopt.grad_threshold = static_cast<float>(o.densify_grad_threshold * o.photometric_weight());
+  dopt.grad_threshold = o.densify_grad_threshold;
   dopt.max_gaussians = o.max_gaussians;
   dopt.opacity_reset_interval = o.opacity_reset_every;
   dopt.seed = o.seed;
@@ -188,7 +189,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   const uint32_t densify_until = std::min(o.densify_until, o.iterations);
   const float extent = static_cast<float>(data.scene_extent_m);
   std::unique_ptr<PlaneDistance> plane_index;
-  if (geometric) plane_index = std::make_unique<PlaneDistance>(*planes);
+  if (geometric && o.plane_prune_k > 0) plane_index = std::make_unique<PlaneDistance>(*planes);
   std::unique_ptr<DeviceArray<float>> plane_distances;
 
   TrainReport report;
@@ -276,7 +277,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
                                                                  std::max<size_t>(d.size() + d.size() / 2, 1));
         plane_distances->upload(d);
         plane_distance = &plane_distances->buffer();
-        step_options.max_plane_distance_m = PlaneDistance::robust_bound(d);
+        step_options.max_plane_distance_m = PlaneDistance::robust_bound(d, o.plane_prune_k);
       }
       if (mcmc) {
         kernels::McmcOptions step_mcmc = mopt;
@@ -310,8 +311,11 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     if (progress && (step % o.progress_every == 0 || last || step == start + 1)) {
       const auto l = losses.download();  // host-visible: written by this iteration's submit
       last_loss = (1.0 - o.lambda_geo) * l[kSlotPhotometric] + (geometric ? o.lambda_geo * l[kSlotGeometric] : 0.0);
+      const double geo_rms = geometric ? std::sqrt(std::max(0.0, static_cast<double>(l[kSlotGeometric])))
+                                       : std::numeric_limits<double>::quiet_NaN();
       const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      progress({step, o.iterations, last_loss, last_psnr, model->size(), (step - start) / std::max(secs, 1e-9)});
+      progress({step, o.iterations, last_loss, l[kSlotPhotometric], geo_rms, last_psnr, model->size(),
+                (step - start) / std::max(secs, 1e-9)});
     }
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

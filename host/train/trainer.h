@@ -40,7 +40,9 @@ struct TrainReport {
 
 struct TrainProgress {
   uint32_t iteration, total;
-  double loss;      // last read back (every few iterations)
+  double loss;      // last read back (every few iterations): (1 - lambda_geo) L_pho + lambda_geo L_geo
+  double photometric_loss;  // its L_pho
+  double geometric_rms_m;   // sqrt(L_geo): the RMS point-to-plane residual over valid pixels (NaN: no term)
   double psnr_db;   // last evaluation (or NaN)
   size_t gaussians;
   double iterations_per_s;

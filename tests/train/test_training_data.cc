@@ -110,6 +110,17 @@ TEST_F(DunrScene, ColmapPointsLandInFrontOfTheCamerasAfterRecentring) {
   EXPECT_GT(coloured, model.size() * 9 / 10);
 }
 
+// A 40x30 camera at the origin looking down +z.
+kernels::SplatCamera camera_at_origin() {
+  kernels::SplatCamera cam;
+  cam.width = 40;
+  cam.height = 30;
+  cam.fx = cam.fy = 40;
+  cam.cx = 20;
+  cam.cy = 15;
+  return cam;
+}
+
 TEST(LidarPlanes, PlaneAndCornerPoints) {
   // A noisy plane z = 2 and a few points of a pole in front of it.
   std::mt19937 rng(1);
@@ -123,12 +134,7 @@ TEST(LidarPlanes, PlaneAndCornerPoints) {
     if (map.planar[i]) {
       ASSERT_GT(std::abs(map.normals[i].z()), 0.98f);
     }
-  kernels::SplatCamera cam;
-  cam.width = 40;
-  cam.height = 30;
-  cam.fx = cam.fy = 40;
-  cam.cx = 20;
-  cam.cy = 15;
+  const kernels::SplatCamera cam = camera_at_origin();
   const ViewPlaneMaps v = project_planes(map, cam);
   EXPECT_GT(v.valid_count, 300u);
   for (size_t p = 0; p < size_t{40} * 30; ++p)
@@ -148,12 +154,7 @@ TEST(LidarPlanes, PixelsCarryPointsMovedOntoTheirLocalPlane) {
   PlaneFitOptions fit;
   fit.max_flatness = 0.5;  // noise this large relative to the spacing: accept the fit
   const PlanarMap map = fit_planes(pts, fit);
-  kernels::SplatCamera cam;
-  cam.width = 40;
-  cam.height = 30;
-  cam.fx = cam.fy = 40;
-  cam.cx = 20;
-  cam.cy = 15;
+  const kernels::SplatCamera cam = camera_at_origin();
   const ViewPlaneMaps v = project_planes(map, cam);
   ASSERT_GT(v.valid_count, 300u);
   double raw_sq = 0, moved_sq = 0;
