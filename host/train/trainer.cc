@@ -186,6 +186,8 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   const kernels::McmcOptions mopt = o.mcmc_options();
   std::unique_ptr<kernels::McmcStrategy> mcmc_strategy;
   if (mcmc) mcmc_strategy = std::make_unique<kernels::McmcStrategy>(ctx);
+  // Refinement and opacity resets run while step < densify_until (3DGS), so never on the last iteration:
+  // Gaussians split, relocated or made transparent there would reach the output unfitted.
   const uint32_t densify_until = std::min(o.densify_until, o.iterations);
   const float extent = static_cast<float>(data.scene_extent_m);
   std::unique_ptr<PlaneDistance> plane_index;
@@ -255,7 +257,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     s.fill(*up.alpha, 0u, uint64_t{W} * H * sizeof(float));
     const auto grads = rasterizer.record_backward(s);
     if (mcmc) mcmc_strategy->record_regularization(s, *model, grads, mopt);
-    else if (step <= densify_until) model->record_accumulate_stats(s, grads, *out.rects, cam);
+    else if (step < densify_until) model->record_accumulate_stats(s, grads, *out.rects, cam);
     kernels::LearningRates lr = adam.rates(it, o.iterations, extent);
     for (float* r : {&lr.means, &lr.log_scales, &lr.quats, &lr.opacity_logits, &lr.sh_dc, &lr.sh_rest}) *r *= o.lr_scale;
     model->record_adam_step(s, grads, lr, step);
@@ -263,7 +265,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     s.submit_and_wait();
     for (const auto& k : s.profile()) kernel_ms[k.name] += k.ms;
 
-    if (step > o.densify_from && step <= densify_until && step % o.densify_every == 0) {
+    if (step > o.densify_from && step < densify_until && step % o.densify_every == 0) {
       // The method's geometric outlier removal: Gaussians far from their LiDAR plane, beyond a robust
       // bound of all distances, are pruned with the others.
       const engine::Buffer* plane_distance = nullptr;
@@ -291,7 +293,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
         report.nonfinite_pruned += d.pruned_nonfinite;
       }
     }
-    if (!mcmc && step <= densify_until && step % o.opacity_reset_every == 0) {
+    if (!mcmc && step < densify_until && step % o.opacity_reset_every == 0) {
       engine::Sequence r(ctx);
       model->record_reset_opacity(r);
       r.submit_and_wait();

@@ -241,6 +241,18 @@ TEST_F(TrainTest, GeometricOutlierPruneRemovesGaussiansOffThePlanesAndCanBeTurne
   EXPECT_THROW(o.check(), std::invalid_argument);
 }
 
+TEST_F(TrainTest, NoRefinementOnTheLastIteration) {
+  // Everything wants to densify, and 30 is a refinement step: stopping at 29 or at 30 must give the same
+  // model size, as a split at the last step would write unfitted children.
+  auto o = small_run(29);
+  o.densify_grad_threshold = 1e-7f;
+  const size_t at_29 = run(o, "last_29").size();
+  o.iterations = 30;
+  const size_t at_30 = run(o, "last_30").size();
+  EXPECT_GT(at_29, initial_->size()) << "the refinement at 20 densified";
+  EXPECT_EQ(at_30, at_29);
+}
+
 TEST_F(TrainTest, DensificationHitsTheCap) {
   auto o = small_run(60);
   o.max_gaussians = static_cast<uint32_t>(initial_->size() + 50);
