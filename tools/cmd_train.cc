@@ -25,6 +25,9 @@ struct TrainCliOptions {
   std::string init = "auto";       // auto | random | a .ply/.pcd file (in the scene's original world frame)
   uint32_t random_count = 20000;   // Gaussians of --init random
   uint32_t max_init_points = 200000;  // LiDAR-map initialization keeps at most this many points
+  // LiDAR-map initialization: a point on a LiDAR plane becomes a disc this thin relative to its radius
+  // (host::surfel_covariances); 1: spheres, as 3DGS.
+  double init_flatness = 0.1;
   std::string intensity = "auto";  // auto | percentile | linear
   std::string poses = "estimated";  // estimated (poses.txt) | truth (gt/poses.txt)
   host::TrainingDataOptions data;
@@ -57,8 +60,9 @@ void run_train(TrainCliOptions o) {
   read.check_images = false;
   const io::Scene scene = io::read_scene(o.scene, read);
   if (scene.map) map_points = scene.map->positions;
+  const bool init_from_map = o.init == "auto" && !map_points.empty();
   std::unique_ptr<host::PlanarMap> planes;
-  if (o.train.lambda_geo > 0 && !map_points.empty())
+  if ((o.train.lambda_geo > 0 || init_from_map) && !map_points.empty())
     planes = std::make_unique<host::PlanarMap>(host::fit_planes(map_points, host::PlaneFitOptions{}));
   if (o.train.lambda_geo > 0 && !planes) {
     std::cerr << "train: the scene has no LiDAR map; training photometric only (lambda_geo 0)\n";
@@ -90,18 +94,31 @@ void run_train(TrainCliOptions o) {
   if (o.init == "random" || (o.init == "auto" && map_points.empty())) {
     model = host::init_random(data, o.random_count, o.train.seed, init);
     init_what = std::to_string(o.random_count) + " random points";
-  } else if (o.init == "auto") {
-    std::vector<Eigen::Vector3d> pts = map_points;
-    if (pts.size() > o.max_init_points) {
+  } else if (init_from_map) {
+    // Planar map points become discs on their plane (the plane fit's normal), the rest spheres.
+    std::vector<size_t> keep(map_points.size());
+    for (size_t i = 0; i < keep.size(); ++i) keep[i] = i;
+    if (keep.size() > o.max_init_points) {
       std::mt19937 rng(o.train.seed);
-      std::shuffle(pts.begin(), pts.end(), rng);
-      pts.resize(o.max_init_points);
+      std::shuffle(keep.begin(), keep.end(), rng);
+      keep.resize(o.max_init_points);
     }
-    model = host::init_from_points(pts, data, init);
+    std::vector<Eigen::Vector3d> pts;
+    std::vector<Eigen::Vector3f> normals;
+    std::vector<uint8_t> planar;
+    for (size_t i : keep) {
+      pts.push_back(map_points[i]);
+      normals.push_back(planes->normals[i]);
+      planar.push_back(planes->planar[i]);
+    }
+    const auto covariances =
+        host::surfel_covariances(host::neighbour_scales(pts, init), normals, planar, o.init_flatness);
+    model = host::init_from_points(pts, data, init, covariances);
     init_what = std::to_string(pts.size()) + " LiDAR map points";
   } else {
-    model = host::init_from_points(host::load_points(o.init, data.world_offset_m), data, init);
-    init_what = o.init;
+    const host::InitPoints file = host::load_points(o.init, data.world_offset_m);
+    model = host::init_from_points(file.positions, data, init, file.covariances);
+    init_what = o.init + (file.covariances.empty() ? "" : " (with covariances)");
   }
 
   engine::Context context;
@@ -140,6 +157,10 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--lambda-geo", o->train.lambda_geo, "Weight of the LiDAR point-to-plane loss")->capture_default_str();
   cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")->capture_default_str();
   cmd->add_option("--init", o->init, "auto (LiDAR map, else random), random, or a .ply/.pcd point file")
+      ->capture_default_str();
+  cmd->add_option("--init-flatness", o->init_flatness,
+                  "LiDAR-map init: thickness / radius of the discs on LiDAR planes (1: spheres)")
+      ->check(CLI::Range(1e-3, 1.0))
       ->capture_default_str();
   cmd->add_option("--random-count", o->random_count, "Gaussians of --init random")->capture_default_str();
   cmd->add_option("--eval-every", o->train.eval_every, "Evaluate held-out views every K iterations (0: at the end)");

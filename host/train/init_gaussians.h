@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <filesystem>
 #include <vector>
 
@@ -22,12 +23,33 @@ struct InitOptions {
 
 // Points of a PLY or PCD file (by extension) in the scene's world frame: the file's coordinates minus the
 // scene's recentring offset. IoError on bad files; std::invalid_argument on an empty cloud.
-std::vector<Eigen::Vector3d> load_points(const std::filesystem::path& file, const Eigen::Vector3d& world_offset_m);
+// A file that carries the six fields cov_xx cov_xy cov_xz cov_yy cov_yz cov_zz (m^2, the upper triangle of
+// each point's 3x3 covariance, the order of anchors.txt) gives them too; a point whose covariance is not
+// finite and positive definite is an error naming it.
+struct InitPoints {
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Eigen::Matrix3d> covariances;  // [N] or empty
+};
+InitPoints load_points(const std::filesystem::path& file, const Eigen::Vector3d& world_offset_m);
 
-// Isotropic Gaussians at the points; the DC term from bilinear sampling of the nearest training view that
-// sees the point (0.5 gray where none does); higher SH coefficients zero; unit quaternions.
+// RMS distance of each point to its `neighbours` nearest others, at least min_scale_m (3DGS's initial scale).
+std::vector<double> neighbour_scales(const std::vector<Eigen::Vector3d>& points, const InitOptions& options);
+
+// Gaussians at the points. With a covariance (covariances non-empty: one per point), the Gaussian takes its
+// axes and their lengths (the square roots of its eigenvalues, at least min_scale_m): anisotropic; without,
+// an isotropic Gaussian of neighbour_scales() size and a unit quaternion. The DC term from bilinear sampling
+// of the nearest training view that sees the point (0.5 gray where none does); higher SH coefficients zero.
 kernels::GaussianModel init_from_points(const std::vector<Eigen::Vector3d>& points, const TrainingData& data,
-                                        const InitOptions& options);
+                                        const InitOptions& options,
+                                        const std::vector<Eigen::Matrix3d>& covariances = {});
+
+// A thin disc per point that lies on a LiDAR plane: radius `scale` in the plane, `flatness * scale` along
+// its normal n (covariance s^2 (I - n n^T) + (flatness s)^2 n n^T); an isotropic s^2 I elsewhere. For the
+// LiDAR-map initialization: a Gaussian centred on a plane then renders that plane's depth at every pixel it
+// covers, where an isotropic one renders its centre's depth across a slanted footprint.
+std::vector<Eigen::Matrix3d> surfel_covariances(const std::vector<double>& scales,
+                                                const std::vector<Eigen::Vector3f>& normals,
+                                                const std::vector<uint8_t>& planar, double flatness);
 
 // `count` points uniform in the cube of side 2 x scene extent around the mean camera centre, then as above.
 kernels::GaussianModel init_random(const TrainingData& data, uint32_t count, uint32_t seed, const InitOptions& options);

@@ -86,7 +86,9 @@ TEST_F(DunrScene, TruePosesOnASceneWithoutGroundTruthIsAnError) {
 }
 
 TEST_F(DunrScene, ColmapPointsLandInFrontOfTheCamerasAfterRecentring) {
-  const auto pts = load_points(kDunr / "colmap-triangulated-points.ply", data_->world_offset_m);
+  const InitPoints file = load_points(kDunr / "colmap-triangulated-points.ply", data_->world_offset_m);
+  EXPECT_TRUE(file.covariances.empty()) << "the COLMAP points carry no covariance";
+  const std::vector<Eigen::Vector3d>& pts = file.positions;
   ASSERT_EQ(pts.size(), 3988u);
   size_t seen = 0;
   for (const auto& p : pts) {
