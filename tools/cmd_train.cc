@@ -69,7 +69,9 @@ void run_train(TrainCliOptions o) {
     o.train.lambda_geo = 0;
   }
 
-  // Ground truth planes (synthetic scenes): the true map's points with their plane's normal.
+  // Ground truth planes (synthetic scenes): the true map's points with their plane's normal; points on no
+  // plane (poles) take part as occluders only. Each point stands for a disc of the map's spacing, so that
+  // the truth, too, is the surface a pixel sees rather than a point behind it.
   std::unique_ptr<host::PlanarMap> gt_planes;
   if (scene.gt && scene.gt->map && !scene.gt->planes.empty()) {
     const io::PointCloud& m = *scene.gt->map;
@@ -78,12 +80,14 @@ void run_train(TrainCliOptions o) {
       gt_planes = std::make_unique<host::PlanarMap>();
       for (size_t i = 0; i < m.size(); ++i) {
         const double pid = id->values[i];
-        if (pid < 0 || pid >= static_cast<double>(scene.gt->planes.size())) continue;
+        const bool on_plane = pid >= 0 && pid < static_cast<double>(scene.gt->planes.size());
         gt_planes->points.push_back(m.positions[i].cast<float>());
         gt_planes->centres.push_back(m.positions[i].cast<float>());  // a true point lies on its plane
-        gt_planes->normals.push_back(scene.gt->planes[static_cast<size_t>(pid)].n.cast<float>());
-        gt_planes->planar.push_back(1);
+        gt_planes->normals.push_back(on_plane ? Eigen::Vector3f(scene.gt->planes[static_cast<size_t>(pid)].n.cast<float>())
+                                              : Eigen::Vector3f(Eigen::Vector3f::Zero()));
+        gt_planes->planar.push_back(on_plane ? 1 : 0);
       }
+      host::assign_surfel_radii(*gt_planes);
     }
   }
 
@@ -155,6 +159,11 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--iterations", o->train.iterations, "Training iterations")->capture_default_str();
   cmd->add_option("--downscale", o->data.downscale, "Divide image size and intrinsics by this")->capture_default_str();
   cmd->add_option("--lambda-geo", o->train.lambda_geo, "Weight of the LiDAR point-to-plane loss")->capture_default_str();
+  cmd->add_option("--geo-robust-scale", o->train.geo_robust_scale_m,
+                  "Cauchy scale of the point-to-plane residual, metres (0: squared residuals)")
+      ->capture_default_str();
+  cmd->add_flag("!--geo-no-opacity-gradient", o->train.geo_gradient_to_opacity,
+                "The LiDAR term moves Gaussians but leaves their opacity to the image");
   cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")->capture_default_str();
   cmd->add_option("--init", o->init, "auto (LiDAR map, else random), random, or a .ply/.pcd point file")
       ->capture_default_str();

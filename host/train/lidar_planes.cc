@@ -69,35 +69,96 @@ PlanarMap fit_planes(const std::vector<Eigen::Vector3d>& points, const PlaneFitO
     map.centres[i] = mean.cast<float>();
     map.planar[i] = 1;
   }
+  assign_surfel_radii(map, o.neighbours);
   return map;
 }
 
-ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& c) {
+void assign_surfel_radii(PlanarMap& map, uint32_t neighbours, double coverage) {
+  if (neighbours < 1) throw std::invalid_argument("assign_surfel_radii: neighbours must be >= 1");
+  if (!(coverage > 0)) throw std::invalid_argument("assign_surfel_radii: coverage must be > 0");
+  map.radii.assign(map.points.size(), 0.0f);
+  if (map.points.size() <= neighbours) return;
+  std::vector<Eigen::Vector3d> pts;
+  pts.reserve(map.points.size());
+  for (const auto& p : map.points) pts.push_back(p.cast<double>());
+  Adaptor adaptor{pts};
+  Tree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  tree.buildIndex();
+  std::vector<uint32_t> idx(neighbours + 1);
+  std::vector<double> d2(neighbours + 1);
+  const double per_neighbour = coverage / std::sqrt(static_cast<double>(neighbours));
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const size_t found = tree.knnSearch(pts[i].data(), neighbours + 1, idx.data(), d2.data());  // itself first
+    if (found == neighbours + 1) map.radii[i] = static_cast<float>(std::sqrt(d2[neighbours]) * per_neighbour);
+  }
+}
+
+ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& c, double max_radius_px) {
   const size_t W = c.width, H = c.height;
   ViewPlaneMaps out;
   out.points.assign(W * H * 4, 0.0f);
   out.normals.assign(W * H * 4, 0.0f);
-  std::vector<float> zbuf(W * H, std::numeric_limits<float>::infinity());
+  std::vector<double> zbuf(W * H, std::numeric_limits<double>::infinity());
   std::vector<int64_t> owner(W * H, -1);
+  const bool discs = map.radii.size() == map.points.size();
+  auto ray = [&](double px, double py) { return glm::dvec3((px - c.cx) / c.fx, (py - c.cy) / c.fy, 1.0); };
+  auto claim = [&](size_t pix, double z, size_t i) {
+    if (z < zbuf[pix]) {
+      zbuf[pix] = z;
+      owner[pix] = static_cast<int64_t>(i);
+    }
+  };
   // Every point takes part in the z-buffer (a non-planar point in front hides the plane behind it); only
-  // pixels whose nearest point is planar carry an entry.
+  // pixels whose nearest surface is planar carry an entry.
+  auto on_plane = [&](size_t i) -> Eigen::Vector3f {
+    if (!map.planar[i]) return map.points[i];
+    const Eigen::Vector3f& n = map.normals[i];
+    return map.points[i] - n * n.dot(map.points[i] - map.centres[i]);
+  };
   for (size_t i = 0; i < map.points.size(); ++i) {
-    const Eigen::Vector3f& p = map.points[i];
+    const Eigen::Vector3f p = on_plane(i);
     const glm::dvec3 q = c.R_cam_world * glm::dvec3(p.x(), p.y(), p.z()) + c.t_cam_world;
     if (q.z <= c.near_m) continue;
     const double u = c.fx * q.x / q.z + c.cx, v = c.fy * q.y / q.z + c.cy;
-    if (u < 0 || v < 0 || u >= static_cast<double>(W) || v >= static_cast<double>(H)) continue;
-    const size_t pix = static_cast<size_t>(v) * W + static_cast<size_t>(u);
-    if (q.z < zbuf[pix]) {
-      zbuf[pix] = static_cast<float>(q.z);
-      owner[pix] = static_cast<int64_t>(i);
+    const double r = discs ? map.radii[i] : 0.0;
+    if (r <= 0 || q.z <= r + c.near_m) {  // a point: the pixel it falls in
+      if (u >= 0 && v >= 0 && u < static_cast<double>(W) && v < static_cast<double>(H))
+        claim(static_cast<size_t>(v) * W + static_cast<size_t>(u), q.z, i);
+      continue;
+    }
+    // The disc's image lies within r / (z - r) of the centre's ray (normalized coordinates).
+    const double reach = std::min(max_radius_px, c.fx * r / (q.z - r));
+    const long x0 = std::max(0L, static_cast<long>(std::floor(u - reach))),
+               x1 = std::min(static_cast<long>(W) - 1, static_cast<long>(std::floor(u + reach)));
+    const long y0 = std::max(0L, static_cast<long>(std::floor(v - reach))),
+               y1 = std::min(static_cast<long>(H) - 1, static_cast<long>(std::floor(v + reach)));
+    if (x0 > x1 || y0 > y1) continue;
+    if (map.planar[i]) {
+      const Eigen::Vector3f& n = map.normals[i];
+      const glm::dvec3 nc = c.R_cam_world * glm::dvec3(n.x(), n.y(), n.z());
+      for (long y = y0; y <= y1; ++y)
+        for (long x = x0; x <= x1; ++x) {
+          const glm::dvec3 d = ray(static_cast<double>(x) + 0.5, static_cast<double>(y) + 0.5);
+          const double denom = glm::dot(nc, d);
+          if (std::abs(denom) < 1e-9) continue;  // the ray runs along the disc
+          const double z = glm::dot(nc, q) / denom;
+          if (z <= c.near_m || glm::length(z * d - q) > r) continue;
+          claim(static_cast<size_t>(y) * W + static_cast<size_t>(x), z, i);
+        }
+    } else {
+      const double r2_px = (c.fx * r / q.z) * (c.fx * r / q.z);
+      for (long y = y0; y <= y1; ++y)
+        for (long x = x0; x <= x1; ++x) {
+          const double dx = static_cast<double>(x) + 0.5 - u, dy = static_cast<double>(y) + 0.5 - v;
+          if (dx * dx + dy * dy <= r2_px) claim(static_cast<size_t>(y) * W + static_cast<size_t>(x), q.z, i);
+        }
     }
   }
   for (size_t pix = 0; pix < W * H; ++pix) {
     if (owner[pix] < 0 || !map.planar[static_cast<size_t>(owner[pix])]) continue;
     const size_t i = static_cast<size_t>(owner[pix]);
     const Eigen::Vector3f& n = map.normals[i];
-    const Eigen::Vector3f p = map.points[i] - n * n.dot(map.points[i] - map.centres[i]);  // onto its plane
+    const Eigen::Vector3f p = on_plane(i);
     const glm::dvec3 q = c.R_cam_world * glm::dvec3(p.x(), p.y(), p.z()) + c.t_cam_world;
     const glm::dvec3 nc = c.R_cam_world * glm::dvec3(n.x(), n.y(), n.z());
     for (int a = 0; a < 3; ++a) {

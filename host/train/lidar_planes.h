@@ -26,10 +26,19 @@ struct PlanarMap {
   std::vector<Eigen::Vector3f> normals;  // unit, sign arbitrary (the loss squares the residual)
   std::vector<Eigen::Vector3f> centres;  // the local plane's point (centroid of the fit); zero where not planar
   std::vector<uint8_t> planar;           // 1 where the fit is valid
+  // The surface each point stands for in a view: a disc of this radius (metres; on its plane where planar,
+  // facing the camera elsewhere), so that a nearer surface hides the points behind it between its own
+  // sparse points. Empty or 0: the point covers only the pixel it falls in.
+  std::vector<float> radii;
   size_t planar_count() const;
 };
 
 PlanarMap fit_planes(const std::vector<Eigen::Vector3d>& points, const PlaneFitOptions& options);
+
+// radii of `map` from the local point density: R_k / sqrt(k) * coverage, R_k the distance to the k-th
+// nearest other point, so that discs of the density's mean area (coverage 1) tile a uniform surface; the
+// default overlaps them a little so that no gaps let farther points through.
+void assign_surfel_radii(PlanarMap& map, uint32_t neighbours = 12, double coverage = 1.5);
 
 // Per-pixel LiDAR point and normal of one view, the layout of the geometric loss kernel:
 // points [H][W][4] = (x, y, z, valid) and normals [H][W][4] = (nx, ny, nz, 0), camera frame.
@@ -39,9 +48,12 @@ struct ViewPlaneMaps {
   uint32_t valid_count = 0;
 };
 
-// Nearest map point per pixel by a z-buffer (pixel centres at +0.5, the rasterizer's convention); where it is
-// planar, the pixel carries that point moved onto its local plane, and the plane's normal.
-ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& camera);
+// The nearest map surface per pixel by a z-buffer of the points' discs (pixel centres at +0.5, the
+// rasterizer's convention): a planar point's disc lies on its local plane and is depth-tested where the pixel's
+// ray meets that plane; a non-planar point's faces the camera at its depth (it only hides what lies behind).
+// Where the nearest disc is planar, the pixel carries its point moved onto the local plane, and the plane's
+// normal. Points project with their radius clamped to max_radius_px pixels.
+ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& camera, double max_radius_px = 16);
 
 }  // namespace litgs::host
 

@@ -101,6 +101,8 @@ void TrainOptions::check() const {
   if (iterations == 0) bad("iterations must be positive");
   if (!(lambda_geo >= 0 && lambda_geo <= 1)) bad("lambda_geo must be in [0, 1]");
   if (!(lambda_ssim >= 0 && lambda_ssim <= 1)) bad("lambda_ssim must be in [0, 1]");
+  if (!(geo_robust_scale_m >= 0) || !std::isfinite(geo_robust_scale_m))
+    bad("geo_robust_scale_m must be finite and >= 0 (0: squared residuals)");
   if (sh_degree > 3) bad("sh_degree must be 0..3");
   if (!(plane_prune_k >= 0) || !std::isfinite(plane_prune_k)) bad("plane_prune_k must be >= 0 (0: no plane prune)");
   if (sh_degree_every == 0) bad("sh_degree_every must be positive");
@@ -141,6 +143,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   // Device state.
   kernels::RasterizerOptions ropt;
   ropt.deterministic = o.deterministic;
+  ropt.depth_gradient_to_opacity = o.geo_gradient_to_opacity;
   kernels::Rasterizer rasterizer(ctx, 1, ropt);
   kernels::PhotometricLossOptions popt;
   popt.lambda_ssim = static_cast<float>(o.lambda_ssim);
@@ -250,7 +253,8 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     if (geometric)
       geometric_loss.record(s, *out.depth, views[v].points->buffer(), views[v].normals->buffer(), W, H,
                             static_cast<float>(cam.fx), static_cast<float>(cam.fy), static_cast<float>(cam.cx),
-                            static_cast<float>(cam.cy), views[v].valid, static_cast<float>(o.lambda_geo), *up.depth,
+                            static_cast<float>(cam.cy), views[v].valid, static_cast<float>(o.lambda_geo),
+                            static_cast<float>(o.geo_robust_scale_m), *up.depth,
                             losses.buffer(), kSlotGeometric);
     else
       s.fill(*up.depth, 0u, uint64_t{W} * H * sizeof(float));

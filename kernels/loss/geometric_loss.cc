@@ -34,8 +34,8 @@ uint32_t GeometricLoss::count_valid(std::span<const float> points) {
 void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& depth,
                            const engine::Buffer& points, const engine::Buffer& normals, uint32_t width,
                            uint32_t height, float fx, float fy, float cx, float cy, uint32_t valid_count,
-                           float weight, const engine::Buffer& grad_depth, const engine::Buffer& loss_out,
-                           uint32_t loss_slot) {
+                           float weight, float robust_scale_m, const engine::Buffer& grad_depth,
+                           const engine::Buffer& loss_out, uint32_t loss_slot) {
   static const char* who = "GeometricLoss::record";
   if (width == 0 || height == 0)
     throw std::invalid_argument(std::string(who) + ": view size " + std::to_string(width) + "x" +
@@ -45,6 +45,8 @@ void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& dep
                                 std::to_string(fy) + " cx " + std::to_string(cx) + " cy " +
                                 std::to_string(cy) + " (need finite values, fx and fy > 0)");
   if (!std::isfinite(weight)) throw std::invalid_argument(std::string(who) + ": weight is not finite");
+  if (!(robust_scale_m >= 0) || !std::isfinite(robust_scale_m))
+    throw std::invalid_argument(std::string(who) + ": robust_scale_m must be finite and >= 0 (0: squares)");
   const uint64_t n = uint64_t{width} * height;
   if (valid_count > n)
     throw std::invalid_argument(std::string(who) + ": valid_count " + std::to_string(valid_count) +
@@ -67,6 +69,7 @@ void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& dep
   p.cy = cy;
   p.inv_valid = valid_count > 0 ? static_cast<float>(1.0 / valid_count) : 0.0f;
   p.weight = weight;
+  p.inv_scale2 = robust_scale_m > 0 ? static_cast<float>(1.0 / (double{robust_scale_m} * robust_scale_m)) : 0.0f;
   sequence.dispatch(*kernel_, groups,
                     {{GEOMETRIC_BINDING_DEPTH, &depth, Access::kRead},
                      {GEOMETRIC_BINDING_POINTS, &points, Access::kRead},

@@ -1,5 +1,9 @@
 // The LiDAR point-to-plane training loss on the device (the method's geometric term):
-//   L_geo = (1 / N_valid) * sum_i (n_i . (P_i - D(u_i) K^-1 [u_i + 0.5, v_i + 0.5, 1]))^2      [metres^2]
+//   L_geo = (1 / N_valid) * sum_i rho(n_i . (P_i - D(u_i) K^-1 [u_i + 0.5, v_i + 0.5, 1]))      [metres^2]
+// with rho(r) = r^2 (robust scale s = 0: the method's squared residual) or the Cauchy kernel
+// rho(r) = s^2 log(1 + r^2 / s^2), which is r^2 for |r| << s and grows only logarithmically beyond: a pixel
+// whose LiDAR surface is not the one it sees (a farther surface between a nearer one's sparse points, a disc
+// reaching over an edge) pulls with a force that falls as s^2 / r instead of growing as r.
 // over pixels i that carry a LiDAR point P_i (camera frame, metres) and its unit plane normal n_i; D is the
 // rendered expected depth (metres, camera z). N_valid is the number of pixels with a point (the host counts
 // it once per view: count_valid()), so the loss is a mean over LiDAR pixels and does not jump as rendered
@@ -38,7 +42,7 @@ class GeometricLoss {
   void reserve(uint32_t width, uint32_t height);
 
   // Records forward and backward into `sequence` (no submit):
-  //   loss_out[loss_slot]     = L_geo (unweighted, metres^2)
+  //   loss_out[loss_slot]     = L_geo (unweighted, metres^2; robust_scale_m = s of the kernel, 0: squares)
   //   loss_out[loss_slot + 1] = pixels that counted
   //   grad_depth = weight * dL_geo/dD, [H][W] (metres^2 per metre), OVERWRITTEN (not accumulated).
   // depth holds H*W floats, points and normals H*W*4 ([H][W][4]: x y z valid / nx ny nz 0), loss_out at
@@ -46,7 +50,7 @@ class GeometricLoss {
   // Intrinsics in pixels; pixel (u, v) has its centre at (u + 0.5, v + 0.5). Scratch as PhotometricLoss.
   void record(engine::Sequence& sequence, const engine::Buffer& depth, const engine::Buffer& points,
               const engine::Buffer& normals, uint32_t width, uint32_t height, float fx, float fy, float cx,
-              float cy, uint32_t valid_count, float weight, const engine::Buffer& grad_depth,
+              float cy, uint32_t valid_count, float weight, float robust_scale_m, const engine::Buffer& grad_depth,
               const engine::Buffer& loss_out, uint32_t loss_slot);
 
   // N_valid of a point map [H][W][4]: pixels whose valid flag (element 3) is above 0.5.

@@ -119,7 +119,7 @@ PhotometricLossResult photometric_loss_reference(std::span<const double> image,
 GeometricLossResult geometric_loss_reference(std::span<const double> depth, std::span<const float> points,
                                              std::span<const float> normals, uint32_t width, uint32_t height,
                                              double fx, double fy, double cx, double cy,
-                                             uint32_t valid_count) {
+                                             uint32_t valid_count, double robust_scale_m) {
   static const char* who = "geometric_loss_reference";
   const size_t n = size_t{width} * height;
   check_size(who, "depth", depth.size(), n);
@@ -141,8 +141,9 @@ GeometricLossResult geometric_loss_reference(std::span<const double> depth, std:
       n_p += static_cast<double>(normals[4 * i + a]) * points[4 * i + a];
     }
     const double r = n_p - d * n_ray;
-    sum += r * r;
-    result.grad_depth[i] = inv_valid * (-2.0 * r * n_ray);
+    const double s2 = robust_scale_m * robust_scale_m, x = s2 > 0 ? r * r / s2 : 0.0;
+    sum += s2 > 0 ? s2 * std::log1p(x) : r * r;
+    result.grad_depth[i] = inv_valid * (-2.0 * r * n_ray) / (1.0 + x);
     ++result.counted;
   }
   result.loss = sum * inv_valid;

@@ -26,16 +26,17 @@ PhotometricLossResult photometric_loss_reference(std::span<const double> image,
                                                  bool gradient = true);
 
 struct GeometricLossResult {
-  double loss = 0.0;               // metres^2
+  double loss = 0.0;               // metres^2 (mean of rho(r))
   uint32_t counted = 0;            // pixels with a valid point and a rendered depth
   std::vector<double> grad_depth;  // [H][W] dloss/dD (unweighted)
 };
 
-// depth [H][W], points and normals [H][W][4]; valid_count = N_valid (0: loss 0, gradient 0).
+// depth [H][W], points and normals [H][W][4]; valid_count = N_valid (0: loss 0, gradient 0); robust_scale_m
+// the Cauchy kernel's s (0: squares), as geometric_loss.h.
 GeometricLossResult geometric_loss_reference(std::span<const double> depth, std::span<const float> points,
                                              std::span<const float> normals, uint32_t width, uint32_t height,
                                              double fx, double fy, double cx, double cy,
-                                             uint32_t valid_count);
+                                             uint32_t valid_count, double robust_scale_m = 0.0);
 
 // Mean SSIM over all pixels and channels (3DGS's ssim(), as the photometric loss), in double.
 double ssim_reference(std::span<const float> image, std::span<const float> target, uint32_t channels,

@@ -66,7 +66,7 @@ struct PhotometricParams {
 #define GEOMETRIC_BINDING_POINTS 1   // [H][W][4] LiDAR point x y z (camera frame, metres), valid in {0, 1}
 #define GEOMETRIC_BINDING_NORMALS 2  // [H][W][4] unit plane normal nx ny nz, 0
 #define GEOMETRIC_BINDING_GRAD 3     // [H][W] weight * dL_geo/dD, metres^-1 * m^2 (out, overwritten)
-#define GEOMETRIC_BINDING_TERMS 4    // [H][W][2] (r^2, 1 if the pixel counted else 0) (out)
+#define GEOMETRIC_BINDING_TERMS 4    // [H][W][2] (rho(r), 1 if the pixel counted else 0) (out)
 
 struct GeometricParams {
   uint width, height;
@@ -75,7 +75,8 @@ struct GeometricParams {
   float fx, fy, cx, cy;  // pixels; pixel (u, v) has its centre at (u + 0.5, v + 0.5)
   float inv_valid;       // 1 / N_valid, 0 when there are no valid points
   float weight;          // the gradient is weight * dL/dD
-  float reserved2, reserved3;
+  float inv_scale2;      // 1 / s^2 of the Cauchy kernel, metres^-2; 0: the plain square (geometric_loss.h)
+  float reserved3;
 };
 
 // ---- reduce_blocks.comp / reduce_finish.comp: deterministic sums of vec2 rows ----

@@ -39,6 +39,9 @@ layout(std430, binding = BWD_BINDING_GRAD2D) buffer Grad2d { float grad2d[]; };
 #endif
 
 #include "splat/footprint.glsl"
+
+// 1: the exact gradient; 0: the expected depth's and the alpha map's gradients skip the opacity.
+layout(constant_id = 2) const uint DEPTH_GRAD_TO_OPACITY = 1u;
 #include "splat/channels.glsl"
 
 // The gradient values of one entry for one pixel, as three vectors (no arrays: CPU drivers spill them):
@@ -61,15 +64,20 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
   const float one_minus = 1.0 - alpha;
   const float Ti = T / one_minus;
   const float w = hit ? alpha * Ti : 0.0;
-  float dL_dalpha = channels_dot(dL_dC, channels_fma(channels_scale(-1.0 / one_minus, acc_c), Ti, color)) + dL_dN * (depth * Ti - acc_z / one_minus) +
-                    dL_dA * T_final / one_minus;
-  dL_dalpha = hit && raw <= float(SPLAT_ALPHA_MAX) ? dL_dalpha : 0.0;  // the 0.99 clamp has no gradient
+  const float dL_dalpha_image = channels_dot(dL_dC, channels_fma(channels_scale(-1.0 / one_minus, acc_c), Ti, color));
+  const bool differentiable = hit && raw <= float(SPLAT_ALPHA_MAX);  // the 0.99 clamp has no gradient
+  const float dL_dalpha = differentiable ? dL_dalpha_image + dL_dN * (depth * Ti - acc_z / one_minus) +
+                                               dL_dA * T_final / one_minus
+                                         : 0.0;
+  // Without DEPTH_GRAD_TO_OPACITY the depth and alpha terms reach the footprint (mean, shape) but not the
+  // opacity, which only the image decides (RasterizerOptions::depth_gradient_to_opacity).
+  const float dL_dopacity = DEPTH_GRAD_TO_OPACITY != 0u ? dL_dalpha : (differentiable ? dL_dalpha_image : 0.0);
   const float dL_dsigma = -dL_dalpha * alpha;
   EntryGrad r;
   r.g0 = vec4(-dL_dsigma * (conic_opacity.x * d.x + conic_opacity.y * d.y),
               -dL_dsigma * (conic_opacity.y * d.x + conic_opacity.z * d.y), dL_dsigma * 0.5 * d.x * d.x,
               dL_dsigma * d.x * d.y);
-  r.g1 = vec4(dL_dsigma * 0.5 * d.y * d.y, dL_dalpha * vis, w * dL_dN, 0.0);
+  r.g1 = vec4(dL_dsigma * 0.5 * d.y * d.y, dL_dopacity * vis, w * dL_dN, 0.0);
   r.g2 = channels_scale(w, dL_dC);
   acc_c = channels_fma(acc_c, w, color);
   acc_z += w * depth;

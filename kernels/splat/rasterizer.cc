@@ -134,7 +134,7 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   const char* backward = options_.deterministic ? "splat/rasterize_backward_deterministic"
                          : uses_float_atomics()  ? "splat/rasterize_backward_float_atomics"
                                                  : "splat/rasterize_backward_cas_atomics";
-  backward_ = make(backward, 15);
+  backward_ = make(backward, 15, {{2, options_.depth_gradient_to_opacity ? 1u : 0u}});
   reduce_ = make("splat/reduce_isect_grads", 5);
   project_backward_ = make("splat/project_backward", 13);
   buffers_->counters = std::make_unique<DeviceArray<uint32_t>>(context, "splat: counters", 4);
@@ -146,13 +146,15 @@ bool Rasterizer::uses_float_atomics() const {
   return !options_.deterministic && !options_.force_cas_atomics && context_->info().float_atomic_add;
 }
 
-std::unique_ptr<engine::Kernel> Rasterizer::make(const char* name, uint32_t bindings) {
+std::unique_ptr<engine::Kernel> Rasterizer::make(const char* name, uint32_t bindings,
+                                                 std::vector<engine::SpecConstant> extra_constants) {
   engine::KernelDesc desc;
   desc.name = name;
   desc.spirv = spirv(name);
   desc.binding_count = bindings;
   desc.push_constant_bytes = sizeof(SplatView);
   desc.spec_constants = {{1, channels_}};
+  desc.spec_constants.insert(desc.spec_constants.end(), extra_constants.begin(), extra_constants.end());
   return std::make_unique<engine::Kernel>(*context_, std::move(desc));
 }
 

@@ -22,6 +22,12 @@ struct RasterizerOptions {
   bool deterministic = false;
   // Use the compare-and-swap fallback even where VK_EXT_shader_atomic_float exists (tests both paths).
   bool force_cas_atomics = false;
+  // false: the gradients of the expected depth and of the alpha map move Gaussians (mean, scale, rotation,
+  // through the depth and the footprint) but do not reach their opacity, which only the image decides.
+  // Training with the LiDAR term uses it: through opacity the depth loss can reweight which Gaussians are
+  // seen instead of moving them, and that trades against the image (README, Training). true: the exact
+  // gradient.
+  bool depth_gradient_to_opacity = true;
 };
 
 // A Gaussian model on the device, one buffer per attribute (structure of arrays, each binding bounded).
@@ -101,7 +107,8 @@ class Rasterizer {
 
  private:
   struct Buffers;
-  std::unique_ptr<engine::Kernel> make(const char* name, uint32_t bindings);
+  std::unique_ptr<engine::Kernel> make(const char* name, uint32_t bindings,
+                                       std::vector<engine::SpecConstant> extra_constants = {});
   void append_profile(const engine::Sequence& sequence);
 
   engine::Context* context_;

@@ -175,7 +175,7 @@ RenderImages<double> reference_forward(const GaussianModel& m, const SplatCamera
 }
 
 GaussianGrads<double> reference_backward(const GaussianModel& m, const SplatCamera& cam,
-                                         const RenderGradInput& grad_out) {
+                                         const RenderGradInput& grad_out, bool depth_gradient_to_opacity) {
   const Prepared p = prepare(m, cam);
   const uint32_t W = cam.width, H = cam.height, C = m.channels, K = m.sh_coeffs();
   const size_t n = m.size(), npix = static_cast<size_t>(W) * H;
@@ -222,19 +222,19 @@ GaussianGrads<double> reference_backward(const GaussianModel& m, const SplatCame
         const double one_minus = 1.0 - h.alpha;
         const double Ti = T / one_minus;
         const double w = h.alpha * Ti;
-        double dL_dalpha = 0.0;
+        double dL_dalpha_image = 0.0;
         for (uint32_t c = 0; c < C; ++c) {
           gcolor[g][c] += w * dL_dC[c];
-          dL_dalpha += dL_dC[c] * (p.color[g][c] * Ti - acc_c[c] / one_minus);
+          dL_dalpha_image += dL_dC[c] * (p.color[g][c] * Ti - acc_c[c] / one_minus);
           acc_c[c] += w * p.color[g][c];
         }
         g2[g].depth += w * dL_dN;
-        dL_dalpha += dL_dN * (pr.depth * Ti - acc_z / one_minus);
-        dL_dalpha += dL_dA * T_final / one_minus;
+        const double dL_dalpha =
+            dL_dalpha_image + dL_dN * (pr.depth * Ti - acc_z / one_minus) + dL_dA * T_final / one_minus;
         acc_z += w * pr.depth;
         T = Ti;
         if (h.clamped) continue;  // alpha = ALPHA_MAX does not depend on the Gaussian
-        g2[g].opacity += dL_dalpha * h.vis;
+        g2[g].opacity += (depth_gradient_to_opacity ? dL_dalpha : dL_dalpha_image) * h.vis;
         const double dL_dsigma = -dL_dalpha * h.alpha;
         g2[g].conic += dL_dsigma * glm::dvec3(0.5 * h.d.x * h.d.x, h.d.x * h.d.y, 0.5 * h.d.y * h.d.y);
         g2[g].mean2d += dL_dsigma * glm::dvec2(-(pr.conic.x * h.d.x + pr.conic.y * h.d.y),

@@ -2,6 +2,7 @@
 // finite differences in tests/kernels), in all three accumulation modes, and bit-identical determinism.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -79,6 +80,36 @@ TEST_F(RasterizerBackward, AtomicModeMatchesReference) {
     const auto grad = random_grad(channels, camera.width, camera.height, 5);
     SCOPED_TRACE("channels " + std::to_string(channels));
     expect_grads_match(device_grads(model, camera, grad, {}), kernels::reference_backward(model, camera, grad));
+  }
+}
+
+TEST_F(RasterizerBackward, DepthGradientWithoutOpacityMatchesReference) {
+  // The LiDAR term's routing: the depth and alpha gradients skip the opacity. The device must agree with the
+  // reference's routing in every accumulation mode, and the opacity gradient must then equal the one of the
+  // image gradient alone.
+  const auto model = testing::random_scene(200, 1, 3, 51);
+  const auto camera = testing::camera_looking_down_z(50, 38);
+  const auto grad = random_grad(1, camera.width, camera.height, 8);
+  kernels::RenderGradInput image_only = grad;
+  std::fill(image_only.depth.begin(), image_only.depth.end(), 0.0f);
+  std::fill(image_only.alpha.begin(), image_only.alpha.end(), 0.0f);
+  const auto want = kernels::reference_backward(model, camera, grad, false);
+  const auto exact = kernels::reference_backward(model, camera, grad, true);
+  const auto image_want = kernels::reference_backward(model, camera, image_only, true);
+  for (size_t i = 0; i < want.opacity_logits.size(); ++i)
+    ASSERT_DOUBLE_EQ(want.opacity_logits[i], image_want.opacity_logits[i]) << "Gaussian " << i;
+  double moved = 0;
+  for (size_t i = 0; i < want.means.size(); ++i) moved += std::abs(want.means[i] - image_want.means[i]);
+  EXPECT_GT(moved, 0.0) << "the depth gradient still moves the means";
+  double differs = 0;
+  for (size_t i = 0; i < want.opacity_logits.size(); ++i) differs += std::abs(want.opacity_logits[i] - exact.opacity_logits[i]);
+  EXPECT_GT(differs, 0.0) << "the exact gradient's opacity part depends on depth and alpha";
+  for (const bool deterministic : {false, true}) {
+    RasterizerOptions options;
+    options.depth_gradient_to_opacity = false;
+    options.deterministic = deterministic;
+    SCOPED_TRACE(deterministic ? "deterministic" : "atomics");
+    expect_grads_match(device_grads(model, camera, grad, options), want);
   }
 }
 

@@ -155,10 +155,11 @@ GeoScene random_geo_scene(uint32_t seed) {
   return s;
 }
 
-TEST(LossReference, GeometricGradientMatchesFiniteDifferences) {
+void expect_geometric_gradient_matches_fd(double robust_scale) {
+  SCOPED_TRACE("robust scale " + std::to_string(robust_scale));
   GeoScene s = random_geo_scene(3);
-  const auto r =
-      geometric_loss_reference(s.depth, s.points, s.normals, s.w, s.h, s.fx, s.fy, s.cx, s.cy, s.valid);
+  const auto r = geometric_loss_reference(s.depth, s.points, s.normals, s.w, s.h, s.fx, s.fy, s.cx, s.cy, s.valid,
+                                          robust_scale);
   const double step = 1e-6;
   double worst = 0.0, scale = 0.0;
   uint32_t counted = 0;
@@ -169,13 +170,13 @@ TEST(LossReference, GeometricGradientMatchesFiniteDifferences) {
     }
     const double d0 = s.depth[i];
     s.depth[i] = d0 + step;
-    const double lp =
-        geometric_loss_reference(s.depth, s.points, s.normals, s.w, s.h, s.fx, s.fy, s.cx, s.cy, s.valid)
-            .loss;
+    const double lp = geometric_loss_reference(s.depth, s.points, s.normals, s.w, s.h, s.fx, s.fy, s.cx, s.cy,
+                                               s.valid, robust_scale)
+                          .loss;
     s.depth[i] = d0 - step;
-    const double lm =
-        geometric_loss_reference(s.depth, s.points, s.normals, s.w, s.h, s.fx, s.fy, s.cx, s.cy, s.valid)
-            .loss;
+    const double lm = geometric_loss_reference(s.depth, s.points, s.normals, s.w, s.h, s.fx, s.fy, s.cx, s.cy,
+                                               s.valid, robust_scale)
+                          .loss;
     s.depth[i] = d0;
     const double fd = (lp - lm) / (2 * step);
     worst = std::max(worst, std::abs(fd - r.grad_depth[i]));
@@ -188,6 +189,29 @@ TEST(LossReference, GeometricGradientMatchesFiniteDifferences) {
   EXPECT_EQ(r.counted, counted);
   ASSERT_GT(scale, 0.0);
   EXPECT_LT(worst / scale, 1e-7) << "worst |fd - analytic| " << worst << " against max |grad| " << scale;
+}
+
+TEST(LossReference, GeometricGradientMatchesFiniteDifferences) {
+  expect_geometric_gradient_matches_fd(0.0);
+}
+
+TEST(LossReference, CauchyGeometricGradientMatchesFiniteDifferences) {
+  for (const double scale : {0.02, 0.1, 1.0}) expect_geometric_gradient_matches_fd(scale);
+}
+
+TEST(LossReference, CauchyKernelIsTheSquareForSmallResidualsAndBoundsTheOutliersPull) {
+  // One pixel, plane z = 2, n = +z, seen at depth 2 + e: residual -e, scale 0.05 m.
+  auto one = [](double e, double scale) {
+    std::vector<double> depth = {2.0 + e};
+    std::vector<float> points = {0.0f, 0.0f, 2.0f, 1.0f}, normals = {0, 0, 1, 0};
+    return geometric_loss_reference(depth, points, normals, 1, 1, 10, 10, 0.5, 0.5, 1, scale);
+  };
+  // At 0.1 mm (x = r^2 / s^2 = 4e-6) both agree to x / 2 and x.
+  EXPECT_NEAR(one(1e-4, 0.05).loss, one(1e-4, 0.0).loss, 3e-6 * one(1e-4, 0.0).loss);
+  EXPECT_NEAR(one(1e-4, 0.05).grad_depth[0], one(1e-4, 0.0).grad_depth[0], 5e-6 * 2e-4);
+  // At 0.5 m (ten scales off) the squared loss pulls 101x harder than the kernel.
+  EXPECT_NEAR(one(0.5, 0.0).grad_depth[0] / one(0.5, 0.05).grad_depth[0], 101.0, 1e-9);
+  EXPECT_NEAR(one(0.5, 0.05).loss, 0.0025 * std::log(101.0), 1e-15);
 }
 
 TEST(LossReference, GeometricValueByHand) {
