@@ -116,7 +116,8 @@ void run_train(TrainCliOptions o) {
       planar.push_back(planes->planar[i]);
     }
     const auto covariances =
-        host::surfel_covariances(host::neighbour_scales(pts, init), normals, planar, o.init_flatness);
+        host::surfel_covariances(host::neighbour_scales(pts, init, data.scene_extent_m * 0.01), normals, planar,
+                                 o.init_flatness);
     model = host::init_from_points(pts, data, init, covariances);
     init_what = std::to_string(pts.size()) + " LiDAR map points";
   } else {

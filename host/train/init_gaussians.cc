@@ -120,9 +120,10 @@ InitPoints load_points(const std::filesystem::path& file, const Eigen::Vector3d&
   return out;
 }
 
-std::vector<double> neighbour_scales(const std::vector<Eigen::Vector3d>& points, const InitOptions& o) {
+std::vector<double> neighbour_scales(const std::vector<Eigen::Vector3d>& points, const InitOptions& o,
+                                     double isolated_scale_m) {
   o.check();
-  std::vector<double> scales(points.size(), o.min_scale_m);
+  std::vector<double> scales(points.size(), std::max(o.min_scale_m, isolated_scale_m));
   if (points.size() < 2) return scales;
   CloudAdaptor adaptor{points};
   KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
@@ -175,7 +176,8 @@ kernels::GaussianModel init_from_points(const std::vector<Eigen::Vector3d>& poin
   m.sh_degree = o.sh_degree;
   m.resize(points.size());
   const uint32_t K = m.sh_coeffs();
-  const std::vector<double> scales = covariances.empty() ? neighbour_scales(points, o) : std::vector<double>{};
+  const std::vector<double> scales =
+      covariances.empty() ? neighbour_scales(points, o, data.scene_extent_m * 0.01) : std::vector<double>{};
   const float logit = std::log(o.initial_opacity / (1.0f - o.initial_opacity));
   for (size_t i = 0; i < points.size(); ++i) {
     Eigen::Vector3d axes_scale = Eigen::Vector3d::Constant(covariances.empty() ? scales[i] : 0.0);

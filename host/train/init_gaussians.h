@@ -32,8 +32,10 @@ struct InitPoints {
 };
 InitPoints load_points(const std::filesystem::path& file, const Eigen::Vector3d& world_offset_m);
 
-// RMS distance of each point to its `neighbours` nearest others, at least min_scale_m (3DGS's initial scale).
-std::vector<double> neighbour_scales(const std::vector<Eigen::Vector3d>& points, const InitOptions& options);
+// RMS distance of each point to its `neighbours` nearest others, at least min_scale_m (3DGS's initial scale);
+// isolated_scale_m for a point with no other (a one-point cloud).
+std::vector<double> neighbour_scales(const std::vector<Eigen::Vector3d>& points, const InitOptions& options,
+                                     double isolated_scale_m = 0.0);
 
 // Gaussians at the points. With a covariance (covariances non-empty: one per point), the Gaussian takes its
 // axes and their lengths (the square roots of its eigenvalues, at least min_scale_m): anisotropic; without,

@@ -14,9 +14,9 @@ struct TrainOptions {
   double lambda_geo = 0.6;         // L = (1 - lambda_geo) L_pho + lambda_geo L_geo (0: photometric only)
   double lambda_ssim = 0.2;        // L_pho = (1 - lambda_ssim) L1 + lambda_ssim (1 - SSIM)
   // Scale s of the Cauchy kernel on the point-to-plane residual (kernels/loss/geometric_loss.h), metres; 0:
-  // the plain square. Residuals well below s are squared as the method states; the few LiDAR targets that are
-  // not the surface a pixel sees (up to ~1 m off on the synthetic facade, yet ~99% of the squared error of all
-  // targets: tests/train/test_plane_targets_synthetic.cc) pull with a bounded force.
+  // the plain square. Residuals well below s are squared as the method states; the ~1% of LiDAR targets that
+  // are not the surface a pixel sees (up to ~1 m off on the synthetic facade, yet half the squared loss's pull
+  // on a true render: tests/train/test_plane_targets_synthetic.cc) pull with a bounded force.
   double geo_robust_scale_m = 0.05;
   // false: the LiDAR term's gradient moves Gaussians but leaves their opacity to the image
   // (kernels::RasterizerOptions::depth_gradient_to_opacity).
