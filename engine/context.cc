@@ -139,6 +139,7 @@ Candidate describe(VkPhysicalDevice pd) {
   d.max_memory_allocation_size = maint3.maxMemoryAllocationSize;
   d.max_push_constants_size = base.limits.maxPushConstantsSize;
   d.max_compute_shared_memory_size = base.limits.maxComputeSharedMemorySize;
+  d.max_per_stage_storage_buffers = base.limits.maxPerStageDescriptorStorageBuffers;
   d.max_compute_workgroup_invocations = base.limits.maxComputeWorkGroupInvocations;
   for (int i = 0; i < 3; ++i) d.max_compute_workgroup_count[i] = base.limits.maxComputeWorkGroupCount[i];
   d.timestamp_period_ns = base.limits.timestampPeriod;

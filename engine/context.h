@@ -51,6 +51,7 @@ struct DeviceInfo {
   uint64_t max_memory_allocation_size = 0;
   uint32_t max_push_constants_size = 0;
   uint32_t max_compute_shared_memory_size = 0;
+  uint32_t max_per_stage_storage_buffers = 0;  // storage-buffer bindings one kernel may have
   uint32_t max_compute_workgroup_invocations = 0;
   uint32_t max_compute_workgroup_count[3] = {0, 0, 0};
   bool timestamps = false;            // compute queue supports timestamps

@@ -15,6 +15,10 @@ Kernel::Kernel(Context& context, KernelDesc desc) : context_(&context), desc_(st
     throw std::invalid_argument("kernel '" + desc_.name + "': push constants of " +
                                 std::to_string(desc_.push_constant_bytes) + " bytes exceed maxPushConstantsSize " +
                                 std::to_string(info.max_push_constants_size));
+  if (desc_.binding_count > info.max_per_stage_storage_buffers)
+    throw std::invalid_argument("kernel '" + desc_.name + "': " + std::to_string(desc_.binding_count) +
+                                " storage buffers exceed maxPerStageDescriptorStorageBuffers " +
+                                std::to_string(info.max_per_stage_storage_buffers) + " of " + info.name);
   const uint32_t sg = desc_.required_subgroup_size;
   const bool fixed_size = info.min_subgroup_size == info.max_subgroup_size && sg == info.subgroup_size;
   if (sg != 0 && !fixed_size &&

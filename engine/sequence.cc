@@ -10,7 +10,8 @@ namespace litgs::engine {
 namespace {
 
 constexpr uint32_t kSetsPerPool = 128;
-constexpr uint32_t kMaxBindingsPerKernel = 16;
+// Descriptor pools are sized for this many bindings per set (lavapipe allows 32 storage buffers per stage).
+constexpr uint32_t kMaxBindingsPerKernel = 32;
 constexpr uint32_t kQueriesPerPool = 512;  // 256 dispatches
 
 bool reads(Access a) { return a != Access::kWrite; }
@@ -129,7 +130,7 @@ void Sequence::dispatch_raw(const Kernel& kernel, Groups groups, std::initialize
                                 std::to_string(params_bytes) + " bytes, the kernel declares " +
                                 std::to_string(kernel.push_constant_bytes()));
   if (kernel.binding_count() > kMaxBindingsPerKernel)
-    throw std::invalid_argument("kernel '" + kernel.name() + "' has more than 16 bindings");
+    throw std::invalid_argument("kernel '" + kernel.name() + "' has more than " + std::to_string(kMaxBindingsPerKernel) + " bindings");
   if (bindings.size() != kernel.binding_count())
     throw std::invalid_argument("dispatch of '" + kernel.name() + "': " + std::to_string(bindings.size()) +
                                 " bindings given, the kernel declares " + std::to_string(kernel.binding_count()));

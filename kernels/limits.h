@@ -12,8 +12,9 @@
 // that 16.7M elements fit in the 65535 workgroups every device allows in one dimension.
 #define ELEMENTWISE_GROUP_SIZE 256
 
-// A pixel walks at most this many entries of its tile's list (lavapipe's loop cap; see above). Tiles with
-// longer lists are truncated and counted.
-#define MAX_TILE_LIST_WALK 60000
+// The rasterize kernels walk a tile's list in passes (kernels/splat/splat_shared.h) and size each pass so that
+// an invocation spends at most this many loop iterations in it: three quarters of lavapipe's limit, the rest
+// being margin for the bound's uncertainty (Rasterizer: loops per chunk of entries) and the kernel's other loops.
+#define RASTERIZE_PASS_LOOP_BUDGET 49152
 
 #endif

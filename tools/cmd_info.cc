@@ -28,6 +28,7 @@ void print_text(const engine::DeviceInfo& d, const std::vector<engine::DeviceInf
             << "\n"
             << "max storage buffer range " << d.max_storage_buffer_range / (1024 * 1024) << " MiB\n"
             << "max shared memory        " << d.max_compute_shared_memory_size / 1024 << " KiB\n"
+            << "storage buffers / kernel " << d.max_per_stage_storage_buffers << "\n"
             << "timestamps    " << (d.timestamps ? "yes" : "no") << ", " << d.timestamp_period_ns << " ns/tick\n";
   for (size_t i = 0; i < d.memory_heaps.size(); ++i)
     std::cout << "heap " << i << "        " << std::fixed << std::setprecision(1)

@@ -32,7 +32,7 @@ void main() {
   const Projected pr = project_gaussian(view_geometry(), mean, log_scale, quat, opacity_logits[i]);
   bool sh_finite = true;
   for (uint k = 0u; k < view.sh_coeffs * CHANNELS; ++k) sh_finite = sh_finite && is_finite_real(sh[i * view.sh_coeffs * CHANNELS + k]);
-  if (!pr.finite || !sh_finite) atomicAdd(counters[0], 1u);
+  if (!pr.finite || !sh_finite) atomicAdd(counters[SPLAT_COUNTER_CULLED_NONFINITE], 1u);
 
   uvec4 rect = uvec4(0u);
   if (pr.visible && sh_finite) {

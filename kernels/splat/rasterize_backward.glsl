@@ -10,6 +10,8 @@
 #define SPLAT_BWD_FLOAT_ATOMICS 0
 #define SPLAT_BWD_CAS_ATOMICS 1
 #define SPLAT_BWD_DETERMINISTIC 2
+// One list segment per pass, passes from the last segment to the first (splat_shared.h).
+#define SPLAT_RASTERIZE_PASS
 
 #include "limits.h"
 #include "splat/splat_shared.h"
@@ -37,6 +39,8 @@ layout(std430, binding = BWD_BINDING_GRAD2D) buffer Grad2d { uint grad2d_bits[];
 #else
 layout(std430, binding = BWD_BINDING_GRAD2D) buffer Grad2d { float grad2d[]; };
 #endif
+layout(std430, binding = BWD_BINDING_STATE) buffer State { float state[]; };
+layout(std430, binding = BWD_BINDING_COUNTERS) buffer Counters { uint counters[]; };
 
 #include "splat/footprint.glsl"
 
@@ -119,8 +123,9 @@ void subgroup_sum3(inout vec4 a, inout vec4 b, inout vec4 c) {
 }
 
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
-const uint MAX_SUBGROUPS = SPLAT_TILE_SIZE * SPLAT_TILE_SIZE;  // subgroups of one lane at worst
-shared vec4 s_partial[MAX_SUBGROUPS][3];
+// Per chunk, each lane's entry sums of each subgroup: [subgroup * S + lane][3] (subgroups x S = 256).
+const uint WORKGROUP_INVOCATIONS = SPLAT_TILE_SIZE * SPLAT_TILE_SIZE;
+shared vec4 s_partial[WORKGROUP_INVOCATIONS * 3];
 shared uint s_walk;
 #else
 void add_to(uint index, float value) {
@@ -146,6 +151,50 @@ void add_entry_grads(uint g, vec4 a0, vec4 a1, vec4 a2) {
 }
 #endif
 
+// The entry sums of one chunk of the list, [chunk_start, chunk_end) relative to the list start, walked back
+// to front: lane k loads entry chunk_start + k, a ballot keeps entries whose footprint reaches the subgroup,
+// and the lanes take them from lane k by shuffle, last to first. Lane k returns its entry's subgroup sums.
+void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 centre, vec2 subgroup_lo,
+                    vec2 subgroup_hi, uint my_last, float T_final, vec4 dL_dC, float dL_dN, float dL_dA,
+                    inout float T, inout vec4 acc_c, inout float acc_z, out uint g, out bool relevant,
+                    out vec4 a0, out vec4 a1, out vec4 a2) {
+  const uint rel = chunk_start + gl_SubgroupInvocationID;
+  g = 0u;
+  vec4 mean_extent = vec4(0.0), conic_opacity = vec4(0.0), color = vec4(0.0);
+  float depth = 0.0;
+  relevant = false;
+  if (rel < chunk_end) {
+    load_entry(list_start + rel, g, mean_extent, conic_opacity, color, depth);
+    relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
+  }
+  a0 = vec4(0.0);
+  a1 = vec4(0.0);
+  a2 = vec4(0.0);
+  uvec4 todo = subgroupBallot(relevant);
+  for (int word = 3; word >= 0; --word) {
+    while (todo[word] != 0u) {
+      const uint bit = uint(findMSB(todo[word]));
+      todo[word] &= ~(1u << bit);
+      const uint k = 32u * uint(word) + bit;
+      const EntryGrad r = entry_backward(centre, subgroupShuffle(mean_extent, k), subgroupShuffle(conic_opacity, k),
+                                         channels_shuffle(color, k), subgroupShuffle(depth, k),
+                                         chunk_start + k < my_last, T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
+      vec4 s0 = r.g0, s1 = r.g1, s2 = r.g2;
+      subgroup_sum3(s0, s1, s2);
+      if (gl_SubgroupInvocationID == k) {
+        a0 = s0;
+        a1 = s1;
+        a2 = s2;
+      }
+    }
+  }
+}
+
+// The next chunk's start going back from chunk_end, not below the segment's begin.
+uint chunk_start_below(uint chunk_end) {
+  return chunk_end > segment.begin + gl_SubgroupSize ? chunk_end - gl_SubgroupSize : segment.begin;
+}
+
 void main() {
   const uvec2 pixel = gl_GlobalInvocationID.xy;
   const bool inside = pixel.x < view.width && pixel.y < view.height;
@@ -156,6 +205,9 @@ void main() {
 
   const vec2 centre = vec2(pixel) + 0.5;
   const uint my_last = inside ? fwd_last[pix] : 0u;
+#if SPLAT_BWD_MODE != SPLAT_BWD_DETERMINISTIC
+  if (subgroupAll(my_last <= segment.begin)) return;  // nothing of this subgroup's walks lies in this pass
+#endif
   const float A = inside ? fwd_alpha[pix] : 0.0;
   const float T_final = 1.0 - A;
   const bool has_depth = A >= float(SPLAT_MIN_DEPTH_WEIGHT);
@@ -166,84 +218,75 @@ void main() {
   vec4 dL_dC = vec4(0.0);
   for (uint c = 0u; c < CHANNELS; ++c) dL_dC[c] = inside ? grad_image[c * plane + pix] : 0.0;
 
+  // A pixel whose walk reaches past this segment was walked by the previous pass, which stored its state.
   float T = T_final;
   vec4 acc_c = vec4(0.0);
   float acc_z = 0.0;
+  if (my_last > segment.end) {
+    T = state[pix];
+    acc_z = state[plane + pix];
+    for (uint c = 0u; c < CHANNELS; ++c) acc_c[c] = state[(2u + c) * plane + pix];
+  }
+  const vec2 subgroup_lo = subgroupMin(centre), subgroup_hi = subgroupMax(centre);
+  uint chunk_end;
 
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
-  // Every subgroup takes part in every entry's workgroup sum, in a fixed order: the same bits every run.
+  // Every subgroup walks the workgroup's longest walk, chunk by chunk; per chunk each entry's sums over the
+  // subgroups are added in a fixed order and written to the intersection's own row: the same bits every run.
   if (gl_LocalInvocationIndex == 0u) s_walk = 0u;
   barrier();
   atomicMax(s_walk, my_last);
   barrier();
-  const uint walk = s_walk;
-  for (uint j = walk; j > 0u; --j) {
+  const uint walk = min(s_walk, segment.end);
+  const uint S = gl_SubgroupSize;
+  for (chunk_end = walk; chunk_end > segment.begin; chunk_end = chunk_start_below(chunk_end)) {
+    const uint chunk_start = chunk_start_below(chunk_end);
     uint g;
-    vec4 mean_extent, conic_opacity, color;
-    float depth;
-    load_entry(range.x + j - 1u, g, mean_extent, conic_opacity, color, depth);
-    const uint e = isect_ids[range.x + j - 1u];
-    const EntryGrad r = entry_backward(centre, mean_extent, conic_opacity, color, depth, j <= my_last, T_final,
-                                       dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
-    vec4 s0 = r.g0, s1 = r.g1, s2 = r.g2;
-    subgroup_sum3(s0, s1, s2);
-    if (subgroupElect()) {
-      s_partial[gl_SubgroupID][0] = s0;
-      s_partial[gl_SubgroupID][1] = s1;
-      s_partial[gl_SubgroupID][2] = s2;
-    }
+    bool relevant;
+    vec4 a0, a1, a2;
+    chunk_backward(range.x, chunk_start, chunk_end, centre, subgroup_lo, subgroup_hi, my_last, T_final, dL_dC, dL_dN,
+                   dL_dA, T, acc_c, acc_z, g, relevant, a0, a1, a2);
+    const uint slot = (gl_SubgroupID * S + gl_SubgroupInvocationID) * 3u;
+    s_partial[slot] = a0;
+    s_partial[slot + 1u] = a1;
+    s_partial[slot + 2u] = a2;
     barrier();
-    if (gl_LocalInvocationIndex < 3u) {
+    for (uint t = gl_LocalInvocationIndex; t < 3u * S; t += WORKGROUP_INVOCATIONS) {
+      const uint k = t / 3u, part = t % 3u;
+      if (chunk_start + k >= chunk_end) continue;
       vec4 total = vec4(0.0);
-      for (uint sg = 0u; sg < gl_NumSubgroups; ++sg) total += s_partial[sg][gl_LocalInvocationIndex];
-      const uint base = e * GRAD2D_STRIDE;
-      if (gl_LocalInvocationIndex == 0u)
-        for (uint k = 0u; k < 4u; ++k) grad2d[base + k] = total[k];
-      else if (gl_LocalInvocationIndex == 1u)
-        for (uint k = 0u; k < 3u; ++k) grad2d[base + 4u + k] = total[k];
+      for (uint sg = 0u; sg < gl_NumSubgroups; ++sg) total += s_partial[(sg * S + k) * 3u + part];
+      const uint base = isect_ids[range.x + chunk_start + k] * GRAD2D_STRIDE;
+      if (part == 0u)
+        for (uint v = 0u; v < 4u; ++v) grad2d[base + v] = total[v];
+      else if (part == 1u)
+        for (uint v = 0u; v < 3u; ++v) grad2d[base + 4u + v] = total[v];
       else
         for (uint c = 0u; c < CHANNELS; ++c) grad2d[base + SPLAT_GRAD2D_FIXED + c] = total[c];
     }
     barrier();
   }
+  // A driver's loop limit ends the walk early without an error (see rasterize_forward.comp): count it.
+  if (chunk_end > segment.begin && gl_LocalInvocationIndex == 0u)
+    atomicAdd(counters[SPLAT_COUNTER_BACKWARD_WALKS_CUT], 1u);
 #else
-  // Each subgroup walks back from its longest walk, a subgroup-wide chunk at a time: lane k loads entry k
-  // of the chunk, a ballot keeps entries whose footprint reaches the subgroup, and the lanes take them from
-  // lane k by shuffle, last to first. Lane k gathers its entry's subgroup sums and adds them once.
-  const uint walk = subgroupMax(my_last);
-  const uint S = gl_SubgroupSize;
-  const vec2 subgroup_lo = subgroupMin(centre), subgroup_hi = subgroupMax(centre);
-  for (uint chunk_end = walk; chunk_end > 0u; chunk_end = chunk_end > S ? chunk_end - S : 0u) {
-    const uint chunk_start = chunk_end > S ? chunk_end - S : 0u;
-    const uint rel = chunk_start + gl_SubgroupInvocationID;  // entry position within the tile's list
-    uint g = 0u;
-    vec4 mean_extent = vec4(0.0), conic_opacity = vec4(0.0), color = vec4(0.0);
-    float depth = 0.0;
-    bool relevant = false;
-    if (rel < chunk_end) {
-      load_entry(range.x + rel, g, mean_extent, conic_opacity, color, depth);
-      relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
-    }
-    vec4 a0 = vec4(0.0), a1 = vec4(0.0), a2 = vec4(0.0);
-    uvec4 todo = subgroupBallot(relevant);
-    for (int word = 3; word >= 0; --word) {
-      while (todo[word] != 0u) {
-        const uint bit = uint(findMSB(todo[word]));
-        todo[word] &= ~(1u << bit);
-        const uint k = 32u * uint(word) + bit;
-        const EntryGrad r = entry_backward(centre, subgroupShuffle(mean_extent, k), subgroupShuffle(conic_opacity, k),
-                                           channels_shuffle(color, k), subgroupShuffle(depth, k),
-                                           chunk_start + k < my_last, T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
-        vec4 s0 = r.g0, s1 = r.g1, s2 = r.g2;
-        subgroup_sum3(s0, s1, s2);
-        if (gl_SubgroupInvocationID == k) {
-          a0 += s0;
-          a1 += s1;
-          a2 += s2;
-        }
-      }
-    }
+  // Each subgroup walks back from its own longest walk; lane k adds its entry's sums once.
+  for (chunk_end = min(subgroupMax(my_last), segment.end); chunk_end > segment.begin;
+       chunk_end = chunk_start_below(chunk_end)) {
+    uint g;
+    bool relevant;
+    vec4 a0, a1, a2;
+    chunk_backward(range.x, chunk_start_below(chunk_end), chunk_end, centre, subgroup_lo, subgroup_hi, my_last,
+                   T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z, g, relevant, a0, a1, a2);
     if (relevant) add_entry_grads(g, a0, a1, a2);
   }
+  if (chunk_end > segment.begin && subgroupElect()) atomicAdd(counters[SPLAT_COUNTER_BACKWARD_WALKS_CUT], 1u);
 #endif
+
+  // Pixels walked in this pass whose walk goes on in the next pass (the segment before) hand over their state.
+  if (segment.begin > 0u && my_last > segment.begin) {
+    state[pix] = T;
+    state[plane + pix] = acc_z;
+    for (uint c = 0u; c < CHANNELS; ++c) state[(2u + c) * plane + pix] = acc_c[c];
+  }
 }

@@ -4,7 +4,9 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_shuffle : require
-// One workgroup per 16x16 tile, one invocation per pixel: alpha-blend the tile's list front to back.
+// One workgroup per 16x16 tile, one invocation per pixel: alpha-blend the tile's list front to back, one list
+// segment per pass (splat_shared.h: a long list takes several passes, carrying the blend state).
+#define SPLAT_RASTERIZE_PASS
 #include "limits.h"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
@@ -22,10 +24,10 @@ layout(std430, binding = FWD_BINDING_CONICS) readonly buffer Conics { float coni
 layout(std430, binding = FWD_BINDING_DEPTHS) readonly buffer Depths { float depths[]; };
 layout(std430, binding = FWD_BINDING_OPACITIES) readonly buffer Opacities { float opacities[]; };
 layout(std430, binding = FWD_BINDING_COLORS) readonly buffer Colors { float colors[]; };
-layout(std430, binding = FWD_BINDING_IMAGE) writeonly buffer Image { float image[]; };
-layout(std430, binding = FWD_BINDING_DEPTH) writeonly buffer Depth { float depth_out[]; };
-layout(std430, binding = FWD_BINDING_ALPHA) writeonly buffer Alpha { float alpha_out[]; };
-layout(std430, binding = FWD_BINDING_LAST) writeonly buffer Last { uint last_out[]; };
+layout(std430, binding = FWD_BINDING_IMAGE) buffer Image { float image[]; };
+layout(std430, binding = FWD_BINDING_DEPTH) buffer Depth { float depth_out[]; };
+layout(std430, binding = FWD_BINDING_ALPHA) buffer Alpha { float alpha_out[]; };
+layout(std430, binding = FWD_BINDING_LAST) buffer Last { uint last_out[]; };
 layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]; };
 
 // Each subgroup walks the tile's list on its own, SUBGROUP-wide chunk by chunk: lane k loads entry k of the
@@ -37,8 +39,12 @@ void main() {
   const bool inside = pixel.x < view.width && pixel.y < view.height;
   const uint tile = gl_WorkGroupID.y * view.tiles_x + gl_WorkGroupID.x;
   const uvec2 range = ranges[tile];
-  const uint end = min(range.y, range.x + uint(MAX_TILE_LIST_WALK));
-  if (gl_LocalInvocationIndex == 0u && end < range.y) atomicAdd(counters[1], 1u);
+  const uint length = range.y - range.x;
+  if (segment.begin >= length && segment.begin > 0u) return;  // the tile's list ended in an earlier pass
+  const uint end = range.x + min(length, segment.end);
+  const bool final_pass = length <= segment.end;
+  const uint pix = pixel.y * view.width + pixel.x;
+  const uint plane = view.width * view.height;
 
   const vec2 centre = vec2(pixel) + 0.5;
   const vec2 subgroup_lo = subgroupMin(centre), subgroup_hi = subgroupMax(centre);
@@ -47,7 +53,16 @@ void main() {
   float depth_sum = 0.0;
   uint last = 0u;
   bool done = !inside;
-  for (uint chunk = range.x; chunk < end; chunk += gl_SubgroupSize) {
+  if (segment.begin > 0u && inside) {  // continue from the previous pass's state
+    T = alpha_out[pix];
+    for (uint c = 0u; c < CHANNELS; ++c) accum[c] = image[c * plane + pix];
+    depth_sum = depth_out[pix];
+    last = last_out[pix];
+    done = (last & FWD_LAST_DONE) != 0u;
+    last &= ~FWD_LAST_DONE;
+  }
+  uint chunk = range.x + segment.begin;
+  for (; chunk < end; chunk += gl_SubgroupSize) {
     if (subgroupAll(done)) break;
     // Lane k loads entry chunk + k.
     const uint entry = chunk + gl_SubgroupInvocationID;
@@ -87,10 +102,17 @@ void main() {
       }
     }
   }
+  // A driver's loop limit (lavapipe: 65535 iterations per invocation) ends the walk early without an error:
+  // count it, so that a pass sized wrongly for a device is seen (SPLAT_COUNTER_FORWARD_WALKS_CUT).
+  if (chunk < end && !subgroupAll(done) && subgroupElect()) atomicAdd(counters[SPLAT_COUNTER_FORWARD_WALKS_CUT], 1u);
   if (!inside) return;
-  const uint pix = pixel.y * view.width + pixel.x;
-  const uint plane = view.width * view.height;
   for (uint c = 0u; c < CHANNELS; ++c) image[c * plane + pix] = accum[c];
+  if (!final_pass) {  // more of the list follows in the next pass
+    alpha_out[pix] = T;
+    depth_out[pix] = depth_sum;
+    last_out[pix] = last | (done ? FWD_LAST_DONE : 0u);
+    return;
+  }
   const float a = 1.0 - T;
   alpha_out[pix] = a;
   depth_out[pix] = a >= float(SPLAT_MIN_DEPTH_WEIGHT) ? depth_sum / a : 0.0;

@@ -29,6 +29,34 @@ engine::Groups elementwise(size_t n) {
   return {static_cast<uint32_t>((n + ELEMENTWISE_GROUP_SIZE - 1) / ELEMENTWISE_GROUP_SIZE)};
 }
 
+// Upper bounds on the loop iterations one subgroup spends per chunk of S list entries (S = subgroup size,
+// C = channels), counting as lavapipe does: every loop entered costs its iterations plus one. They follow
+// the loop structure of the kernels (rasterize_forward.comp, rasterize_backward.glsl): the chunk loop, the
+// colour load, the four ballot words and their entries, and per entry the butterfly sum (log2 S steps), the
+// atomic adds (compare-and-swap loops) or the deterministic mode's sum over the workgroup's subgroups.
+uint32_t log2_ceil(uint32_t v) { return static_cast<uint32_t>(std::bit_width(std::max(v, 1u) - 1)); }
+
+uint32_t forward_loops_per_chunk(uint32_t S, uint32_t C) { return 1 + (C + 1) + 5 + (S + 4); }
+
+uint32_t backward_loops_per_chunk(uint32_t S, uint32_t C, bool deterministic) {
+  const uint32_t walk = 1 + (C + 1) + 5 + (S + 4) + S * (log2_ceil(S) + 1);
+  if (!deterministic) return walk + 3 + 4 + 5 + (C + 1) + 2 * (SPLAT_GRAD2D_FIXED + C);
+  const uint32_t subgroups = (SPLAT_TILE_SIZE * SPLAT_TILE_SIZE + S - 1) / S;
+  const uint32_t sums_per_invocation = (3 * S + SPLAT_TILE_SIZE * SPLAT_TILE_SIZE - 1) / (SPLAT_TILE_SIZE * SPLAT_TILE_SIZE);
+  return walk + (sums_per_invocation + 1) * ((subgroups + 1) + 5);
+}
+
+// Entries per pass: whole chunks within RASTERIZE_PASS_LOOP_BUDGET, for every subgroup size the device may use.
+template <class LoopsPerChunk>
+uint32_t entries_within_budget(const engine::DeviceInfo& info, LoopsPerChunk loops_per_chunk) {
+  uint32_t entries = 0xFFFFFFFFu;
+  for (uint32_t S : {info.min_subgroup_size, info.subgroup_size, info.max_subgroup_size}) {
+    S = std::max(S, 1u);
+    entries = std::min(entries, RASTERIZE_PASS_LOOP_BUDGET / loops_per_chunk(S) * S);
+  }
+  return std::max(entries, 1u);
+}
+
 SplatView make_view(const SplatCamera& c, uint32_t count, uint32_t sh_coeffs) {
   SplatView v{};
   for (int col = 0; col < 3; ++col)
@@ -49,6 +77,12 @@ SplatView make_view(const SplatCamera& c, uint32_t count, uint32_t sh_coeffs) {
   return v;
 }
 
+// The pass's push constants: entries [p E, (p + 1) E) of every tile's list.
+RasterizeParams pass_params(const SplatView& view, uint32_t pass, uint32_t entries_per_pass) {
+  const uint64_t begin = uint64_t{pass} * entries_per_pass;
+  return {view, {static_cast<uint32_t>(begin), static_cast<uint32_t>(std::min<uint64_t>(begin + entries_per_pass, 0xFFFFFFFFu))}};
+}
+
 }  // namespace
 
 SplatView make_splat_view(const SplatCamera& camera, uint32_t count, uint32_t sh_coeffs) {
@@ -66,7 +100,10 @@ struct Rasterizer::Buffers {
   // Per pixel and per tile.
   std::unique_ptr<DeviceArray<float>> image, depth, alpha, grad_image, grad_depth, grad_alpha;
   std::unique_ptr<DeviceArray<uint32_t>> last, ranges;
-  std::unique_ptr<DeviceArray<uint32_t>> counters;  // [4]
+  std::unique_ptr<DeviceArray<uint32_t>> corners;       // [(tiles_y + 1) * (tiles_x + 1)] list lengths
+  std::unique_ptr<DeviceArray<float>> backward_state;   // [2 + C][H][W] between backward passes (else [1])
+  std::unique_ptr<DeviceArray<uint32_t>> counters;      // [SPLAT_COUNTER_COUNT]
+  std::unique_ptr<DeviceArray<uint32_t>> readback;      // [SPLAT_COUNTER_COUNT] host-visible copy
 };
 
 DeviceGaussians::DeviceGaussians(engine::Context& context, const GaussianModel& model)
@@ -126,18 +163,45 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   if (channels < 1 || channels > SPLAT_MAX_CHANNELS)
     throw std::invalid_argument("Rasterizer: channels = " + std::to_string(channels) + ", must be 1.." +
                                 std::to_string(SPLAT_MAX_CHANNELS));
-  project_ = make("splat/project", 14);
-  gather_ = make("splat/gather_counts", 3);
-  emit_ = make("splat/emit_intersections", 6);
-  ranges_ = make("splat/tile_ranges", 2);
-  forward_ = make("splat/rasterize_forward", 13);
+  project_ = make("splat/project", PROJECT_BINDING_COUNT, sizeof(SplatView));
+  gather_ = make("splat/gather_counts", GATHER_BINDING_COUNT, sizeof(SplatView));
+  lengths_ = make("splat/tile_list_lengths", LENGTHS_BINDING_COUNT, sizeof(SplatView));
+  emit_ = make("splat/emit_intersections", EMIT_BINDING_COUNT, sizeof(SplatView));
+  ranges_ = make("splat/tile_ranges", RANGES_BINDING_COUNT, sizeof(SplatView));
+  forward_ = make("splat/rasterize_forward", FWD_BINDING_COUNT, sizeof(RasterizeParams));
   const char* backward = options_.deterministic ? "splat/rasterize_backward_deterministic"
                          : uses_float_atomics()  ? "splat/rasterize_backward_float_atomics"
                                                  : "splat/rasterize_backward_cas_atomics";
-  backward_ = make(backward, 15, {{2, options_.depth_gradient_to_opacity ? 1u : 0u}});
-  reduce_ = make("splat/reduce_isect_grads", 5);
-  project_backward_ = make("splat/project_backward", 13);
-  buffers_->counters = std::make_unique<DeviceArray<uint32_t>>(context, "splat: counters", 4);
+  backward_ = make(backward, BWD_BINDING_COUNT, sizeof(RasterizeParams), {{2, options_.depth_gradient_to_opacity ? 1u : 0u}});
+  reduce_ = make("splat/reduce_isect_grads", REDUCE_BINDING_COUNT, sizeof(SplatView));
+  project_backward_ = make("splat/project_backward", PBWD_BINDING_COUNT, sizeof(SplatView));
+  buffers_->counters = std::make_unique<DeviceArray<uint32_t>>(context, "splat: counters", SPLAT_COUNTER_COUNT);
+  buffers_->counters->upload(std::vector<uint32_t>(SPLAT_COUNTER_COUNT, 0u));
+  buffers_->readback = std::make_unique<DeviceArray<uint32_t>>(context, "splat: readback", SPLAT_COUNTER_COUNT,
+                                                                engine::MemoryKind::kHostVisible);
+  const engine::DeviceInfo& info = context.info();
+  forward_entries_per_pass_ = options_.entries_per_pass
+                                  ? options_.entries_per_pass
+                                  : entries_within_budget(info, [&](uint32_t S) { return forward_loops_per_chunk(S, channels); });
+  backward_entries_per_pass_ =
+      options_.entries_per_pass ? options_.entries_per_pass : entries_within_budget(info, [&](uint32_t S) {
+        return backward_loops_per_chunk(S, channels, options_.deterministic);
+      });
+}
+
+uint32_t Rasterizer::passes_for(uint32_t entries_per_pass) const {
+  return static_cast<uint32_t>(std::max<uint64_t>(1, (uint64_t{longest_tile_list_} + entries_per_pass - 1) / entries_per_pass));
+}
+
+RasterizerCounters Rasterizer::read_counters() const {
+  const std::vector<uint32_t> c = buffers_->counters->download();
+  RasterizerCounters r;
+  r.culled_nonfinite = c[SPLAT_COUNTER_CULLED_NONFINITE];
+  r.longest_tile_list = longest_tile_list_;
+  r.forward_passes = forward_passes_;
+  r.backward_passes = backward_passes_;
+  r.walks_cut_short = uint64_t{c[SPLAT_COUNTER_FORWARD_WALKS_CUT]} + c[SPLAT_COUNTER_BACKWARD_WALKS_CUT];
+  return r;
 }
 
 Rasterizer::~Rasterizer() = default;
@@ -146,13 +210,13 @@ bool Rasterizer::uses_float_atomics() const {
   return !options_.deterministic && !options_.force_cas_atomics && context_->info().float_atomic_add;
 }
 
-std::unique_ptr<engine::Kernel> Rasterizer::make(const char* name, uint32_t bindings,
+std::unique_ptr<engine::Kernel> Rasterizer::make(const char* name, uint32_t bindings, uint32_t push_constant_bytes,
                                                  std::vector<engine::SpecConstant> extra_constants) {
   engine::KernelDesc desc;
   desc.name = name;
   desc.spirv = spirv(name);
   desc.binding_count = bindings;
-  desc.push_constant_bytes = sizeof(SplatView);
+  desc.push_constant_bytes = push_constant_bytes;
   desc.spec_constants = {{1, channels_}};
   desc.spec_constants.insert(desc.spec_constants.end(), extra_constants.begin(), extra_constants.end());
   return std::make_unique<engine::Kernel>(*context_, std::move(desc));
@@ -186,6 +250,11 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   const size_t pixels = static_cast<size_t>(camera.width) * camera.height;
   SplatView view = make_view(camera, n, K);
   const size_t tiles = static_cast<size_t>(view.tiles_x) * view.tiles_y;
+  // gather_counts sums a subgroup's tile counts in 32 bits: at most 128 lanes of at most `tiles` each.
+  if (tiles > (size_t{1} << 24))
+    throw std::invalid_argument("Rasterizer::forward: " + std::to_string(camera.width) + "x" +
+                                std::to_string(camera.height) + " pixels is more than 2^24 tiles");
+  const size_t corner_cells = static_cast<size_t>(view.tiles_x + 1) * (view.tiles_y + 1);
 
   ensure(ctx, b.means2d, 2 * size_t{n}, "splat: means2d");
   ensure(ctx, b.conics, 3 * size_t{n}, "splat: conics");
@@ -202,11 +271,14 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   ensure(ctx, b.alpha, pixels, "splat: alpha");
   ensure(ctx, b.last, pixels, "splat: last");
   ensure(ctx, b.ranges, 2 * tiles, "splat: tile ranges");
+  ensure(ctx, b.corners, corner_cells, "splat: tile corners");
   profile_.clear();
 
-  // 1. Project, sort by depth, count tiles per depth rank, scan.
+  // 1. Project, sort by depth, count tiles per depth rank (and their exact total), scan, list lengths.
   engine::Sequence s1(ctx);
-  s1.fill(b.counters->buffer(), 0u, 4 * sizeof(uint32_t));
+  // Zero the per-render counters; the walks-cut counters after them keep running.
+  s1.fill(b.counters->buffer(), 0u, (SPLAT_COUNTER_MAX_LIST + 1) * sizeof(uint32_t));
+  s1.fill(b.corners->buffer(), 0u, corner_cells * sizeof(uint32_t));
   s1.dispatch(*project_, elementwise(n),
               {{PROJECT_BINDING_MEANS, &g.means.buffer(), Access::kRead},
                {PROJECT_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
@@ -227,23 +299,37 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   s1.dispatch(*gather_, elementwise(n),
               {{GATHER_BINDING_ORDER, &b.order->buffer(), Access::kRead},
                {GATHER_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kRead},
-               {GATHER_BINDING_COUNTS, &b.counts->buffer(), Access::kWrite}},
+               {GATHER_BINDING_COUNTS, &b.counts->buffer(), Access::kWrite},
+               {GATHER_BINDING_CORNERS, &b.corners->buffer(), Access::kReadWrite},
+               {GATHER_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
               view);
   s1.copy(b.counts->buffer(), b.offsets->buffer(), uint64_t{n} * sizeof(uint32_t));
   scan_.record(s1, b.offsets->buffer(), n);
+  s1.dispatch(*lengths_, {1},
+              {{LENGTHS_BINDING_CORNERS, &b.corners->buffer(), Access::kReadWrite},
+               {LENGTHS_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
+              view);
+  s1.copy(b.counters->buffer(), b.readback->buffer(), SPLAT_COUNTER_COUNT * sizeof(uint32_t));
   s1.submit_and_wait();
   append_profile(s1);
 
-  // The one readback: how many (tile, Gaussian) intersections to emit and sort.
-  uint64_t m = 0;
-  if (n > 0) m = uint64_t{b.offsets->download(n - 1, 1)[0]} + b.counts->download(n - 1, 1)[0];
-  if (m > 0xFFFFFFFFull) throw std::length_error("Rasterizer::forward: more than 2^32 tile intersections");
+  // The one readback: how many (tile, Gaussian) intersections to emit and sort, and the longest tile list
+  // (how many rasterize passes it takes).
+  const std::vector<uint32_t> c = b.readback->download();
+  const uint64_t m = (uint64_t{c[SPLAT_COUNTER_ISECT_HI]} << 32) | c[SPLAT_COUNTER_ISECT_LO];
+  if (m > 0xFFFFFFFFull)
+    throw std::length_error("Rasterizer::forward: " + std::to_string(m) + " tile intersections (" + std::to_string(n) +
+                            " Gaussians on " + std::to_string(tiles) +
+                            " tiles) exceed the 2^32 an intersection id can index; render fewer or smaller Gaussians");
   intersections_ = m;
+  longest_tile_list_ = c[SPLAT_COUNTER_MAX_LIST];
+  forward_walks_cut_before_ = c[SPLAT_COUNTER_FORWARD_WALKS_CUT];
+  forward_passes_ = passes_for(forward_entries_per_pass_);
   ensure(ctx, b.tile_keys, m, "splat: tile keys");
   ensure(ctx, b.isect_ids, m, "splat: intersection ids");
   ensure(ctx, b.isect_gaussian, m, "splat: intersection gaussians");
 
-  // 2. Emit intersections in depth order, stable sort by tile, tile ranges, blend.
+  // 2. Emit intersections in depth order, stable sort by tile, tile ranges, blend in passes over the lists.
   engine::Sequence s2(ctx);
   s2.fill(b.ranges->buffer(), 0u, 2 * tiles * sizeof(uint32_t));
   s2.dispatch(*emit_, elementwise(n),
@@ -262,21 +348,22 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
               {{RANGES_BINDING_TILE_KEYS, &b.tile_keys->buffer(), Access::kRead},
                {RANGES_BINDING_RANGES, &b.ranges->buffer(), Access::kReadWrite}},
               ranges_view);
-  s2.dispatch(*forward_, {view.tiles_x, view.tiles_y},
-              {{FWD_BINDING_RANGES, &b.ranges->buffer(), Access::kRead},
-               {FWD_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kRead},
-               {FWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
-               {FWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
-               {FWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
-               {FWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
-               {FWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
-               {FWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
-               {FWD_BINDING_IMAGE, &b.image->buffer(), Access::kWrite},
-               {FWD_BINDING_DEPTH, &b.depth->buffer(), Access::kWrite},
-               {FWD_BINDING_ALPHA, &b.alpha->buffer(), Access::kWrite},
-               {FWD_BINDING_LAST, &b.last->buffer(), Access::kWrite},
-               {FWD_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
-              view);
+  for (uint32_t pass = 0; pass < forward_passes_; ++pass)
+    s2.dispatch(*forward_, {view.tiles_x, view.tiles_y},
+                {{FWD_BINDING_RANGES, &b.ranges->buffer(), Access::kRead},
+                 {FWD_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kRead},
+                 {FWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
+                 {FWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
+                 {FWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
+                 {FWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
+                 {FWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
+                 {FWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
+                 {FWD_BINDING_IMAGE, &b.image->buffer(), Access::kReadWrite},
+                 {FWD_BINDING_DEPTH, &b.depth->buffer(), Access::kReadWrite},
+                 {FWD_BINDING_ALPHA, &b.alpha->buffer(), Access::kReadWrite},
+                 {FWD_BINDING_LAST, &b.last->buffer(), Access::kReadWrite},
+                 {FWD_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
+                pass_params(view, pass, forward_entries_per_pass_));
   s2.submit_and_wait();
   append_profile(s2);
   last_gaussians_ = &g;
@@ -295,7 +382,9 @@ RenderImages<float> Rasterizer::download_images() {
   out.depth = b.depth->download(0, pixels);
   out.alpha = b.alpha->download(0, pixels);
   out.last = b.last->download(0, pixels);
-  out.culled_nonfinite = b.counters->download(0, 1)[0];
+  const std::vector<uint32_t> c = b.counters->download();
+  out.culled_nonfinite = c[SPLAT_COUNTER_CULLED_NONFINITE];
+  out.walks_cut_short = c[SPLAT_COUNTER_FORWARD_WALKS_CUT] - forward_walks_cut_before_;
   out.intersections = intersections_;
   return out;
 }
@@ -356,26 +445,32 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
   ensure(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
   ensure(ctx, b.g_means2d, 2 * size_t{n}, "splat: grad means2d");
   if (options_.deterministic) ensure(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
+  backward_passes_ = passes_for(backward_entries_per_pass_);
+  const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
+  ensure(ctx, b.backward_state, backward_passes_ > 1 ? pixels * (2 + channels_) : 1, "splat: backward state");
   const engine::Buffer& rows = options_.deterministic ? b.isect_grads->buffer() : b.grad2d->buffer();
   const uint64_t row_values = options_.deterministic ? intersections_ * stride : uint64_t{n} * stride;
   s.fill(rows, 0u, row_values * sizeof(float));
-  s.dispatch(*backward_, {view.tiles_x, view.tiles_y},
-             {{BWD_BINDING_RANGES, &b.ranges->buffer(), Access::kRead},
-              {BWD_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kRead},
-              {BWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
-              {BWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
-              {BWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
-              {BWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
-              {BWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
-              {BWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
-              {BWD_BINDING_DEPTH, &b.depth->buffer(), Access::kRead},
-              {BWD_BINDING_ALPHA, &b.alpha->buffer(), Access::kRead},
-              {BWD_BINDING_LAST, &b.last->buffer(), Access::kRead},
-              {BWD_BINDING_GRAD_IMAGE, &b.grad_image->buffer(), Access::kRead},
-              {BWD_BINDING_GRAD_DEPTH, &b.grad_depth->buffer(), Access::kRead},
-              {BWD_BINDING_GRAD_ALPHA, &b.grad_alpha->buffer(), Access::kRead},
-              {BWD_BINDING_GRAD2D, &rows, Access::kReadWrite}},
-             view);
+  for (uint32_t pass = backward_passes_; pass-- > 0;)  // last segment first
+    s.dispatch(*backward_, {view.tiles_x, view.tiles_y},
+               {{BWD_BINDING_RANGES, &b.ranges->buffer(), Access::kRead},
+                {BWD_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kRead},
+                {BWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
+                {BWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
+                {BWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
+                {BWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
+                {BWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
+                {BWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
+                {BWD_BINDING_DEPTH, &b.depth->buffer(), Access::kRead},
+                {BWD_BINDING_ALPHA, &b.alpha->buffer(), Access::kRead},
+                {BWD_BINDING_LAST, &b.last->buffer(), Access::kRead},
+                {BWD_BINDING_GRAD_IMAGE, &b.grad_image->buffer(), Access::kRead},
+                {BWD_BINDING_GRAD_DEPTH, &b.grad_depth->buffer(), Access::kRead},
+                {BWD_BINDING_GRAD_ALPHA, &b.grad_alpha->buffer(), Access::kRead},
+                {BWD_BINDING_GRAD2D, &rows, Access::kReadWrite},
+                {BWD_BINDING_STATE, &b.backward_state->buffer(), Access::kReadWrite},
+                {BWD_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
+               pass_params(view, pass, backward_entries_per_pass_));
   if (options_.deterministic)
     s.dispatch(*reduce_, elementwise(n),
                {{REDUCE_BINDING_ORDER, &b.order->buffer(), Access::kRead},

@@ -28,6 +28,20 @@ struct RasterizerOptions {
   // seen instead of moving them, and that trades against the image (README, Training). true: the exact
   // gradient.
   bool depth_gradient_to_opacity = true;
+  // List entries one rasterize pass walks per tile (kernels/splat/splat_shared.h); 0: derived per kernel from
+  // the device's subgroup size so that no pass exceeds a driver's loop limit (the default). Tests set it to
+  // force many passes on short lists, or one oversized pass.
+  uint32_t entries_per_pass = 0;
+};
+
+// Counters of a rasterizer's renders (Rasterizer::read_counters).
+struct RasterizerCounters {
+  uint32_t culled_nonfinite = 0;     // Gaussians culled for a non-finite parameter, last forward
+  uint32_t longest_tile_list = 0;    // entries in the longest tile list, last forward
+  uint32_t forward_passes = 0;       // rasterize passes of the last forward
+  uint32_t backward_passes = 0;      // ... and of the last backward
+  uint64_t walks_cut_short = 0;      // subgroup walks that a driver's loop limit ended early, all renders so
+                                     // far (forward + backward); 0 unless a pass size is wrong for the device
 };
 
 // A Gaussian model on the device, one buffer per attribute (structure of arrays, each binding bounded).
@@ -99,6 +113,12 @@ class Rasterizer {
   // records loss kernels before it and the optimizer after it.
   DeviceGrads record_backward(engine::Sequence& sequence);
 
+  // The counters (one small readback: call it when reporting, not every step).
+  RasterizerCounters read_counters() const;
+  // List entries per pass of the forward and of the backward on this device (see RasterizerOptions).
+  uint32_t forward_entries_per_pass() const { return forward_entries_per_pass_; }
+  uint32_t backward_entries_per_pass() const { return backward_entries_per_pass_; }
+
   // Per-kernel GPU times of the last forward (and backward, if run after it).
   const std::vector<engine::KernelTime>& profile() const { return profile_; }
   uint64_t intersections() const { return intersections_; }
@@ -107,8 +127,9 @@ class Rasterizer {
 
  private:
   struct Buffers;
-  std::unique_ptr<engine::Kernel> make(const char* name, uint32_t bindings,
+  std::unique_ptr<engine::Kernel> make(const char* name, uint32_t bindings, uint32_t push_constant_bytes,
                                        std::vector<engine::SpecConstant> extra_constants = {});
+  uint32_t passes_for(uint32_t entries_per_pass) const;
   void append_profile(const engine::Sequence& sequence);
 
   engine::Context* context_;
@@ -116,12 +137,15 @@ class Rasterizer {
   RasterizerOptions options_;
   RadixSort sort_;
   ExclusiveScan scan_;
-  std::unique_ptr<engine::Kernel> project_, gather_, emit_, ranges_, forward_, backward_, reduce_,
+  std::unique_ptr<engine::Kernel> project_, gather_, lengths_, emit_, ranges_, forward_, backward_, reduce_,
       project_backward_;
   std::unique_ptr<Buffers> buffers_;
   const DeviceGaussians* last_gaussians_ = nullptr;
   SplatCamera last_camera_;
   uint64_t intersections_ = 0;
+  uint32_t longest_tile_list_ = 0, forward_passes_ = 0, backward_passes_ = 0;
+  uint32_t forward_entries_per_pass_ = 0, backward_entries_per_pass_ = 0;
+  uint32_t forward_walks_cut_before_ = 0;  // the running counter before the last forward's passes
   std::vector<engine::KernelTime> profile_;
 };
 

@@ -42,12 +42,37 @@ using uint = uint32_t;
 #define PROJECT_BINDING_TILE_RECTS 10    // [N][4] tile x0 y0 x1 y1, half-open; empty if culled (out)
 #define PROJECT_BINDING_DEPTH_KEYS 11    // [N] sortable depth bits, 0xFFFFFFFF if culled (out)
 #define PROJECT_BINDING_ORDER 12         // [N] identity permutation, the depth sort's values (out)
-#define PROJECT_BINDING_COUNTERS 13      // [4] uint: [0] += Gaussians culled as non-finite (atomic)
+#define PROJECT_BINDING_COUNTERS 13      // [SPLAT_COUNTER_COUNT] uint, see SPLAT_COUNTER_*
+#define PROJECT_BINDING_COUNT 14
+
+// ---- The rasterizer's counters buffer: [SPLAT_COUNTER_COUNT] uint ----
+// Zeroed by every forward: culls, the intersection total and the longest tile list of that render.
+#define SPLAT_COUNTER_CULLED_NONFINITE 0   // Gaussians culled for a non-finite parameter (project.comp)
+#define SPLAT_COUNTER_ISECT_LO 1           // total tile intersections, low 32 bits (gather_counts.comp)
+#define SPLAT_COUNTER_ISECT_HI 2           // ... and the carries out of the low word: exact beyond 2^32
+#define SPLAT_COUNTER_MAX_LIST 3           // the longest tile list (tile_list_lengths.comp)
+// Never zeroed (the host reads running totals and takes differences): subgroup walks that a driver's
+// loop limit ended before the end of their list segment (lavapipe ends an invocation's loops silently
+// after 65535 iterations). The passes are sized so that this never happens; a non-zero value means a
+// loop-cost bound below is wrong for this device.
+#define SPLAT_COUNTER_FORWARD_WALKS_CUT 4
+#define SPLAT_COUNTER_BACKWARD_WALKS_CUT 5
+#define SPLAT_COUNTER_COUNT 8
 
 // ---- gather_counts.comp: one invocation per depth-sorted position ----
 #define GATHER_BINDING_ORDER 0           // [N] Gaussian index by depth rank
 #define GATHER_BINDING_TILE_RECTS 1      // [N][4]
 #define GATHER_BINDING_COUNTS 2          // [N] tiles touched, in depth order (out)
+#define GATHER_BINDING_CORNERS 3         // [(tiles_y + 1) * (tiles_x + 1)] uint, zeroed before: each
+                                         // rectangle adds +1 -1 -1 +1 at its corners (a 2D difference grid)
+#define GATHER_BINDING_COUNTERS 4        // SPLAT_COUNTER_ISECT_LO/HI (atomic)
+#define GATHER_BINDING_COUNT 5
+
+// ---- tile_list_lengths.comp: one workgroup; the corner grid's 2D prefix sum is each tile's list length ----
+#define LENGTHS_BINDING_CORNERS 0        // [(tiles_y + 1) * (tiles_x + 1)] in: differences; out: lengths
+#define LENGTHS_BINDING_COUNTERS 1       // SPLAT_COUNTER_MAX_LIST (out)
+#define LENGTHS_BINDING_COUNT 2
+#define LENGTHS_GROUP_SIZE 256
 
 // ---- emit_intersections.comp: one invocation per depth-sorted position ----
 #define EMIT_BINDING_ORDER 0             // [N]
@@ -56,12 +81,19 @@ using uint = uint32_t;
 #define EMIT_BINDING_TILE_KEYS 3         // [M] tile id (out)
 #define EMIT_BINDING_ISECT_IDS 4         // [M] intersection id = its emission position (out)
 #define EMIT_BINDING_ISECT_GAUSSIAN 5    // [M] Gaussian index of each intersection id (out)
+#define EMIT_BINDING_COUNT 6
 
 // ---- tile_ranges.comp: one invocation per sorted intersection ----
 #define RANGES_BINDING_TILE_KEYS 0       // [M] sorted tile ids
 #define RANGES_BINDING_RANGES 1          // [tiles][2] first, end (out; zero-filled before)
+#define RANGES_BINDING_COUNT 2
 
-// ---- rasterize_forward.comp: one workgroup per tile ----
+// ---- rasterize_forward.comp: one workgroup per tile and pass ----
+// A pass walks the entries [ListSegment.begin, ListSegment.end) of every tile's list. Between passes the
+// per-pixel blend state rides in the output buffers: image = the colour sum so far, depth = the sum of
+// w * z, alpha = the transmittance T, last = the walk length | FWD_LAST_DONE once the pixel has stopped.
+// A tile's final pass (its list ends within the segment) writes the outputs proper.
+#define FWD_LAST_DONE 0x80000000u
 #define FWD_BINDING_RANGES 0
 #define FWD_BINDING_ISECT_IDS 1          // [M] sorted by tile, depth order within a tile
 #define FWD_BINDING_ISECT_GAUSSIAN 2     // [M]
@@ -74,9 +106,13 @@ using uint = uint32_t;
 #define FWD_BINDING_DEPTH 9              // [H][W] expected depth sum(w z)/sum(w) (out)
 #define FWD_BINDING_ALPHA 10             // [H][W] accumulated alpha = 1 - T (out)
 #define FWD_BINDING_LAST 11              // [H][W] number of list entries the pixel walked (out)
-#define FWD_BINDING_COUNTERS 12          // the counters of project.comp; [1] += tiles truncated
+#define FWD_BINDING_COUNTERS 12          // SPLAT_COUNTER_FORWARD_WALKS_CUT (atomic)
+#define FWD_BINDING_COUNT 13
 
-// ---- rasterize_backward.comp: one workgroup per tile ----
+// ---- rasterize_backward.comp: one workgroup per tile and pass ----
+// Passes run from the last list segment to the first. A pixel's running state (transmittance, the colour
+// and depth sums of what lies behind) is stored in BWD_BINDING_STATE by the pass that walks past it and
+// loaded by the next; a pixel whose walk ends before a pass's segment starts from the forward's results.
 #define BWD_BINDING_RANGES 0
 #define BWD_BINDING_ISECT_IDS 1
 #define BWD_BINDING_ISECT_GAUSSIAN 2
@@ -92,6 +128,9 @@ using uint = uint32_t;
 #define BWD_BINDING_GRAD_DEPTH 12        // [H][W]
 #define BWD_BINDING_GRAD_ALPHA 13        // [H][W]
 #define BWD_BINDING_GRAD2D 14            // atomic mode: [N][7 + C] float; deterministic: [M][7 + C]
+#define BWD_BINDING_STATE 15             // [2 + C][H][W]: T, depth sum, colour sums (single pass: unused)
+#define BWD_BINDING_COUNTERS 16          // SPLAT_COUNTER_BACKWARD_WALKS_CUT (atomic)
+#define BWD_BINDING_COUNT 17
 
 // ---- reduce_isect_grads.comp (deterministic mode): one invocation per depth-sorted position ----
 #define REDUCE_BINDING_ORDER 0
@@ -99,6 +138,7 @@ using uint = uint32_t;
 #define REDUCE_BINDING_COUNTS 2
 #define REDUCE_BINDING_ISECT_GRADS 3     // [M][7 + C]
 #define REDUCE_BINDING_GRAD2D 4          // [N][7 + C] (out)
+#define REDUCE_BINDING_COUNT 5
 
 // ---- project_backward.comp: one invocation per Gaussian ----
 #define PBWD_BINDING_MEANS 0
@@ -114,6 +154,7 @@ using uint = uint32_t;
 #define PBWD_BINDING_GRAD_OPACITY_LOGITS 10  // [N] (out)
 #define PBWD_BINDING_GRAD_SH 11          // [N][K][C] (out)
 #define PBWD_BINDING_GRAD_MEANS2D 12     // [N][2] screen-space mean gradient, for densification (out)
+#define PBWD_BINDING_COUNT 13
 
 // The view: world-to-camera pose, pinhole intrinsics, image size. Push constants of every splat kernel.
 struct SplatView {
@@ -128,8 +169,22 @@ struct SplatView {
   uint sh_coeffs;      // K of the model's SH buffer (1, 4, 9 or 16)
 };
 
+// The list segment of one rasterize pass, in entries counted from each tile's list start: [begin, end).
+struct ListSegment {
+  uint begin;
+  uint end;
+};
+
+// Push constants of rasterize_forward and rasterize_backward.
+struct RasterizeParams {
+  SplatView view;
+  ListSegment segment;
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(SplatView) <= 128);
+static_assert(sizeof(RasterizeParams) <= 128);
+static_assert(sizeof(SplatView) % 4 == 0, "the segment follows the view at a 4-byte boundary, as std430");
 }  // namespace litgs::kernels
 #endif
 #endif

@@ -49,6 +49,7 @@ struct RenderImages {
   std::vector<uint32_t> last;     // [H][W] entries of the pixel's tile list walked (for backward)
   uint32_t culled_nonfinite = 0;  // Gaussians with a non-finite parameter (culled, counted)
   uint64_t intersections = 0;     // (Gaussian, tile) pairs
+  uint32_t walks_cut_short = 0;   // subgroup walks a driver's loop limit ended early (device; 0 expected)
 };
 
 // Upstream gradients of a render's outputs.

@@ -1,5 +1,13 @@
-// The view of every splat kernel, from push constants, as the shared math's ViewGeometry.
+// The view of every splat kernel, from push constants, as the shared math's ViewGeometry. The rasterize
+// kernels define SPLAT_RASTERIZE_PASS: their push constants add the pass's list segment (RasterizeParams).
+#ifdef SPLAT_RASTERIZE_PASS
+layout(push_constant) uniform Push {
+  SplatView view;
+  ListSegment segment;
+};
+#else
 layout(push_constant) uniform Push { SplatView view; };
+#endif
 
 ViewGeometry view_geometry() {
   ViewGeometry v;
