@@ -63,6 +63,8 @@ void run_bench_render(const BenchRenderOptions& o) {
     total_ms.push_back(f + b);
   }
   const auto& profile = rasterizer.profile();
+  const kernels::RasterizerCounters counters = rasterizer.read_counters();
+  const double per_gaussian = o.gaussians ? static_cast<double>(rasterizer.intersections()) / o.gaussians : 0.0;
   if (o.json) {
     nlohmann::json kernels = nlohmann::json::array();
     for (const auto& k : profile) kernels.push_back({{"name", k.name}, {"ms", k.ms}, {"dispatches", k.dispatches}});
@@ -70,7 +72,12 @@ void run_bench_render(const BenchRenderOptions& o) {
                         {"height", o.height},             {"sh_degree", o.sh_degree},
                         {"channels", o.channels},         {"runs", o.runs},
                         {"forward_ms", median(forward_ms)}, {"intersections", rasterizer.intersections()},
-                        {"kernels", kernels},             {"device", device_json(context.info())}};
+                        {"kernels", kernels},             {"device", device_json(context.info())},
+                        {"intersections_per_gaussian", per_gaussian},
+                        {"longest_tile_list", counters.longest_tile_list},
+                        {"forward_passes", counters.forward_passes},
+                        {"backward_passes", counters.backward_passes},
+                        {"walks_cut_short", counters.walks_cut_short}};
     if (o.backward) j["forward_backward_ms"] = median(total_ms);
     std::cout << j.dump(2) << "\n";
     return;
@@ -78,7 +85,11 @@ void run_bench_render(const BenchRenderOptions& o) {
   std::cout << std::fixed << std::setprecision(2) << "bench render: " << o.gaussians << " Gaussians, " << o.width
             << "x" << o.height << ", " << o.channels << " channel(s), SH degree " << o.sh_degree << ", median of "
             << o.runs << " runs after a warm-up, on " << context.info().name << "\n"
-            << "  intersections        " << rasterizer.intersections() << "\n"
+            << "  intersections        " << rasterizer.intersections() << " (" << per_gaussian << " per Gaussian)\n"
+            << "  longest tile list    " << counters.longest_tile_list << " entries: " << counters.forward_passes
+            << " forward pass(es) of " << rasterizer.forward_entries_per_pass() << ", " << counters.backward_passes
+            << " backward pass(es) of " << rasterizer.backward_entries_per_pass() << "\n"
+            << "  walks cut short      " << counters.walks_cut_short << " (a driver's loop limit; must be 0)\n"
             << "  forward              " << median(forward_ms) << " ms\n";
   if (o.backward)
     std::cout << "  forward + backward   " << median(total_ms) << " ms"
