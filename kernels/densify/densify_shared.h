@@ -28,6 +28,7 @@ using uint = uint32_t;
 #define STATS_BINDING_GRAD_ACCUM 6      // [N] float += |(dL/du W/2, dL/dv H/2)| where visible
 #define STATS_BINDING_DENOM 7           // [N] uint += 1 where visible
 #define STATS_BINDING_MAX_RADIUS 8      // [N] float = max(., max(extent.x, extent.y)) pixels where visible
+#define STATS_BINDING_COUNT 9
 
 // ---- densify_candidates.comp and densify_decide.comp (push constants: DensifyParams) ----
 #define DECIDE_BINDING_MEANS 0           // [N][3]
@@ -44,7 +45,7 @@ using uint = uint32_t;
 #define DECIDE_BINDING_DECISION 11       // [N] uint DENSIFY_KIND_* | DENSIFY_SLOT_A | DENSIFY_SLOT_B (decide)
 #define DECIDE_BINDING_COUNTS 12         // [N] uint rows written: 0, 1 or 2 (decide)
 #define DECIDE_BINDING_REPORT 13         // [DENSIFY_REPORT_SLOTS] uint (decide, atomic)
-#define DECIDE_BINDINGS 14
+#define DECIDE_BINDING_COUNT 14
 
 // Decision word.
 #define DENSIFY_KIND_MASK 3u
@@ -101,6 +102,7 @@ struct DensifyParams {
 #define SCATTER_BINDING_OFFSETS 1   // [N] exclusive scan of counts
 #define SCATTER_BINDING_SRC 2       // [N][stride] 32-bit words
 #define SCATTER_BINDING_DST 3       // [new N][stride]
+#define SCATTER_BINDING_COUNT 4
 
 // ---- densify_scatter_geometry.comp (push constants: ScatterParams): means and log-scales ----
 #define GEOMETRY_BINDING_DECISION 0
@@ -110,6 +112,7 @@ struct DensifyParams {
 #define GEOMETRY_BINDING_QUATS 4           // [N][4]
 #define GEOMETRY_BINDING_MEANS_OUT 5       // [new N][3]
 #define GEOMETRY_BINDING_LOG_SCALES_OUT 6  // [new N][3]
+#define GEOMETRY_BINDING_COUNT 7
 
 struct ScatterParams {
   uint count;     // N
@@ -123,6 +126,7 @@ struct ScatterParams {
 
 // ---- densify_reset_opacity.comp (push constants: ResetOpacityParams) ----
 #define RESET_BINDING_OPACITY_LOGITS 0  // [N] updated in place
+#define RESET_BINDING_COUNT 1
 
 struct ResetOpacityParams {
   uint count;
@@ -134,6 +138,11 @@ struct ResetOpacityParams {
 static_assert(sizeof(DensifyParams) <= 128);
 static_assert(sizeof(ScatterParams) <= 128);
 static_assert(sizeof(ResetOpacityParams) <= 128);
+static_assert(STATS_BINDING_COUNT == STATS_BINDING_MAX_RADIUS + 1);
+static_assert(DECIDE_BINDING_COUNT == DECIDE_BINDING_REPORT + 1);
+static_assert(SCATTER_BINDING_COUNT == SCATTER_BINDING_DST + 1);
+static_assert(GEOMETRY_BINDING_COUNT == GEOMETRY_BINDING_LOG_SCALES_OUT + 1);
+static_assert(RESET_BINDING_COUNT == RESET_BINDING_OPACITY_LOGITS + 1);
 }  // namespace litgs::kernels
 #endif
 #endif

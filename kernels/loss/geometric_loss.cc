@@ -11,7 +11,7 @@ namespace litgs::kernels {
 using engine::Access;
 
 GeometricLoss::GeometricLoss(engine::Context& context) : context_(&context), sum_(context) {
-  kernel_ = loss_detail::make_kernel(context, "loss/geometric", 5, sizeof(GeometricParams));
+  kernel_ = loss_detail::make_kernel(context, "loss/geometric", GEOMETRIC_BINDING_COUNT, sizeof(GeometricParams));
 }
 
 GeometricLoss::~GeometricLoss() = default;

@@ -31,6 +31,7 @@ using uint = uint32_t;
 #define SSIM_MOMENTS_BINDING_TARGET 1  // [C][H][W] y
 #define SSIM_MOMENTS_BINDING_OUT4 2    // [C][H][W][4] row sums G*x, G*y, G*x^2, G*y^2 (out)
 #define SSIM_MOMENTS_BINDING_OUT1 3    // [C][H][W] row sums G*xy (out)
+#define SSIM_MOMENTS_BINDING_COUNT 4
 
 // ---- ssim_pixel.comp: one invocation per element: vertical blur, SSIM, its partials, the L1 term ----
 #define SSIM_PIXEL_BINDING_IMAGE 0     // [C][H][W] x
@@ -39,16 +40,19 @@ using uint = uint32_t;
 #define SSIM_PIXEL_BINDING_MOMENTS1 3  // [C][H][W] from ssim_moments_h
 #define SSIM_PIXEL_BINDING_PARTIALS 4  // [C][H][W][4] dL/d(mu_x), dL/d(E[x^2]), dL/d(E[xy]), 0 (out)
 #define SSIM_PIXEL_BINDING_TERMS 5     // [C][H][W][2] (1 - SSIM, |x - y|) (out)
+#define SSIM_PIXEL_BINDING_COUNT 6
 
 // ---- ssim_partials_h.comp: one invocation per element, horizontal blur of the three partial maps ----
 #define SSIM_PARTIALS_BINDING_IN 0   // [C][H][W][4]
 #define SSIM_PARTIALS_BINDING_OUT 1  // [C][H][W][4] (out)
+#define SSIM_PARTIALS_BINDING_COUNT 2
 
 // ---- ssim_backward.comp: one invocation per element: vertical blur of the partials, combine ----
 #define SSIM_BACKWARD_BINDING_IMAGE 0     // [C][H][W] x
 #define SSIM_BACKWARD_BINDING_TARGET 1    // [C][H][W] y
 #define SSIM_BACKWARD_BINDING_PARTIALS 2  // [C][H][W][4] from ssim_partials_h
 #define SSIM_BACKWARD_BINDING_GRAD 3      // [C][H][W] weight * dL_pho/dx (out, overwritten)
+#define SSIM_BACKWARD_BINDING_COUNT 4
 
 // Push constants of the four photometric kernels.
 struct PhotometricParams {
@@ -67,6 +71,7 @@ struct PhotometricParams {
 #define GEOMETRIC_BINDING_NORMALS 2  // [H][W][4] unit plane normal nx ny nz, 0
 #define GEOMETRIC_BINDING_GRAD 3     // [H][W] weight * dL_geo/dD, metres^-1 * m^2 (out, overwritten)
 #define GEOMETRIC_BINDING_TERMS 4    // [H][W][2] (rho(r), 1 if the pixel counted else 0) (out)
+#define GEOMETRIC_BINDING_COUNT 5
 
 struct GeometricParams {
   uint width, height;
@@ -87,8 +92,10 @@ struct GeometricParams {
 #define LOSS_REDUCE_ROWS_PER_GROUP (256 * LOSS_REDUCE_ROWS_PER_THREAD)
 #define REDUCE_BLOCKS_BINDING_ROWS 0  // [count][2]
 #define REDUCE_BLOCKS_BINDING_SUMS 1  // [blocks][2] (out)
+#define REDUCE_BLOCKS_BINDING_COUNT 2
 #define REDUCE_FINISH_BINDING_SUMS 0  // [blocks][2]
 #define REDUCE_FINISH_BINDING_OUT 1   // float loss buffer: [slot .. slot + outputs) written
+#define REDUCE_FINISH_BINDING_COUNT 2
 
 // With (s0, s1) the sums of the two columns, output j (j < outputs) is
 //   out[slot + j] = bias_j + w_j0 * s0 + w_j1 * s1.
@@ -106,6 +113,13 @@ struct ReduceParams {
 static_assert(sizeof(PhotometricParams) <= 128 && sizeof(PhotometricParams) % 16 == 0);
 static_assert(sizeof(GeometricParams) <= 128 && sizeof(GeometricParams) % 16 == 0);
 static_assert(sizeof(ReduceParams) <= 128 && sizeof(ReduceParams) % 16 == 0);
+static_assert(SSIM_MOMENTS_BINDING_COUNT == SSIM_MOMENTS_BINDING_OUT1 + 1);
+static_assert(SSIM_PIXEL_BINDING_COUNT == SSIM_PIXEL_BINDING_TERMS + 1);
+static_assert(SSIM_PARTIALS_BINDING_COUNT == SSIM_PARTIALS_BINDING_OUT + 1);
+static_assert(SSIM_BACKWARD_BINDING_COUNT == SSIM_BACKWARD_BINDING_GRAD + 1);
+static_assert(GEOMETRIC_BINDING_COUNT == GEOMETRIC_BINDING_TERMS + 1);
+static_assert(REDUCE_BLOCKS_BINDING_COUNT == REDUCE_BLOCKS_BINDING_SUMS + 1);
+static_assert(REDUCE_FINISH_BINDING_COUNT == REDUCE_FINISH_BINDING_OUT + 1);
 }  // namespace litgs::kernels
 #endif
 #endif

@@ -38,8 +38,8 @@ void ensure(engine::Context& context, std::unique_ptr<engine::Buffer>& buffer, u
 }
 
 LossSum::LossSum(engine::Context& context) : context_(&context) {
-  blocks_ = make_kernel(context, "loss/reduce_blocks", 2, sizeof(ReduceParams));
-  finish_ = make_kernel(context, "loss/reduce_finish", 2, sizeof(ReduceParams));
+  blocks_ = make_kernel(context, "loss/reduce_blocks", REDUCE_BLOCKS_BINDING_COUNT, sizeof(ReduceParams));
+  finish_ = make_kernel(context, "loss/reduce_finish", REDUCE_FINISH_BINDING_COUNT, sizeof(ReduceParams));
 }
 
 namespace {

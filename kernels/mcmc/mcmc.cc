@@ -54,13 +54,13 @@ std::string McmcReport::to_string() const {
 }
 
 McmcStrategy::McmcStrategy(engine::Context& context) : context_(&context), scan_(context) {
-  weights_ = make_kernel(context, "mcmc/mcmc_weights", 8, sizeof(McmcParams));
-  list_dead_ = make_kernel(context, "mcmc/mcmc_list_dead", 3, sizeof(McmcParams));
-  sample_ = make_kernel(context, "mcmc/mcmc_sample", 5, sizeof(McmcParams));
-  update_sources_ = make_kernel(context, "mcmc/mcmc_update_sources", 3, sizeof(McmcParams));
-  copy_rows_ = make_kernel(context, "mcmc/mcmc_copy_rows", 3, sizeof(CopyRowsParams));
-  noise_ = make_kernel(context, "mcmc/mcmc_noise", 4, sizeof(McmcParams));
-  regularize_ = make_kernel(context, "mcmc/mcmc_regularize", 4, sizeof(McmcParams));
+  weights_ = make_kernel(context, "mcmc/mcmc_weights", WEIGHTS_BINDING_COUNT, sizeof(McmcParams));
+  list_dead_ = make_kernel(context, "mcmc/mcmc_list_dead", LIST_BINDING_COUNT, sizeof(McmcParams));
+  sample_ = make_kernel(context, "mcmc/mcmc_sample", SAMPLE_BINDING_COUNT, sizeof(McmcParams));
+  update_sources_ = make_kernel(context, "mcmc/mcmc_update_sources", UPDATE_BINDING_COUNT, sizeof(McmcParams));
+  copy_rows_ = make_kernel(context, "mcmc/mcmc_copy_rows", COPY_BINDING_COUNT, sizeof(CopyRowsParams));
+  noise_ = make_kernel(context, "mcmc/mcmc_noise", NOISE_BINDING_COUNT, sizeof(McmcParams));
+  regularize_ = make_kernel(context, "mcmc/mcmc_regularize", REG_BINDING_COUNT, sizeof(McmcParams));
   report_ = std::make_unique<DeviceArray<uint32_t>>(context, "mcmc: report", MCMC_REPORT_SLOTS);
   no_plane_ = std::make_unique<DeviceArray<float>>(context, "mcmc: no plane distances", 1);
 }

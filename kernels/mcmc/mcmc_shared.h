@@ -34,11 +34,13 @@ using uint = uint32_t;
 #define WEIGHTS_BINDING_WEIGHT 5          // [N] uint: 0 for dead rows
 #define WEIGHTS_BINDING_DEAD 6            // [N] uint 0/1
 #define WEIGHTS_BINDING_REPORT 7          // [MCMC_REPORT_SLOTS] uint (atomic)
+#define WEIGHTS_BINDING_COUNT 8
 
 // ---- mcmc_list_dead.comp (push constants: McmcParams) ----
 #define LIST_BINDING_DEAD 0        // [N] uint 0/1
 #define LIST_BINDING_DEAD_RANK 1   // [N] uint exclusive scan of DEAD
 #define LIST_BINDING_DEAD_INDEX 2  // [dead] uint
+#define LIST_BINDING_COUNT 3
 
 // ---- mcmc_sample.comp (push constants: McmcParams; targets = dead + added) ----
 #define SAMPLE_BINDING_CDF 0         // [N] uint exclusive scan of the weights
@@ -46,16 +48,19 @@ using uint = uint32_t;
 #define SAMPLE_BINDING_SOURCE 2      // [targets] uint row to copy from
 #define SAMPLE_BINDING_TARGET 3      // [targets] uint row to write: dead_index[t], or N + t - dead
 #define SAMPLE_BINDING_COPIES 4      // [N] uint += 1 per draw (atomic; zeroed before)
+#define SAMPLE_BINDING_COUNT 5
 
 // ---- mcmc_update_sources.comp (push constants: McmcParams) ----
 #define UPDATE_BINDING_COPIES 0         // [N]
 #define UPDATE_BINDING_OPACITY_LOGITS 1  // [N] updated in place
 #define UPDATE_BINDING_LOG_SCALES 2      // [N][3] updated in place
+#define UPDATE_BINDING_COUNT 3
 
 // ---- mcmc_copy_rows.comp (push constants: CopyRowsParams) ----
 #define COPY_BINDING_SOURCE 0  // [targets]
 #define COPY_BINDING_TARGET 1  // [targets]
 #define COPY_BINDING_ROWS 2    // [rows][stride] 32-bit words, updated in place
+#define COPY_BINDING_COUNT 3
 #define COPY_MODE_SOURCE_TO_TARGET 0u  // rows[target[t]] = rows[source[t]]
 #define COPY_MODE_ZERO_TARGET 1u       // rows[target[t]] = 0
 #define COPY_MODE_ZERO_SOURCE 2u       // rows[source[t]] = 0 (a relocated source's moments restart)
@@ -65,12 +70,14 @@ using uint = uint32_t;
 #define NOISE_BINDING_LOG_SCALES 1      // [N][3]
 #define NOISE_BINDING_QUATS 2           // [N][4]
 #define NOISE_BINDING_OPACITY_LOGITS 3  // [N]
+#define NOISE_BINDING_COUNT 4
 
 // ---- mcmc_regularize.comp (push constants: McmcParams) ----
 #define REG_BINDING_OPACITY_LOGITS 0  // [N]
 #define REG_BINDING_LOG_SCALES 1      // [N][3]
 #define REG_BINDING_GRAD_OPACITY 2    // [N] += opacity_reg / N * o (1 - o)
 #define REG_BINDING_GRAD_LOG_SCALES 3  // [N][3] += scale_reg / (3N) * exp(log_scale)
+#define REG_BINDING_COUNT 4
 
 // Flags of McmcParams.flags.
 #define MCMC_FLAG_PLANE 1u  // a Gaussian farther than max_plane_distance from its LiDAR plane is dead
@@ -112,6 +119,13 @@ struct CopyRowsParams {
 #ifdef __cplusplus
 static_assert(sizeof(McmcParams) <= 128);
 static_assert(sizeof(CopyRowsParams) <= 128);
+static_assert(WEIGHTS_BINDING_COUNT == WEIGHTS_BINDING_REPORT + 1);
+static_assert(LIST_BINDING_COUNT == LIST_BINDING_DEAD_INDEX + 1);
+static_assert(SAMPLE_BINDING_COUNT == SAMPLE_BINDING_COPIES + 1);
+static_assert(UPDATE_BINDING_COUNT == UPDATE_BINDING_LOG_SCALES + 1);
+static_assert(COPY_BINDING_COUNT == COPY_BINDING_ROWS + 1);
+static_assert(NOISE_BINDING_COUNT == NOISE_BINDING_OPACITY_LOGITS + 1);
+static_assert(REG_BINDING_COUNT == REG_BINDING_GRAD_LOG_SCALES + 1);
 }  // namespace litgs::kernels
 #endif
 #endif

@@ -75,7 +75,7 @@ AdamKernel::AdamKernel(engine::Context& context) {
   engine::KernelDesc desc;
   desc.name = "optim/adam";
   desc.spirv = spirv("optim/adam");
-  desc.binding_count = 5;
+  desc.binding_count = ADAM_BINDING_COUNT;
   desc.push_constant_bytes = sizeof(AdamParams);
   kernel_ = std::make_unique<engine::Kernel>(context, std::move(desc));
 }

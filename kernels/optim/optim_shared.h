@@ -16,6 +16,7 @@ using uint = uint32_t;
 #define ADAM_BINDING_EXP_AVG 2     // [count] float first moment m, updated in place
 #define ADAM_BINDING_EXP_AVG_SQ 3  // [count] float second moment v, updated in place
 #define ADAM_BINDING_COUNTERS 4    // [ADAM_COUNTER_SLOTS] uint: [counter_slot] += elements skipped (atomic)
+#define ADAM_BINDING_COUNT 5
 
 // One counter per parameter group: elements whose gradient (or whose updated value) was not finite. Such an
 // element keeps its parameter and both moments.
@@ -38,6 +39,7 @@ struct AdamParams {
 
 #ifdef __cplusplus
 static_assert(sizeof(AdamParams) <= 128);
+static_assert(ADAM_BINDING_COUNT == ADAM_BINDING_COUNTERS + 1);
 }  // namespace litgs::kernels
 #endif
 #endif

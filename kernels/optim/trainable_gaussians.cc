@@ -81,12 +81,12 @@ TrainableGaussians::TrainableGaussians(engine::Context& context, const TrainingS
       scan_(context) {
   adam_options_.check();
   state.check();
-  stats_ = make_kernel(context, "densify/densify_stats", 9, sizeof(SplatView));
-  candidates_ = make_kernel(context, "densify/densify_candidates", DECIDE_BINDINGS, sizeof(DensifyParams));
-  decide_ = make_kernel(context, "densify/densify_decide", DECIDE_BINDINGS, sizeof(DensifyParams));
-  scatter_rows_ = make_kernel(context, "densify/densify_scatter_rows", 4, sizeof(ScatterParams));
-  scatter_geometry_ = make_kernel(context, "densify/densify_scatter_geometry", 7, sizeof(ScatterParams));
-  reset_opacity_ = make_kernel(context, "densify/densify_reset_opacity", 1, sizeof(ResetOpacityParams));
+  stats_ = make_kernel(context, "densify/densify_stats", STATS_BINDING_COUNT, sizeof(SplatView));
+  candidates_ = make_kernel(context, "densify/densify_candidates", DECIDE_BINDING_COUNT, sizeof(DensifyParams));
+  decide_ = make_kernel(context, "densify/densify_decide", DECIDE_BINDING_COUNT, sizeof(DensifyParams));
+  scatter_rows_ = make_kernel(context, "densify/densify_scatter_rows", SCATTER_BINDING_COUNT, sizeof(ScatterParams));
+  scatter_geometry_ = make_kernel(context, "densify/densify_scatter_geometry", GEOMETRY_BINDING_COUNT, sizeof(ScatterParams));
+  reset_opacity_ = make_kernel(context, "densify/densify_reset_opacity", RESET_BINDING_COUNT, sizeof(ResetOpacityParams));
   adam_counters_ =
       std::make_unique<DeviceArray<uint32_t>>(context, "optim: adam counters", ADAM_COUNTER_SLOTS);
   adam_counters_->upload(std::vector<uint32_t>(ADAM_COUNTER_SLOTS, 0u));

@@ -26,8 +26,8 @@ ExclusiveScan::ExclusiveScan(engine::Context& context, ScanOptions options)
   const uint32_t width = subgroup_width(context);
   options.check(width);
   block_size_ = options.block_size != 0 ? options.block_size : width * 256;
-  reduce_ = make_subgroup_kernel(context, "scan/scan_reduce", 2, sizeof(ScanParams));
-  downsweep_ = make_subgroup_kernel(context, "scan/scan_downsweep", 2, sizeof(ScanParams));
+  reduce_ = make_subgroup_kernel(context, "scan/scan_reduce", SCAN_REDUCE_BINDING_COUNT, sizeof(ScanParams));
+  downsweep_ = make_subgroup_kernel(context, "scan/scan_downsweep", SCAN_DOWNSWEEP_BINDING_COUNT, sizeof(ScanParams));
 }
 
 ExclusiveScan::~ExclusiveScan() = default;

@@ -13,10 +13,12 @@ using uint = uint32_t;
 // scan_reduce.comp
 #define SCAN_REDUCE_BINDING_DATA 0        // [count] read
 #define SCAN_REDUCE_BINDING_BLOCK_SUMS 1  // [block_count] written: sum of each block
+#define SCAN_REDUCE_BINDING_COUNT 2
 
 // scan_downsweep.comp
 #define SCAN_DOWNSWEEP_BINDING_DATA 0           // [count] scanned in place
 #define SCAN_DOWNSWEEP_BINDING_BLOCK_OFFSETS 1  // [block_count] read when use_block_offsets != 0
+#define SCAN_DOWNSWEEP_BINDING_COUNT 2
 
 struct ScanParams {
   uint count;              // elements to scan
@@ -27,6 +29,8 @@ struct ScanParams {
 
 #ifdef __cplusplus
 static_assert(sizeof(ScanParams) <= 128);
+static_assert(SCAN_REDUCE_BINDING_COUNT == SCAN_REDUCE_BINDING_BLOCK_SUMS + 1);
+static_assert(SCAN_DOWNSWEEP_BINDING_COUNT == SCAN_DOWNSWEEP_BINDING_BLOCK_OFFSETS + 1);
 }  // namespace litgs::kernels
 #endif
 #endif

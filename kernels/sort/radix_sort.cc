@@ -25,8 +25,8 @@ RadixSort::RadixSort(engine::Context& context, RadixSortOptions options)
     : context_(&context), options_(options), width_(subgroup_width(context)), scan_(context) {
   options_.check();
   if (options_.max_blocks == 0) options_.max_blocks = context.info().type == "cpu" ? 64 : 2048;
-  histogram_ = make_subgroup_kernel(context, "sort/radix_histogram", 2, sizeof(RadixPassParams));
-  scatter_ = make_subgroup_kernel(context, "sort/radix_scatter", 5, sizeof(RadixPassParams));
+  histogram_ = make_subgroup_kernel(context, "sort/radix_histogram", RADIX_HISTOGRAM_BINDING_COUNT, sizeof(RadixPassParams));
+  scatter_ = make_subgroup_kernel(context, "sort/radix_scatter", RADIX_SCATTER_BINDING_COUNT, sizeof(RadixPassParams));
 }
 
 RadixSort::~RadixSort() = default;

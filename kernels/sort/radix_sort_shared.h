@@ -17,6 +17,7 @@ using uint = uint32_t;
 // radix_histogram.comp
 #define RADIX_HISTOGRAM_BINDING_KEYS 0    // [count] read
 #define RADIX_HISTOGRAM_BINDING_COUNTS 1  // [RADIX_BUCKETS][block_count] written, digit-major
+#define RADIX_HISTOGRAM_BINDING_COUNT 2
 
 // radix_scatter.comp
 #define RADIX_SCATTER_BINDING_KEYS_IN 0     // [count] read
@@ -24,6 +25,7 @@ using uint = uint32_t;
 #define RADIX_SCATTER_BINDING_OFFSETS 2     // [RADIX_BUCKETS][block_count] read: scanned counts
 #define RADIX_SCATTER_BINDING_KEYS_OUT 3    // [count] written
 #define RADIX_SCATTER_BINDING_VALUES_OUT 4  // [count] written
+#define RADIX_SCATTER_BINDING_COUNT 5
 
 struct RadixPassParams {
   uint count;        // pairs to sort
@@ -35,6 +37,8 @@ struct RadixPassParams {
 
 #ifdef __cplusplus
 static_assert(sizeof(RadixPassParams) <= 128);
+static_assert(RADIX_HISTOGRAM_BINDING_COUNT == RADIX_HISTOGRAM_BINDING_COUNTS + 1);
+static_assert(RADIX_SCATTER_BINDING_COUNT == RADIX_SCATTER_BINDING_VALUES_OUT + 1);
 }  // namespace litgs::kernels
 #endif
 #endif

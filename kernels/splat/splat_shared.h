@@ -185,6 +185,15 @@ struct RasterizeParams {
 static_assert(sizeof(SplatView) <= 128);
 static_assert(sizeof(RasterizeParams) <= 128);
 static_assert(sizeof(SplatView) % 4 == 0, "the segment follows the view at a 4-byte boundary, as std430");
+static_assert(PROJECT_BINDING_COUNT == PROJECT_BINDING_COUNTERS + 1);
+static_assert(GATHER_BINDING_COUNT == GATHER_BINDING_COUNTERS + 1);
+static_assert(LENGTHS_BINDING_COUNT == LENGTHS_BINDING_COUNTERS + 1);
+static_assert(EMIT_BINDING_COUNT == EMIT_BINDING_ISECT_GAUSSIAN + 1);
+static_assert(RANGES_BINDING_COUNT == RANGES_BINDING_RANGES + 1);
+static_assert(FWD_BINDING_COUNT == FWD_BINDING_COUNTERS + 1);
+static_assert(BWD_BINDING_COUNT == BWD_BINDING_COUNTERS + 1);
+static_assert(REDUCE_BINDING_COUNT == REDUCE_BINDING_GRAD2D + 1);
+static_assert(PBWD_BINDING_COUNT == PBWD_BINDING_GRAD_MEANS2D + 1);
 }  // namespace litgs::kernels
 #endif
 #endif
