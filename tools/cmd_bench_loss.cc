@@ -15,6 +15,7 @@
 #include "tools/bench_stats.h"
 #include "tools/commands.h"
 #include "tools/device_json.h"
+#include "tools/kernel_profile.h"
 
 namespace litgs::tools {
 namespace {
@@ -64,9 +65,6 @@ void run_bench_loss(const BenchLossOptions& o) {
   const auto values = out.download();
   const auto profile = seq.profile();
   if (o.json) {
-    nlohmann::json kernels = nlohmann::json::array();
-    for (const auto& k : profile)
-      kernels.push_back({{"name", k.name}, {"ms", k.ms}, {"dispatches", k.dispatches}});
     nlohmann::json j = {{"width", o.width},
                         {"height", o.height},
                         {"channels", o.channels},
@@ -76,7 +74,7 @@ void run_bench_loss(const BenchLossOptions& o) {
                         {"loss", values[0]},
                         {"mean_ssim", values[1]},
                         {"mean_l1", values[2]},
-                        {"kernels", kernels},
+                        {"kernels", kernel_profile_json(profile)},
                         {"device", device_json(context.info())}};
     std::cout << j.dump(2) << "\n";
     return;
@@ -87,11 +85,8 @@ void run_bench_loss(const BenchLossOptions& o) {
             << "  forward + backward   " << median(wall_ms) << " ms (submit to wait), " << median(device_ms)
             << " ms GPU\n"
             << std::setprecision(5) << "  loss " << values[0] << ", mean SSIM " << values[1] << ", mean L1 "
-            << values[2] << "\n"
-            << std::setprecision(2) << "  per kernel (last run, GPU timestamps):\n";
-  for (const auto& k : profile)
-    std::cout << "    " << std::left << std::setw(42) << k.name << std::right << std::setw(3) << k.dispatches
-              << "x " << std::setw(9) << k.ms << " ms\n";
+            << values[2] << "\n";
+  print_kernel_profile(std::cout, profile);
 }
 
 }  // namespace

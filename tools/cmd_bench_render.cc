@@ -14,6 +14,7 @@
 #include "tools/bench_stats.h"
 #include "tools/commands.h"
 #include "tools/device_json.h"
+#include "tools/kernel_profile.h"
 
 namespace litgs::tools {
 namespace {
@@ -66,13 +67,11 @@ void run_bench_render(const BenchRenderOptions& o) {
   const kernels::RasterizerCounters counters = rasterizer.read_counters();
   const double per_gaussian = o.gaussians ? static_cast<double>(rasterizer.intersections()) / o.gaussians : 0.0;
   if (o.json) {
-    nlohmann::json kernels = nlohmann::json::array();
-    for (const auto& k : profile) kernels.push_back({{"name", k.name}, {"ms", k.ms}, {"dispatches", k.dispatches}});
     nlohmann::json j = {{"gaussians", o.gaussians},       {"width", o.width},
                         {"height", o.height},             {"sh_degree", o.sh_degree},
                         {"channels", o.channels},         {"runs", o.runs},
                         {"forward_ms", median(forward_ms)}, {"intersections", rasterizer.intersections()},
-                        {"kernels", kernels},             {"device", device_json(context.info())},
+                        {"kernels", kernel_profile_json(profile)}, {"device", device_json(context.info())},
                         {"intersections_per_gaussian", per_gaussian},
                         {"longest_tile_list", counters.longest_tile_list},
                         {"forward_passes", counters.forward_passes},
@@ -96,10 +95,7 @@ void run_bench_render(const BenchRenderOptions& o) {
               << (o.deterministic ? " (deterministic)" : rasterizer.uses_float_atomics() ? " (float atomics)"
                                                                                         : " (CAS atomics)")
               << "\n";
-  std::cout << "  per kernel (last run, GPU timestamps):\n";
-  for (const auto& k : profile)
-    std::cout << "    " << std::left << std::setw(42) << k.name << std::right << std::setw(3) << k.dispatches
-              << "x " << std::setw(9) << k.ms << " ms\n";
+  print_kernel_profile(std::cout, profile);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "tools/bench_stats.h"
 #include "tools/commands.h"
 #include "tools/device_json.h"
+#include "tools/kernel_profile.h"
 
 namespace litgs::tools {
 namespace {
@@ -84,8 +85,6 @@ void run_bench_sort(const BenchSortOptions& o) {
   const auto layout = sort.layout(o.n);
   const auto profile = sequence.profile();
   if (o.json) {
-    nlohmann::json kernels = nlohmann::json::array();
-    for (const auto& k : profile) kernels.push_back({{"name", k.name}, {"ms", k.ms}, {"dispatches", k.dispatches}});
     nlohmann::json j = {{"n", o.n},
                         {"bits", o.bits},
                         {"runs", o.runs},
@@ -98,7 +97,7 @@ void run_bench_sort(const BenchSortOptions& o) {
                         {"verified", verified},
                         {"block_size", layout.block_size},
                         {"block_count", layout.block_count},
-                        {"kernels", kernels},
+                        {"kernels", kernel_profile_json(profile)},
                         {"device", device_json(context.info())}};
     std::cout << j.dump(2) << "\n";
     return;
@@ -113,11 +112,8 @@ void run_bench_sort(const BenchSortOptions& o) {
             << median(gpu_times) << " ms)\n"
             << "  std::stable_sort  " << std::setw(9) << cpu_ms << " ms  " << std::setw(8)
             << (cpu_ms > 0 ? o.n / cpu_ms * 1e-3 : 0.0) << " Mkeys/s\n"
-            << "  ratio (cpu / device) " << ratio << "x; device result equals std::stable_sort\n"
-            << "  per kernel (last run):\n";
-  for (const auto& k : profile)
-    std::cout << "    " << std::left << std::setw(22) << k.name << std::right << std::setw(3) << k.dispatches
-              << "x " << std::setw(8) << k.ms << " ms\n";
+            << "  ratio (cpu / device) " << ratio << "x; device result equals std::stable_sort\n";
+  print_kernel_profile(std::cout, profile);
 }
 
 }  // namespace
