@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "kernels/device_growth.h"
 #include "kernels/loss/loss_shared.h"
 
 namespace litgs::kernels {
@@ -18,7 +19,7 @@ GeometricLoss::~GeometricLoss() = default;
 
 void GeometricLoss::reserve(uint32_t width, uint32_t height) {
   const uint64_t n = uint64_t{width} * height;
-  loss_detail::ensure(*context_, terms_buf_, 2 * n * sizeof(float), "loss: geometric terms");
+  grow(*context_, terms_buf_, 2 * n, "loss: geometric terms");
   sum_.reserve(n);
 }
 
@@ -75,14 +76,14 @@ void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& dep
                      {GEOMETRIC_BINDING_POINTS, &points, Access::kRead},
                      {GEOMETRIC_BINDING_NORMALS, &normals, Access::kRead},
                      {GEOMETRIC_BINDING_GRAD, &grad_depth, Access::kWrite},
-                     {GEOMETRIC_BINDING_TERMS, terms_buf_.get(), Access::kWrite}},
+                     {GEOMETRIC_BINDING_TERMS, &terms_buf_->buffer(), Access::kWrite}},
                     p);
   ReduceParams r{};
   r.slot = loss_slot;
   r.outputs = kOutputs;
   r.w00 = p.inv_valid;  // L_geo = sum r^2 / N_valid
   r.w11 = 1.0f;         // pixels that counted
-  sum_.record(sequence, *terms_buf_, n, r, loss_out);
+  sum_.record(sequence, terms_buf_->buffer(), n, r, loss_out);
 }
 
 }  // namespace litgs::kernels

@@ -60,7 +60,7 @@ class GeometricLoss {
   engine::Context* context_;
   std::unique_ptr<engine::Kernel> kernel_;
   loss_detail::LossSum sum_;
-  std::unique_ptr<engine::Buffer> terms_buf_;  // [H][W][2]
+  std::unique_ptr<engine::DeviceArray<float>> terms_buf_;  // [H][W][2]
 };
 
 }  // namespace litgs::kernels

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include "kernels/device_growth.h"
 #include "kernels/limits.h"
 #include "kernels/spirv_registry.h"
 
@@ -29,14 +30,6 @@ engine::Groups elementwise_groups(const engine::Context& context, const char* wh
   return {static_cast<uint32_t>(groups)};
 }
 
-void ensure(engine::Context& context, std::unique_ptr<engine::Buffer>& buffer, uint64_t bytes,
-            const char* name) {
-  if (buffer && buffer->size_bytes() >= bytes) return;
-  const uint64_t grown = buffer ? std::max(bytes, buffer->size_bytes() + buffer->size_bytes() / 2) : bytes;
-  buffer.reset();
-  buffer = std::make_unique<engine::Buffer>(context, name, std::max<uint64_t>(grown, 16));
-}
-
 LossSum::LossSum(engine::Context& context) : context_(&context) {
   blocks_ = make_kernel(context, "loss/reduce_blocks", REDUCE_BLOCKS_BINDING_COUNT, sizeof(ReduceParams));
   finish_ = make_kernel(context, "loss/reduce_finish", REDUCE_FINISH_BINDING_COUNT, sizeof(ReduceParams));
@@ -49,7 +42,7 @@ uint64_t block_count(uint64_t rows) {
 }  // namespace
 
 void LossSum::reserve(uint64_t rows) {
-  ensure(*context_, block_sums_, block_count(rows) * 2 * sizeof(float), "loss: block sums");
+  grow(*context_, block_sums_, block_count(rows) * 2, "loss: block sums");
 }
 
 void LossSum::record(engine::Sequence& sequence, const engine::Buffer& terms, uint64_t rows,
@@ -66,11 +59,11 @@ void LossSum::record(engine::Sequence& sequence, const engine::Buffer& terms, ui
   params.count = static_cast<uint32_t>(rows);
   sequence.dispatch(*blocks_, {static_cast<uint32_t>(blocks)},
                     {{REDUCE_BLOCKS_BINDING_ROWS, &terms, engine::Access::kRead},
-                     {REDUCE_BLOCKS_BINDING_SUMS, block_sums_.get(), engine::Access::kWrite}},
+                     {REDUCE_BLOCKS_BINDING_SUMS, &block_sums_->buffer(), engine::Access::kWrite}},
                     params);
   params.count = static_cast<uint32_t>(blocks);
   sequence.dispatch(*finish_, {1},
-                    {{REDUCE_FINISH_BINDING_SUMS, block_sums_.get(), engine::Access::kRead},
+                    {{REDUCE_FINISH_BINDING_SUMS, &block_sums_->buffer(), engine::Access::kRead},
                      {REDUCE_FINISH_BINDING_OUT, &out, engine::Access::kReadWrite}},
                     params);
 }

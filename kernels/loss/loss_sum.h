@@ -24,10 +24,6 @@ engine::Groups elementwise_groups(const engine::Context& context, const char* wh
 
 using kernels::make_kernel;  // kernels/subgroup_kernel.h
 
-// Grows `buffer` to at least `bytes` (by 1.5x steps).
-void ensure(engine::Context& context, std::unique_ptr<engine::Buffer>& buffer, uint64_t bytes,
-            const char* name);
-
 class LossSum {
  public:
   explicit LossSum(engine::Context& context);
@@ -41,7 +37,7 @@ class LossSum {
  private:
   engine::Context* context_;
   std::unique_ptr<engine::Kernel> blocks_, finish_;
-  std::unique_ptr<engine::Buffer> block_sums_;
+  std::unique_ptr<engine::DeviceArray<float>> block_sums_;  // [blocks][2]
 };
 
 }  // namespace litgs::kernels::loss_detail

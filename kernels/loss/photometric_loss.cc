@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "kernels/device_growth.h"
 #include "kernels/loss/loss_shared.h"
 #include "kernels/splat/splat_shared.h"
 
@@ -33,10 +34,10 @@ PhotometricLoss::~PhotometricLoss() = default;
 
 void PhotometricLoss::reserve(uint32_t width, uint32_t height) {
   const uint64_t n = uint64_t{channels_} * width * height;
-  loss_detail::ensure(*context_, moments4_buf_, 4 * n * sizeof(float), "loss: ssim moments (4)");
-  loss_detail::ensure(*context_, moments1_buf_, n * sizeof(float), "loss: ssim moments (xy)");
-  loss_detail::ensure(*context_, partials_buf_, 4 * n * sizeof(float), "loss: ssim partials");
-  loss_detail::ensure(*context_, terms_buf_, 2 * n * sizeof(float), "loss: photometric terms");
+  grow(*context_, moments4_buf_, 4 * n, "loss: ssim moments (4)");
+  grow(*context_, moments1_buf_, n, "loss: ssim moments (xy)");
+  grow(*context_, partials_buf_, 4 * n, "loss: ssim partials");
+  grow(*context_, terms_buf_, 2 * n, "loss: photometric terms");
   sum_.reserve(n);
 }
 
@@ -58,7 +59,7 @@ void PhotometricLoss::record(engine::Sequence& sequence, const engine::Buffer& i
   loss_detail::check_binding(who, "loss_out", loss_out, (uint64_t{loss_slot} + kOutputs) * sizeof(float));
   const engine::Groups groups = loss_detail::elementwise_groups(*context_, who, n);
   reserve(width, height);
-  loss_detail::check_binding(who, "ssim moments (scratch)", *moments4_buf_, 4 * bytes);
+  loss_detail::check_binding(who, "ssim moments (scratch)", moments4_buf_->buffer(), 4 * bytes);
 
   PhotometricParams p{};
   p.width = width;
@@ -68,10 +69,10 @@ void PhotometricLoss::record(engine::Sequence& sequence, const engine::Buffer& i
   p.inv_count = static_cast<float>(1.0 / static_cast<double>(n));
   p.weight = weight;
 
-  const engine::Buffer& moments4 = *moments4_buf_;
-  const engine::Buffer& moments1 = *moments1_buf_;
-  const engine::Buffer& partials = *partials_buf_;
-  const engine::Buffer& terms = *terms_buf_;
+  const engine::Buffer& moments4 = moments4_buf_->buffer();
+  const engine::Buffer& moments1 = moments1_buf_->buffer();
+  const engine::Buffer& partials = partials_buf_->buffer();
+  const engine::Buffer& terms = terms_buf_->buffer();
   sequence.dispatch(*moments_, groups,
                     {{SSIM_MOMENTS_BINDING_IMAGE, &image, Access::kRead},
                      {SSIM_MOMENTS_BINDING_TARGET, &target, Access::kRead},

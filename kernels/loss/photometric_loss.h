@@ -61,7 +61,7 @@ class PhotometricLoss {
   loss_detail::LossSum sum_;
   // moments4 [N][4] and moments1 [N]: row blurs (moments4 is reused for the blurred partials);
   // partials [N][4]; terms [N][2]. Vectors per element: one load per tap on CPU drivers, not one per map.
-  std::unique_ptr<engine::Buffer> moments4_buf_, moments1_buf_, partials_buf_, terms_buf_;
+  std::unique_ptr<engine::DeviceArray<float>> moments4_buf_, moments1_buf_, partials_buf_, terms_buf_;
 };
 
 }  // namespace litgs::kernels

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "kernels/device_growth.h"
 #include "kernels/optim/adam.h"
 #include "kernels/subgroup_kernel.h"
 
@@ -19,15 +20,6 @@ void require(bool ok, const char* field, double value, const char* rule) {
   if (!ok)
     throw std::invalid_argument(std::string("McmcOptions.") + field + " = " + std::to_string(value) + ": " +
                                 rule);
-}
-
-template <class T>
-void grow(engine::Context& ctx, std::unique_ptr<DeviceArray<T>>& array, size_t count, const char* name) {
-  count = std::max<size_t>(count, 1);
-  if (array && array->size() >= count) return;
-  const size_t grown = array ? std::max(count, array->size() + array->size() / 2) : count;
-  array.reset();
-  array = std::make_unique<DeviceArray<T>>(ctx, name, grown);
 }
 
 float logit(double p) { return static_cast<float>(std::log(p / (1.0 - p))); }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "kernels/densify/densify_shared.h"
+#include "kernels/device_growth.h"
 #include "kernels/optim/optim_shared.h"
 #include "kernels/subgroup_kernel.h"
 
@@ -48,14 +49,6 @@ const engine::Buffer* grad_buffer(const Rasterizer::DeviceGrads& g, uint32_t gro
     default:
       return g.sh;
   }
-}
-
-template <class T>
-void grow(engine::Context& ctx, std::unique_ptr<DeviceArray<T>>& array, size_t count, const char* name) {
-  if (array && array->size() >= count) return;
-  const size_t grown = array ? std::max(count, array->size() + array->size() / 2) : count;
-  array.reset();
-  array = std::make_unique<DeviceArray<T>>(ctx, name, std::max<size_t>(grown, 1));
 }
 
 }  // namespace
@@ -257,7 +250,7 @@ DensifyReport TrainableGaussians::densify_and_prune(const DensifyOptions& option
   if (!spare_) spare_ = std::make_unique<Slot>();
   if (!spare_->params || spare_->capacity < after) {
     const uint64_t limit_rows = ctx.info().max_storage_buffer_range / (4ull * std::max<uint32_t>(sv, 4));
-    size_t capacity = std::max<size_t>(after, in.capacity + in.capacity / 2);
+    size_t capacity = grown_capacity(in.capacity, after);  // kernels/device_growth.h, then capped
     if (options.max_gaussians > 0)
       capacity = std::min<size_t>(capacity, std::max<size_t>(options.max_gaussians, after));
     if (limit_rows > 0) capacity = std::min<size_t>(capacity, std::max<size_t>(limit_rows, after));
@@ -371,7 +364,7 @@ void TrainableGaussians::grow_rows(size_t rows, size_t capacity_cap) {
                                 std::to_string(n) + " in use");
   if (rows == n) return;
   if (rows > current_->capacity) {
-    size_t capacity = std::max(rows, current_->capacity + current_->capacity / 2);
+    size_t capacity = grown_capacity(current_->capacity, rows);  // kernels/device_growth.h, then capped
     if (capacity_cap > 0) capacity = std::max(rows, std::min(capacity, capacity_cap));
     if (!spare_) spare_ = std::make_unique<Slot>();
     spare_->params.reset();  // free the old spare first

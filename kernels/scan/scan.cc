@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "kernels/device_growth.h"
 #include "kernels/limits.h"
 #include "kernels/scan/scan_shared.h"
 #include "kernels/subgroup_kernel.h"
@@ -59,13 +60,9 @@ void ExclusiveScan::record_level(engine::Sequence& sequence, const engine::Buffe
   }
   if (block_sums_.size() <= level) block_sums_.resize(level + 1);
   std::unique_ptr<engine::DeviceArray<uint32_t>>& level_sums = block_sums_[level];
-  if (!level_sums || level_sums->size() < blocks) {
-    // Grow geometrically; a sequence recorded earlier may still use the old buffer, so it is kept alive.
-    const size_t capacity = level_sums ? std::max<size_t>(blocks, level_sums->size() * 2) : blocks;
-    if (level_sums) retired_.push_back(std::move(level_sums));
-    level_sums = std::make_unique<engine::DeviceArray<uint32_t>>(
-        *context_, "scan: block sums level " + std::to_string(level), capacity);
-  }
+  // A sequence recorded earlier may still use an outgrown buffer, so it is retired (kept alive).
+  if (!level_sums || level_sums->size() < blocks)
+    grow(*context_, level_sums, blocks, "scan: block sums level " + std::to_string(level), &retired_);
   // Owned through a unique_ptr: the deeper levels below may grow block_sums_ without moving this buffer.
   const engine::Buffer& sums = level_sums->buffer();
   sequence.dispatch(*reduce_, {blocks},

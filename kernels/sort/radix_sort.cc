@@ -5,6 +5,7 @@
 #include <string>
 #include <utility>
 
+#include "kernels/device_growth.h"
 #include "kernels/limits.h"
 #include "kernels/sort/radix_sort_shared.h"
 #include "kernels/subgroup_kernel.h"
@@ -44,16 +45,10 @@ RadixSort::Layout RadixSort::layout(uint32_t count) const {
 }
 
 void RadixSort::reserve(uint32_t count, uint32_t blocks) {
-  // Outgrown scratch is replaced, not freed, while a recorded sequence may use it: keep it alive.
-  auto grow = [&](std::unique_ptr<engine::DeviceArray<uint32_t>>& array, size_t needed, const char* name) {
-    if (array && array->size() >= needed) return;
-    const size_t capacity = array ? std::max(needed, array->size() * 2) : needed;
-    if (array) retired_.push_back(std::move(array));
-    array = std::make_unique<engine::DeviceArray<uint32_t>>(*context_, name, capacity);
-  };
-  grow(keys_tmp_, count, "radix sort: keys scratch");
-  grow(values_tmp_, count, "radix sort: values scratch");
-  grow(counts_, static_cast<size_t>(RADIX_BUCKETS) * blocks, "radix sort: digit counts");
+  // Outgrown scratch is retired, not freed, while a recorded sequence may use it: kept alive.
+  grow(*context_, keys_tmp_, count, "radix sort: keys scratch", &retired_);
+  grow(*context_, values_tmp_, count, "radix sort: values scratch", &retired_);
+  grow(*context_, counts_, static_cast<size_t>(RADIX_BUCKETS) * blocks, "radix sort: digit counts", &retired_);
 }
 
 void RadixSort::record(engine::Sequence& sequence, const engine::DeviceArray<uint32_t>& keys,

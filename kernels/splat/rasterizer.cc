@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "kernels/device_growth.h"
 #include "kernels/limits.h"
 #include "kernels/spirv_registry.h"
 #include "kernels/splat/splat_shared.h"
@@ -15,15 +16,6 @@ using engine::Access;
 using engine::DeviceArray;
 
 namespace {
-
-// Grows `array` to hold at least `count` elements (by 1.5x steps, so buffers track the model's size).
-template <class T>
-void ensure(engine::Context& ctx, std::unique_ptr<DeviceArray<T>>& array, size_t count, const char* name) {
-  if (array && array->size() >= count) return;
-  const size_t grown = array ? std::max(count, array->size() + array->size() / 2) : count;
-  array.reset();
-  array = std::make_unique<DeviceArray<T>>(ctx, name, std::max<size_t>(grown, 1));
-}
 
 engine::Groups elementwise(size_t n) {
   return {static_cast<uint32_t>((n + ELEMENTWISE_GROUP_SIZE - 1) / ELEMENTWISE_GROUP_SIZE)};
@@ -256,22 +248,22 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
                                 std::to_string(camera.height) + " pixels is more than 2^24 tiles");
   const size_t corner_cells = static_cast<size_t>(view.tiles_x + 1) * (view.tiles_y + 1);
 
-  ensure(ctx, b.means2d, 2 * size_t{n}, "splat: means2d");
-  ensure(ctx, b.conics, 3 * size_t{n}, "splat: conics");
-  ensure(ctx, b.depths, n, "splat: depths");
-  ensure(ctx, b.opacities, n, "splat: opacities");
-  ensure(ctx, b.colors, size_t{n} * channels_, "splat: colors");
-  ensure(ctx, b.rects, 4 * size_t{n}, "splat: tile rects");
-  ensure(ctx, b.depth_keys, n, "splat: depth keys");
-  ensure(ctx, b.order, n, "splat: depth order");
-  ensure(ctx, b.counts, n, "splat: tile counts");
-  ensure(ctx, b.offsets, n, "splat: tile offsets");
-  ensure(ctx, b.image, pixels * channels_, "splat: image");
-  ensure(ctx, b.depth, pixels, "splat: expected depth");
-  ensure(ctx, b.alpha, pixels, "splat: alpha");
-  ensure(ctx, b.last, pixels, "splat: last");
-  ensure(ctx, b.ranges, 2 * tiles, "splat: tile ranges");
-  ensure(ctx, b.corners, corner_cells, "splat: tile corners");
+  grow(ctx, b.means2d, 2 * size_t{n}, "splat: means2d");
+  grow(ctx, b.conics, 3 * size_t{n}, "splat: conics");
+  grow(ctx, b.depths, n, "splat: depths");
+  grow(ctx, b.opacities, n, "splat: opacities");
+  grow(ctx, b.colors, size_t{n} * channels_, "splat: colors");
+  grow(ctx, b.rects, 4 * size_t{n}, "splat: tile rects");
+  grow(ctx, b.depth_keys, n, "splat: depth keys");
+  grow(ctx, b.order, n, "splat: depth order");
+  grow(ctx, b.counts, n, "splat: tile counts");
+  grow(ctx, b.offsets, n, "splat: tile offsets");
+  grow(ctx, b.image, pixels * channels_, "splat: image");
+  grow(ctx, b.depth, pixels, "splat: expected depth");
+  grow(ctx, b.alpha, pixels, "splat: alpha");
+  grow(ctx, b.last, pixels, "splat: last");
+  grow(ctx, b.ranges, 2 * tiles, "splat: tile ranges");
+  grow(ctx, b.corners, corner_cells, "splat: tile corners");
   profile_.clear();
 
   // 1. Project, sort by depth, count tiles per depth rank (and their exact total), scan, list lengths.
@@ -325,9 +317,9 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   longest_tile_list_ = c[SPLAT_COUNTER_MAX_LIST];
   forward_walks_cut_before_ = c[SPLAT_COUNTER_FORWARD_WALKS_CUT];
   forward_passes_ = passes_for(forward_entries_per_pass_);
-  ensure(ctx, b.tile_keys, m, "splat: tile keys");
-  ensure(ctx, b.isect_ids, m, "splat: intersection ids");
-  ensure(ctx, b.isect_gaussian, m, "splat: intersection gaussians");
+  grow(ctx, b.tile_keys, m, "splat: tile keys");
+  grow(ctx, b.isect_ids, m, "splat: intersection ids");
+  grow(ctx, b.isect_gaussian, m, "splat: intersection gaussians");
 
   // 2. Emit intersections in depth order, stable sort by tile, tile ranges, blend in passes over the lists.
   engine::Sequence s2(ctx);
@@ -421,9 +413,9 @@ Rasterizer::DeviceUpstream Rasterizer::upstream_buffers() {
   engine::Context& ctx = *context_;
   Buffers& b = *buffers_;
   const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
-  ensure(ctx, b.grad_image, pixels * channels_, "splat: grad image");
-  ensure(ctx, b.grad_depth, pixels, "splat: grad depth");
-  ensure(ctx, b.grad_alpha, pixels, "splat: grad alpha");
+  grow(ctx, b.grad_image, pixels * channels_, "splat: grad image");
+  grow(ctx, b.grad_depth, pixels, "splat: grad depth");
+  grow(ctx, b.grad_alpha, pixels, "splat: grad alpha");
   return {&b.grad_image->buffer(), &b.grad_depth->buffer(), &b.grad_alpha->buffer()};
 }
 
@@ -437,17 +429,17 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
   const SplatView view = make_view(last_camera_, n, K);
   const uint32_t stride = SPLAT_GRAD2D_FIXED + channels_;
   upstream_buffers();
-  ensure(ctx, b.grad2d, size_t{n} * stride, "splat: grad2d");
-  ensure(ctx, b.g_means, 3 * size_t{n}, "splat: grad means");
-  ensure(ctx, b.g_log_scales, 3 * size_t{n}, "splat: grad log_scales");
-  ensure(ctx, b.g_quats, 4 * size_t{n}, "splat: grad quats");
-  ensure(ctx, b.g_logits, n, "splat: grad opacity_logits");
-  ensure(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
-  ensure(ctx, b.g_means2d, 2 * size_t{n}, "splat: grad means2d");
-  if (options_.deterministic) ensure(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
+  grow(ctx, b.grad2d, size_t{n} * stride, "splat: grad2d");
+  grow(ctx, b.g_means, 3 * size_t{n}, "splat: grad means");
+  grow(ctx, b.g_log_scales, 3 * size_t{n}, "splat: grad log_scales");
+  grow(ctx, b.g_quats, 4 * size_t{n}, "splat: grad quats");
+  grow(ctx, b.g_logits, n, "splat: grad opacity_logits");
+  grow(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
+  grow(ctx, b.g_means2d, 2 * size_t{n}, "splat: grad means2d");
+  if (options_.deterministic) grow(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
   backward_passes_ = passes_for(backward_entries_per_pass_);
   const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
-  ensure(ctx, b.backward_state, backward_passes_ > 1 ? pixels * (2 + channels_) : 1, "splat: backward state");
+  grow(ctx, b.backward_state, backward_passes_ > 1 ? pixels * (2 + channels_) : 1, "splat: backward state");
   const engine::Buffer& rows = options_.deterministic ? b.isect_grads->buffer() : b.grad2d->buffer();
   const uint64_t row_values = options_.deterministic ? intersections_ * stride : uint64_t{n} * stride;
   s.fill(rows, 0u, row_values * sizeof(float));
