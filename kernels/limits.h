@@ -8,8 +8,8 @@
 #define MAX_BATCHES_PER_WORKGROUP 32768
 
 
-// Element-wise kernels (one invocation per Gaussian or per intersection) use workgroups of this size, so
-// that 16.7M elements fit in the 65535 workgroups every device allows in one dimension.
+// Element-wise kernels (one invocation per Gaussian, intersection or pixel) use workgroups of this size: 16.7M
+// elements fit in the 65535 workgroups every device allows in x, and more take rows (kernels/elementwise.h).
 #define ELEMENTWISE_GROUP_SIZE 256
 
 // The rasterize kernels walk a tile's list in passes (kernels/splat/splat_shared.h) and size each pass so that

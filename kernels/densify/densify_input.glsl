@@ -1,6 +1,6 @@
 // Shared by densify_candidates.comp and densify_decide.comp: the bindings and the per-Gaussian input.
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "densify/densify_shared.h"
 #include "densify/densify_math.h"
 

@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Per Gaussian: opacity = min(opacity, reset value), in logits (3DGS reset_opacity).
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "densify/densify_shared.h"
 
 layout(std430, binding = RESET_BINDING_OPACITY_LOGITS) buffer Logits { float opacity_logits[]; };

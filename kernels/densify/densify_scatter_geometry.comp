@@ -4,7 +4,7 @@
 // (3DGS densify_and_split): mean + R diag(scale) z, z a standard normal per axis truncated at 3 (so a
 // child lies within the parent's 3 sigma along each principal axis), log-scales - log(1.6).
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
 #include "densify/densify_shared.h"

@@ -4,7 +4,7 @@
 // original (slot A of keep and clone) is copied; new rows (clone copies, split children) are copied or,
 // for optimizer moments and statistics, zeroed.
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "densify/densify_shared.h"
 
 layout(std430, binding = SCATTER_BINDING_DECISION) readonly buffer Decision { uint decision[]; };

@@ -3,12 +3,11 @@
 // Per Gaussian, after a backward: accumulate the densification statistics of visible Gaussians (3DGS
 // add_densification_stats; visible = the rasterizer's tile rectangle is not empty, as 3DGS's radii > 0).
 #include "limits.h"
+#include "elementwise.glsl"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
 #include "densify/densify_shared.h"
-
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 
 layout(std430, binding = STATS_BINDING_MEANS) readonly buffer Means { float means[]; };
 layout(std430, binding = STATS_BINDING_LOG_SCALES) readonly buffer LogScales { float log_scales[]; };
@@ -21,7 +20,7 @@ layout(std430, binding = STATS_BINDING_DENOM) buffer Denom { uint denom[]; };
 layout(std430, binding = STATS_BINDING_MAX_RADIUS) buffer MaxRadius { float max_radius[]; };
 
 void main() {
-  const uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * uint(ELEMENTWISE_GROUP_SIZE) + gl_GlobalInvocationID.x;
+  const uint i = elementwise_index();
   if (i >= view.count) return;
   const uvec4 rect = rects[i];
   if (rect.z <= rect.x || rect.w <= rect.y) return;

@@ -4,9 +4,9 @@
 // and dL/dD = -2 r (n . ray) / (1 + r^2 / s^2) / N_valid. Pixels without a valid point, or where nothing was rendered (D <= 0 or
 // not finite), count 0 and get a zero gradient (see geometric_loss.h).
 #include "limits.h"
+#include "elementwise.glsl"
 #include "loss/loss_shared.h"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = GEOMETRIC_BINDING_DEPTH) readonly buffer Depth { float depth[]; };
 layout(std430, binding = GEOMETRIC_BINDING_POINTS) readonly buffer Points { vec4 points[]; };
 layout(std430, binding = GEOMETRIC_BINDING_NORMALS) readonly buffer Normals { vec4 normals[]; };
@@ -18,7 +18,7 @@ layout(push_constant) uniform Push { GeometricParams p; };
 bool is_finite(float v) { return (floatBitsToUint(v) & 0x7F800000u) != 0x7F800000u; }
 
 void main() {
-  const uint i = gl_GlobalInvocationID.x;
+  const uint i = elementwise_index();
   if (i >= p.count) return;
   const float d = depth[i];
   const vec4 point = points[i];

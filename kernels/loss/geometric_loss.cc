@@ -5,6 +5,7 @@
 #include <string>
 
 #include "kernels/device_growth.h"
+#include "kernels/elementwise.h"
 #include "kernels/loss/loss_shared.h"
 
 namespace litgs::kernels {
@@ -57,7 +58,7 @@ void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& dep
   loss_detail::check_binding(who, "normals", normals, 4 * n * sizeof(float));
   loss_detail::check_binding(who, "grad_depth", grad_depth, n * sizeof(float));
   loss_detail::check_binding(who, "loss_out", loss_out, (uint64_t{loss_slot} + kOutputs) * sizeof(float));
-  const engine::Groups groups = loss_detail::elementwise_groups(*context_, who, n);
+  const engine::Groups groups = elementwise_groups(*context_, n, who);
   reserve(width, height);
 
   GeometricParams p{};

@@ -20,16 +20,6 @@ void check_binding(const char* who, const char* what, const engine::Buffer& buff
                             " bytes, over the device's maxStorageBufferRange of " + std::to_string(range));
 }
 
-engine::Groups elementwise_groups(const engine::Context& context, const char* who, uint64_t n) {
-  const uint64_t groups = (n + ELEMENTWISE_GROUP_SIZE - 1) / ELEMENTWISE_GROUP_SIZE;
-  const uint64_t limit = std::min<uint64_t>(context.info().max_compute_workgroup_count[0], 0xFFFFFFFFull);
-  if (groups > limit)
-    throw std::length_error(std::string(who) + ": " + std::to_string(n) + " elements need " +
-                            std::to_string(groups) + " workgroups, the device allows " +
-                            std::to_string(limit));
-  return {static_cast<uint32_t>(groups)};
-}
-
 LossSum::LossSum(engine::Context& context) : context_(&context) {
   blocks_ = make_kernel(context, "loss/reduce_blocks", REDUCE_BLOCKS_BINDING_COUNT, sizeof(ReduceParams));
   finish_ = make_kernel(context, "loss/reduce_finish", REDUCE_FINISH_BINDING_COUNT, sizeof(ReduceParams));

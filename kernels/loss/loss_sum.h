@@ -19,9 +19,6 @@ namespace litgs::kernels::loss_detail {
 // Throws std::invalid_argument naming `who`, `what` and the sizes when `buffer` holds fewer than `bytes`.
 void check_binding(const char* who, const char* what, const engine::Buffer& buffer, uint64_t bytes);
 
-// Element-wise groups for n invocations; throws std::length_error naming `who` beyond the device's limit.
-engine::Groups elementwise_groups(const engine::Context& context, const char* who, uint64_t n);
-
 using kernels::make_kernel;  // kernels/subgroup_kernel.h
 
 class LossSum {

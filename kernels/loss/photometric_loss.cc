@@ -5,6 +5,7 @@
 #include <string>
 
 #include "kernels/device_growth.h"
+#include "kernels/elementwise.h"
 #include "kernels/loss/loss_shared.h"
 #include "kernels/splat/splat_shared.h"
 
@@ -57,7 +58,7 @@ void PhotometricLoss::record(engine::Sequence& sequence, const engine::Buffer& i
   loss_detail::check_binding(who, "target", target, bytes);
   loss_detail::check_binding(who, "grad_image", grad_image, bytes);
   loss_detail::check_binding(who, "loss_out", loss_out, (uint64_t{loss_slot} + kOutputs) * sizeof(float));
-  const engine::Groups groups = loss_detail::elementwise_groups(*context_, who, n);
+  const engine::Groups groups = elementwise_groups(*context_, n, who);
   reserve(width, height);
   loss_detail::check_binding(who, "ssim moments (scratch)", moments4_buf_->buffer(), 4 * bytes);
 

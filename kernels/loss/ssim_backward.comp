@@ -3,10 +3,10 @@
 // Per element: vertical window sums of the partials, then
 //   dL/dx = G*A + 2 x (G*B) + y (G*C) + (1 - lambda) sign(x - y) / N,   written as weight * dL/dx.
 #include "limits.h"
+#include "elementwise.glsl"
 #include "loss/loss_shared.h"
 #include "loss/ssim_window.glsl"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = SSIM_BACKWARD_BINDING_IMAGE) readonly buffer Image { float image[]; };
 layout(std430, binding = SSIM_BACKWARD_BINDING_TARGET) readonly buffer Target { float target[]; };
 layout(std430, binding = SSIM_BACKWARD_BINDING_PARTIALS) readonly buffer Partials { vec4 partials[]; };
@@ -14,7 +14,7 @@ layout(std430, binding = SSIM_BACKWARD_BINDING_GRAD) writeonly buffer Grad { flo
 layout(push_constant) uniform Push { PhotometricParams p; };
 
 void main() {
-  const uint e = gl_GlobalInvocationID.x;
+  const uint e = elementwise_index();
   if (e >= p.count) return;
   const int y = int((e / p.width) % p.height);
   const int h = int(p.height);

@@ -2,10 +2,10 @@
 #extension GL_GOOGLE_include_directive : require
 // Per element: horizontal window sums of x, y, x^2, y^2 and xy (the first pass of the separable blur).
 #include "limits.h"
+#include "elementwise.glsl"
 #include "loss/loss_shared.h"
 #include "loss/ssim_window.glsl"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = SSIM_MOMENTS_BINDING_IMAGE) readonly buffer Image { float image[]; };
 layout(std430, binding = SSIM_MOMENTS_BINDING_TARGET) readonly buffer Target { float target[]; };
 layout(std430, binding = SSIM_MOMENTS_BINDING_OUT4) writeonly buffer Moments4 { vec4 moments4[]; };
@@ -13,7 +13,7 @@ layout(std430, binding = SSIM_MOMENTS_BINDING_OUT1) writeonly buffer Moments1 { 
 layout(push_constant) uniform Push { PhotometricParams p; };
 
 void main() {
-  const uint e = gl_GlobalInvocationID.x;
+  const uint e = elementwise_index();
   if (e >= p.count) return;
   const int x = int(e % p.width);
   const int w = int(p.width);

@@ -3,16 +3,16 @@
 // Per element: horizontal window sums of the three partial maps (first pass of the adjoint blur; with zero
 // padding and a symmetric window the blur is its own adjoint).
 #include "limits.h"
+#include "elementwise.glsl"
 #include "loss/loss_shared.h"
 #include "loss/ssim_window.glsl"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = SSIM_PARTIALS_BINDING_IN) readonly buffer In { vec4 partials[]; };
 layout(std430, binding = SSIM_PARTIALS_BINDING_OUT) writeonly buffer Out { vec4 blurred[]; };
 layout(push_constant) uniform Push { PhotometricParams p; };
 
 void main() {
-  const uint e = gl_GlobalInvocationID.x;
+  const uint e = elementwise_index();
   if (e >= p.count) return;
   const int x = int(e % p.width);
   const int w = int(p.width);

@@ -3,10 +3,10 @@
 // Per element: vertical window sums of the five moment rows (mu_x, mu_y, E[x^2], E[y^2], E[xy]), SSIM,
 // and the loss's partials w.r.t. (mu_x, E[x^2], E[xy]) for the backward; the per-element loss terms.
 #include "limits.h"
+#include "elementwise.glsl"
 #include "loss/loss_shared.h"
 #include "loss/ssim_window.glsl"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = SSIM_PIXEL_BINDING_IMAGE) readonly buffer Image { float image[]; };
 layout(std430, binding = SSIM_PIXEL_BINDING_TARGET) readonly buffer Target { float target[]; };
 layout(std430, binding = SSIM_PIXEL_BINDING_MOMENTS4) readonly buffer Moments4 { vec4 moments4[]; };
@@ -16,7 +16,7 @@ layout(std430, binding = SSIM_PIXEL_BINDING_TERMS) writeonly buffer Terms { vec2
 layout(push_constant) uniform Push { PhotometricParams p; };
 
 void main() {
-  const uint e = gl_GlobalInvocationID.x;
+  const uint e = elementwise_index();
   if (e >= p.count) return;
   const int y = int((e / p.width) % p.height);
   const int h = int(p.height);

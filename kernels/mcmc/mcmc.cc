@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kernels/device_growth.h"
+#include "kernels/elementwise.h"
 #include "kernels/optim/adam.h"
 #include "kernels/subgroup_kernel.h"
 
@@ -92,7 +93,7 @@ McmcReport McmcStrategy::relocate_and_grow(TrainableGaussians& model, const Mcmc
     const DeviceGaussians& g = model.gaussians();
     engine::Sequence s(ctx);
     s.fill(report_->buffer(), 0u, MCMC_REPORT_SLOTS * 4);
-    s.dispatch(*weights_, elementwise_grid(n),
+    s.dispatch(*weights_, elementwise_groups(*context_, n, "mcmc/mcmc_weights"),
                {{WEIGHTS_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
                 {WEIGHTS_BINDING_MEANS, &g.means.buffer(), Access::kRead},
                 {WEIGHTS_BINDING_QUATS, &g.quats.buffer(), Access::kRead},
@@ -142,26 +143,26 @@ McmcReport McmcStrategy::relocate_and_grow(TrainableGaussians& model, const Mcmc
   engine::Sequence s(ctx);
   s.fill(copies_->buffer(), 0u, uint64_t{n} * 4);
   if (dead > 0)
-    s.dispatch(*list_dead_, elementwise_grid(n),
+    s.dispatch(*list_dead_, elementwise_groups(*context_, n, "mcmc/mcmc_list_dead"),
                {{LIST_BINDING_DEAD, &dead_->buffer(), Access::kRead},
                 {LIST_BINDING_DEAD_RANK, &dead_rank_->buffer(), Access::kRead},
                 {LIST_BINDING_DEAD_INDEX, &dead_index_->buffer(), Access::kWrite}},
                p);
-  s.dispatch(*sample_, elementwise_grid(targets),
+  s.dispatch(*sample_, elementwise_groups(*context_, targets, "mcmc/mcmc_sample"),
              {{SAMPLE_BINDING_CDF, &cdf_->buffer(), Access::kRead},
               {SAMPLE_BINDING_DEAD_INDEX, &dead_index_->buffer(), Access::kRead},
               {SAMPLE_BINDING_SOURCE, &source_->buffer(), Access::kWrite},
               {SAMPLE_BINDING_TARGET, &target_->buffer(), Access::kWrite},
               {SAMPLE_BINDING_COPIES, &copies_->buffer(), Access::kReadWrite}},
              p);
-  s.dispatch(*update_sources_, elementwise_grid(n),
+  s.dispatch(*update_sources_, elementwise_groups(*context_, n, "mcmc/mcmc_update_sources"),
              {{UPDATE_BINDING_COPIES, &copies_->buffer(), Access::kRead},
               {UPDATE_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kReadWrite},
               {UPDATE_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kReadWrite}},
              p);
   auto copy_rows = [&](const engine::Buffer& rows, uint32_t stride, uint32_t mode) {
     const CopyRowsParams cp{targets, stride, mode, 0u};
-    s.dispatch(*copy_rows_, elementwise_grid(targets),
+    s.dispatch(*copy_rows_, elementwise_groups(*context_, targets, "mcmc/mcmc_copy_rows"),
                {{COPY_BINDING_SOURCE, &source_->buffer(), Access::kRead},
                 {COPY_BINDING_TARGET, &target_->buffer(), Access::kRead},
                 {COPY_BINDING_ROWS, &rows, Access::kReadWrite}},
@@ -204,7 +205,7 @@ void McmcStrategy::record_regularization(engine::Sequence& sequence, const Train
   p.opacity_reg = static_cast<float>(double{options.opacity_reg} / n);
   p.scale_reg = static_cast<float>(double{options.scale_reg} / (3.0 * n));
   const DeviceGaussians& g = model.gaussians();
-  sequence.dispatch(*regularize_, elementwise_grid(n),
+  sequence.dispatch(*regularize_, elementwise_groups(*context_, n, "mcmc/mcmc_regularize"),
                     {{REG_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kRead},
                      {REG_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
                      {REG_BINDING_GRAD_OPACITY, grads.opacity_logits, Access::kReadWrite},
@@ -223,7 +224,7 @@ void McmcStrategy::record_noise(engine::Sequence& sequence, const TrainableGauss
   p.step = step;
   p.noise_scale = scale;
   const DeviceGaussians& g = model.gaussians();
-  sequence.dispatch(*noise_, elementwise_grid(n),
+  sequence.dispatch(*noise_, elementwise_groups(*context_, n, "mcmc/mcmc_noise"),
                     {{NOISE_BINDING_MEANS, &g.means.buffer(), Access::kReadWrite},
                      {NOISE_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
                      {NOISE_BINDING_QUATS, &g.quats.buffer(), Access::kRead},

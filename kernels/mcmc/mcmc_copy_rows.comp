@@ -3,7 +3,7 @@
 // Per target: one attribute buffer's row copied from the target's source, or a row zeroed (the moments of
 // relocated rows restart, as 3DGS-MCMC resets them).
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "mcmc/mcmc_shared.h"
 
 layout(std430, binding = COPY_BINDING_SOURCE) readonly buffer Source { uint source[]; };

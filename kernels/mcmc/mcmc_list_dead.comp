@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Per Gaussian: the list of dead rows, in index order (stream compaction by the scanned dead flags).
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "mcmc/mcmc_shared.h"
 
 layout(std430, binding = LIST_BINDING_DEAD) readonly buffer Dead { uint dead[]; };

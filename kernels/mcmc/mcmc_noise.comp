@@ -3,7 +3,7 @@
 // Per Gaussian, after the Adam step: the SGLD noise of 3DGS-MCMC, shaped by the Gaussian's own covariance
 // and gated to nearly transparent Gaussians: means += gate(opacity) * lr_means * noise_lr * Sigma * z.
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "mcmc/mcmc_shared.h"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"

@@ -3,7 +3,7 @@
 // Per Gaussian, after the backward: the gradients of 3DGS-MCMC's regularizers
 // opacity_reg * mean(opacity) + scale_reg * mean(scale), added to the rasterizer's gradients.
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "mcmc/mcmc_shared.h"
 
 layout(std430, binding = REG_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };

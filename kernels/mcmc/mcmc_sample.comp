@@ -3,7 +3,7 @@
 // Per target row (the dead rows, then the rows added after N): draw a source in proportion to opacity by
 // binary search of the weights' CDF, and count the draws of each source.
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "mcmc/mcmc_shared.h"
 #include "densify/densify_shared.h"
 #include "densify/densify_math.h"

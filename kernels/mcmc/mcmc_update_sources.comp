@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Per Gaussian drawn c > 0 times: it and its c copies share its opacity profile (3DGS-MCMC eq. 9).
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "mcmc/mcmc_shared.h"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"

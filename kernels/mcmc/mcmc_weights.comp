@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Per Gaussian: dead or alive, and an alive Gaussian's sampling weight (its opacity, quantized).
 #include "limits.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 #include "mcmc/mcmc_shared.h"
 
 layout(std430, binding = WEIGHTS_BINDING_LOG_SCALES) readonly buffer LogScales { float log_scales[]; };

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "kernels/limits.h"
+#include "kernels/elementwise.h"
 #include "kernels/optim/optim_shared.h"
 #include "kernels/spirv_registry.h"
 
@@ -55,15 +55,6 @@ LearningRates AdamOptions::rates(uint32_t step, uint32_t max_steps, float extent
   return {means_lr(step, max_steps, extent), log_scales_lr, quats_lr, opacity_lr, sh_dc_lr, sh_rest_lr};
 }
 
-engine::Groups elementwise_grid(uint64_t count) {
-  const uint64_t groups = (count + ELEMENTWISE_GROUP_SIZE - 1) / ELEMENTWISE_GROUP_SIZE;
-  if (groups <= 65535) return {static_cast<uint32_t>(groups), 1, 1};
-  const uint64_t y = (groups + 65534) / 65535;
-  if (y > 65535)
-    throw std::length_error("elementwise_grid: " + std::to_string(count) + " elements is too many");
-  return {65535u, static_cast<uint32_t>(y), 1};
-}
-
 void check_binding(const engine::Buffer& buffer, uint64_t count, uint64_t value_bytes, const char* what) {
   if (buffer.size_bytes() < count * value_bytes)
     throw std::out_of_range(std::string(what) + ": buffer '" + buffer.name() + "' holds " +
@@ -71,7 +62,7 @@ void check_binding(const engine::Buffer& buffer, uint64_t count, uint64_t value_
                             std::to_string(count));
 }
 
-AdamKernel::AdamKernel(engine::Context& context) {
+AdamKernel::AdamKernel(engine::Context& context) : context_(&context) {
   engine::KernelDesc desc;
   desc.name = "optim/adam";
   desc.spirv = spirv("optim/adam");
@@ -109,7 +100,7 @@ void AdamKernel::record(engine::Sequence& sequence, const Target& t, uint64_t co
   p.sqrt_bias_correction2 =
       static_cast<float>(std::sqrt(1.0 - std::pow(double{options.beta2}, double(step))));
   using engine::Access;
-  sequence.dispatch(*kernel_, elementwise_grid(count),
+  sequence.dispatch(*kernel_, elementwise_groups(*context_, count, "optim/adam"),
                     {{ADAM_BINDING_PARAMS, t.params, Access::kReadWrite},
                      {ADAM_BINDING_GRADS, t.grads, Access::kRead},
                      {ADAM_BINDING_EXP_AVG, t.exp_avg, Access::kReadWrite},

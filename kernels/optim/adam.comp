@@ -3,7 +3,7 @@
 // Adam, bias-corrected as torch.optim.Adam (no weight decay, no amsgrad), one element per invocation.
 #include "limits.h"
 #include "optim/optim_shared.h"
-#include "optim/elementwise.glsl"
+#include "elementwise.glsl"
 
 layout(std430, binding = ADAM_BINDING_PARAMS) buffer Params { float params[]; };
 layout(std430, binding = ADAM_BINDING_GRADS) readonly buffer Grads { float grads[]; };

@@ -69,11 +69,9 @@ class AdamKernel {
               uint32_t lead = 1) const;
 
  private:
+  engine::Context* context_;
   std::unique_ptr<engine::Kernel> kernel_;
 };
-
-// Elementwise kernels (kernels/optim/elementwise.glsl): a 2D grid of ELEMENTWISE_GROUP_SIZE-wide groups.
-engine::Groups elementwise_grid(uint64_t count);
 
 // Throws std::out_of_range when `buffer` holds fewer than `count` values of `value_bytes` bytes.
 void check_binding(const engine::Buffer& buffer, uint64_t count, uint64_t value_bytes, const char* what);

@@ -10,7 +10,7 @@ namespace litgs::kernels {
 using uint = uint32_t;
 #endif
 
-// ---- adam.comp: one invocation per parameter element (2D grid of ELEMENTWISE_GROUP_SIZE groups) ----
+// ---- adam.comp: one invocation per parameter element (kernels/elementwise.h) ----
 #define ADAM_BINDING_PARAMS 0      // [count] float, updated in place
 #define ADAM_BINDING_GRADS 1       // [count] float dL/dparam
 #define ADAM_BINDING_EXP_AVG 2     // [count] float first moment m, updated in place

@@ -7,6 +7,7 @@
 
 #include "kernels/densify/densify_shared.h"
 #include "kernels/device_growth.h"
+#include "kernels/elementwise.h"
 #include "kernels/optim/optim_shared.h"
 #include "kernels/subgroup_kernel.h"
 
@@ -168,7 +169,7 @@ void TrainableGaussians::record_accumulate_stats(engine::Sequence& sequence,
   const SplatView view =
       make_splat_view(camera, static_cast<uint32_t>(n), (sh_degree_ + 1) * (sh_degree_ + 1));
   const DeviceGaussians& g = *s.params;
-  sequence.dispatch(*stats_, elementwise_grid(n),
+  sequence.dispatch(*stats_, elementwise_groups(*context_, n, "densify/densify_stats"),
                     {{STATS_BINDING_MEANS, &g.means.buffer(), Access::kRead},
                      {STATS_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
                      {STATS_BINDING_QUATS, &g.quats.buffer(), Access::kRead},
@@ -205,7 +206,7 @@ DensifyReport TrainableGaussians::densify_and_prune(const DensifyOptions& option
   engine::Sequence s1(ctx);
   s1.fill(report_->buffer(), 0u, DENSIFY_REPORT_SLOTS * sizeof(uint32_t));
   auto decide_bindings = [&](const engine::Kernel& kernel, bool decide) {
-    s1.dispatch(kernel, elementwise_grid(n),
+    s1.dispatch(kernel, elementwise_groups(*context_, n, kernel.name().c_str()),
                 {{DECIDE_BINDING_MEANS, &g.means.buffer(), Access::kRead},
                  {DECIDE_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
                  {DECIDE_BINDING_QUATS, &g.quats.buffer(), Access::kRead},
@@ -267,7 +268,7 @@ DensifyReport TrainableGaussians::densify_and_prune(const DensifyOptions& option
   sp.log_split_divisor = params.log_split_divisor;
   const engine::Buffer& decision = decision_->buffer();
   const engine::Buffer& offsets = offsets_->buffer();
-  s2.dispatch(*scatter_geometry_, elementwise_grid(n),
+  s2.dispatch(*scatter_geometry_, elementwise_groups(*context_, n, "densify/densify_scatter_geometry"),
               {{GEOMETRY_BINDING_DECISION, &decision, Access::kRead},
                {GEOMETRY_BINDING_OFFSETS, &offsets, Access::kRead},
                {GEOMETRY_BINDING_MEANS, &g.means.buffer(), Access::kRead},
@@ -281,7 +282,7 @@ DensifyReport TrainableGaussians::densify_and_prune(const DensifyOptions& option
     ScatterParams rp = sp;
     rp.stride = stride;
     rp.zero_new = zero_new ? 1u : 0u;
-    s2.dispatch(*scatter_rows_, elementwise_grid(n),
+    s2.dispatch(*scatter_rows_, elementwise_groups(*context_, n, "densify/densify_scatter_rows"),
                 {{SCATTER_BINDING_DECISION, &decision, Access::kRead},
                  {SCATTER_BINDING_OFFSETS, &offsets, Access::kRead},
                  {SCATTER_BINDING_SRC, &src, Access::kRead},
@@ -321,7 +322,7 @@ void TrainableGaussians::record_reset_opacity(engine::Sequence& sequence, float 
   ResetOpacityParams p{};
   p.count = n;
   p.max_logit = static_cast<float>(std::log(double{reset_opacity} / (1.0 - reset_opacity)));
-  sequence.dispatch(*reset_opacity_, elementwise_grid(n),
+  sequence.dispatch(*reset_opacity_, elementwise_groups(*context_, n, "densify/densify_reset_opacity"),
                     {{RESET_BINDING_OPACITY_LOGITS, &s.params->opacity_logits.buffer(), Access::kReadWrite}},
                     p);
   // 3DGS replaces the opacity tensor in the optimizer with fresh (zero) moments.

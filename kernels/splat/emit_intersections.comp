@@ -3,9 +3,9 @@
 // Per depth-sorted position: one (tile, intersection) pair per touched tile, in depth order, so that a
 // stable sort by tile keeps every tile's list front to back. The rectangle was computed once, in project.
 #include "limits.h"
+#include "elementwise.glsl"
 #include "splat/splat_shared.h"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = EMIT_BINDING_ORDER) readonly buffer Order { uint order[]; };
 layout(std430, binding = EMIT_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 rects[]; };
 layout(std430, binding = EMIT_BINDING_OFFSETS) readonly buffer Offsets { uint offsets[]; };
@@ -15,7 +15,7 @@ layout(std430, binding = EMIT_BINDING_ISECT_GAUSSIAN) writeonly buffer IsectGaus
 layout(push_constant) uniform Push { SplatView view; };
 
 void main() {
-  const uint s = gl_GlobalInvocationID.x;
+  const uint s = elementwise_index();
   if (s >= view.count) return;
   const uint g = order[s];
   const uvec4 r = rects[g];

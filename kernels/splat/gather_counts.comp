@@ -6,9 +6,9 @@
 // counts (two words: the scan of the counts wraps at 2^32, so its last value cannot be trusted for the total);
 // and the rectangle's corners in the 2D difference grid whose prefix sum is each tile's list length.
 #include "limits.h"
+#include "elementwise.glsl"
 #include "splat/splat_shared.h"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = GATHER_BINDING_ORDER) readonly buffer Order { uint order[]; };
 layout(std430, binding = GATHER_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 rects[]; };
 layout(std430, binding = GATHER_BINDING_COUNTS) writeonly buffer Counts { uint counts[]; };
@@ -17,7 +17,7 @@ layout(std430, binding = GATHER_BINDING_COUNTERS) buffer Counters { uint counter
 layout(push_constant) uniform Push { SplatView view; };
 
 void main() {
-  const uint s = gl_GlobalInvocationID.x;
+  const uint s = elementwise_index();
   uint count = 0u;
   if (s < view.count) {
     const uvec4 r = rects[order[s]];

@@ -2,11 +2,11 @@
 #extension GL_GOOGLE_include_directive : require
 // Per Gaussian: projection, culling, colour from SH, the tile rectangle and the depth sort key.
 #include "limits.h"
+#include "elementwise.glsl"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 
 layout(std430, binding = PROJECT_BINDING_MEANS) readonly buffer Means { float means[]; };
 layout(std430, binding = PROJECT_BINDING_LOG_SCALES) readonly buffer LogScales { float log_scales[]; };
@@ -24,7 +24,7 @@ layout(std430, binding = PROJECT_BINDING_ORDER) writeonly buffer Order { uint or
 layout(std430, binding = PROJECT_BINDING_COUNTERS) buffer Counters { uint counters[]; };
 
 void main() {
-  const uint i = gl_GlobalInvocationID.x;
+  const uint i = elementwise_index();
   if (i >= view.count) return;
   const vec3 mean = vec3(means[3 * i], means[3 * i + 1], means[3 * i + 2]);
   const vec3 log_scale = vec3(log_scales[3 * i], log_scales[3 * i + 1], log_scales[3 * i + 2]);

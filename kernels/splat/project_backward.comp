@@ -2,11 +2,11 @@
 #extension GL_GOOGLE_include_directive : require
 // Per Gaussian: gradients of the raw parameters from those of its projected quantities and colour.
 #include "limits.h"
+#include "elementwise.glsl"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = PBWD_BINDING_MEANS) readonly buffer Means { float means[]; };
 layout(std430, binding = PBWD_BINDING_LOG_SCALES) readonly buffer LogScales { float log_scales[]; };
 layout(std430, binding = PBWD_BINDING_QUATS) readonly buffer Quats { float quats[]; };
@@ -22,7 +22,7 @@ layout(std430, binding = PBWD_BINDING_GRAD_SH) writeonly buffer GSh { float g_sh
 layout(std430, binding = PBWD_BINDING_GRAD_MEANS2D) writeonly buffer GMeans2d { float g_means2d[]; };
 
 void main() {
-  const uint i = gl_GlobalInvocationID.x;
+  const uint i = elementwise_index();
   if (i >= view.count) return;
   const uint K = view.sh_coeffs;
   const uvec4 r = rects[i];

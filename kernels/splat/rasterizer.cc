@@ -6,6 +6,7 @@
 #include <string>
 
 #include "kernels/device_growth.h"
+#include "kernels/elementwise.h"
 #include "kernels/limits.h"
 #include "kernels/spirv_registry.h"
 #include "kernels/splat/splat_shared.h"
@@ -16,10 +17,6 @@ using engine::Access;
 using engine::DeviceArray;
 
 namespace {
-
-engine::Groups elementwise(size_t n) {
-  return {static_cast<uint32_t>((n + ELEMENTWISE_GROUP_SIZE - 1) / ELEMENTWISE_GROUP_SIZE)};
-}
 
 // Upper bounds on the loop iterations one subgroup spends per chunk of S list entries (S = subgroup size,
 // C = channels), counting as lavapipe does: every loop entered costs its iterations plus one. They follow
@@ -271,7 +268,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   // Zero the per-render counters; the walks-cut counters after them keep running.
   s1.fill(b.counters->buffer(), 0u, (SPLAT_COUNTER_MAX_LIST + 1) * sizeof(uint32_t));
   s1.fill(b.corners->buffer(), 0u, corner_cells * sizeof(uint32_t));
-  s1.dispatch(*project_, elementwise(n),
+  s1.dispatch(*project_, elementwise_groups(*context_, n, "splat/project"),
               {{PROJECT_BINDING_MEANS, &g.means.buffer(), Access::kRead},
                {PROJECT_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
                {PROJECT_BINDING_QUATS, &g.quats.buffer(), Access::kRead},
@@ -288,7 +285,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
                {PROJECT_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
               view);
   sort_.record(s1, *b.depth_keys, *b.order, n, 32);
-  s1.dispatch(*gather_, elementwise(n),
+  s1.dispatch(*gather_, elementwise_groups(*context_, n, "splat/gather_counts"),
               {{GATHER_BINDING_ORDER, &b.order->buffer(), Access::kRead},
                {GATHER_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kRead},
                {GATHER_BINDING_COUNTS, &b.counts->buffer(), Access::kWrite},
@@ -324,7 +321,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   // 2. Emit intersections in depth order, stable sort by tile, tile ranges, blend in passes over the lists.
   engine::Sequence s2(ctx);
   s2.fill(b.ranges->buffer(), 0u, 2 * tiles * sizeof(uint32_t));
-  s2.dispatch(*emit_, elementwise(n),
+  s2.dispatch(*emit_, elementwise_groups(*context_, n, "splat/emit_intersections"),
               {{EMIT_BINDING_ORDER, &b.order->buffer(), Access::kRead},
                {EMIT_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kRead},
                {EMIT_BINDING_OFFSETS, &b.offsets->buffer(), Access::kRead},
@@ -336,7 +333,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   sort_.record(s2, *b.tile_keys, *b.isect_ids, static_cast<uint32_t>(m), tile_bits);
   SplatView ranges_view = view;
   ranges_view.count = static_cast<uint32_t>(m);
-  s2.dispatch(*ranges_, elementwise(m),
+  s2.dispatch(*ranges_, elementwise_groups(*context_, m, "splat/tile_ranges"),
               {{RANGES_BINDING_TILE_KEYS, &b.tile_keys->buffer(), Access::kRead},
                {RANGES_BINDING_RANGES, &b.ranges->buffer(), Access::kReadWrite}},
               ranges_view);
@@ -464,14 +461,14 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
                 {BWD_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
                pass_params(view, pass, backward_entries_per_pass_));
   if (options_.deterministic)
-    s.dispatch(*reduce_, elementwise(n),
+    s.dispatch(*reduce_, elementwise_groups(*context_, n, "splat/reduce_isect_grads"),
                {{REDUCE_BINDING_ORDER, &b.order->buffer(), Access::kRead},
                 {REDUCE_BINDING_OFFSETS, &b.offsets->buffer(), Access::kRead},
                 {REDUCE_BINDING_COUNTS, &b.counts->buffer(), Access::kRead},
                 {REDUCE_BINDING_ISECT_GRADS, &b.isect_grads->buffer(), Access::kRead},
                 {REDUCE_BINDING_GRAD2D, &b.grad2d->buffer(), Access::kWrite}},
                view);
-  s.dispatch(*project_backward_, elementwise(n),
+  s.dispatch(*project_backward_, elementwise_groups(*context_, n, "splat/project_backward"),
              {{PBWD_BINDING_MEANS, &g.means.buffer(), Access::kRead},
               {PBWD_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
               {PBWD_BINDING_QUATS, &g.quats.buffer(), Access::kRead},

@@ -2,11 +2,11 @@
 #extension GL_GOOGLE_include_directive : require
 // Deterministic mode: per depth-sorted position, sum the Gaussian's intersection rows in emission order.
 #include "limits.h"
+#include "elementwise.glsl"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
 
-layout(local_size_x = ELEMENTWISE_GROUP_SIZE) in;
 layout(std430, binding = REDUCE_BINDING_ORDER) readonly buffer Order { uint order[]; };
 layout(std430, binding = REDUCE_BINDING_OFFSETS) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = REDUCE_BINDING_COUNTS) readonly buffer Counts { uint counts[]; };
@@ -14,7 +14,7 @@ layout(std430, binding = REDUCE_BINDING_ISECT_GRADS) readonly buffer IsectGrads 
 layout(std430, binding = REDUCE_BINDING_GRAD2D) writeonly buffer Grad2d { float grad2d[]; };
 
 void main() {
-  const uint s = gl_GlobalInvocationID.x;
+  const uint s = elementwise_index();
   if (s >= view.count) return;
   const uint g = order[s];
   const uint first = offsets[s], n = counts[s];
