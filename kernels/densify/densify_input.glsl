@@ -12,7 +12,9 @@ layout(std430, binding = DECIDE_BINDING_SH) readonly buffer Sh { float sh[]; };
 layout(std430, binding = DECIDE_BINDING_GRAD_ACCUM) readonly buffer GradAccum { float grad_accum[]; };
 layout(std430, binding = DECIDE_BINDING_DENOM) readonly buffer Denom { uint denom[]; };
 layout(std430, binding = DECIDE_BINDING_MAX_RADIUS) readonly buffer MaxRadius { float max_radius[]; };
-layout(std430, binding = DECIDE_BINDING_PLANE_DISTANCE) readonly buffer PlaneDistance { float plane_distance[]; };
+layout(std430, binding = DECIDE_BINDING_PLANE_DISTANCE) readonly buffer PlaneDistance {
+  float plane_distance[];
+};
 layout(push_constant) uniform Push { DensifyParams p; };
 
 DensifyInput load_input(uint i) {

@@ -16,7 +16,9 @@ layout(std430, binding = GEOMETRY_BINDING_MEANS) readonly buffer Means { float m
 layout(std430, binding = GEOMETRY_BINDING_LOG_SCALES) readonly buffer LogScales { float log_scales[]; };
 layout(std430, binding = GEOMETRY_BINDING_QUATS) readonly buffer Quats { float quats[]; };
 layout(std430, binding = GEOMETRY_BINDING_MEANS_OUT) writeonly buffer MeansOut { float means_out[]; };
-layout(std430, binding = GEOMETRY_BINDING_LOG_SCALES_OUT) writeonly buffer LogScalesOut { float log_scales_out[]; };
+layout(std430, binding = GEOMETRY_BINDING_LOG_SCALES_OUT) writeonly buffer LogScalesOut {
+  float log_scales_out[];
+};
 layout(push_constant) uniform Push { ScatterParams p; };
 
 const float TWO_PI = 6.283185307179586;
@@ -54,7 +56,9 @@ void main() {
   const vec3 mean = vec3(means[3 * i], means[3 * i + 1], means[3 * i + 2]);
   const vec3 log_scale = vec3(log_scales[3 * i], log_scales[3 * i + 1], log_scales[3 * i + 2]);
   mat3 R = mat3(1.0);
-  if (split) R = rotation_from_unit_quat(unit_quat(vec4(quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3])));
+  if (split)
+    R = rotation_from_unit_quat(
+        unit_quat(vec4(quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3])));
   const uint o = offsets[i];
   if (a) write_child(i, o, 0u, split, mean, log_scale, R);
   if (b) write_child(i, a ? o + 1u : o, 1u, split, mean, log_scale, R);

@@ -26,7 +26,8 @@ void main() {
   if (rect.z <= rect.x || rect.w <= rect.y) return;
   // 3DGS's viewspace gradient is w.r.t. NDC (its backward multiplies dL/dpixel by W/2 and H/2): the same
   // scaling here makes its threshold (0.0002) apply unchanged, independent of the image size.
-  const vec2 g = vec2(grad_means2d[2 * i] * (0.5 * float(view.width)), grad_means2d[2 * i + 1] * (0.5 * float(view.height)));
+  const vec2 g = vec2(grad_means2d[2 * i] * (0.5 * float(view.width)),
+                      grad_means2d[2 * i + 1] * (0.5 * float(view.height)));
   const float norm = length(g);
   if (is_finite_real(norm)) grad_accum[i] += norm;
   denom[i] += 1u;

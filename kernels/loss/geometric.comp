@@ -1,8 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Per pixel: the LiDAR point-to-plane residual r = n . (P - D K^-1 [u + 0.5, v + 0.5, 1]), its loss rho(r)
-// and dL/dD = -2 r (n . ray) / (1 + r^2 / s^2) / N_valid. Pixels without a valid point, or where nothing was rendered (D <= 0 or
-// not finite), count 0 and get a zero gradient (see geometric_loss.h).
+// and dL/dD = -2 r (n . ray) / (1 + r^2 / s^2) / N_valid. Pixels without a valid point, or where nothing was
+// rendered (D <= 0 or not finite), count 0 and get a zero gradient (see geometric_loss.h).
 #include "limits.h"
 #include "elementwise.glsl"
 #include "loss/loss_shared.h"
@@ -33,7 +33,8 @@ void main() {
     // rho(r) = log(1 + r^2 / s^2) s^2 (Cauchy), r^2 when inv_scale2 = 0; its series where log(1 + x) in
     // float would lose the small x.
     const float x = r * r * p.inv_scale2;
-    r2 = p.inv_scale2 == 0.0 ? r * r : (x < 1e-3 ? r * r * (1.0 - x * (0.5 - x / 3.0)) : log(1.0 + x) / p.inv_scale2);
+    r2 = p.inv_scale2 == 0.0 ? r * r
+                             : (x < 1e-3 ? r * r * (1.0 - x * (0.5 - x / 3.0)) : log(1.0 + x) / p.inv_scale2);
     g = p.weight * p.inv_valid * (-2.0 * r * n_ray) / (1.0 + x);
     counted = 1.0;
   }

@@ -17,5 +17,6 @@ void main() {
   if (i >= p.count) return;
   const float o = 1.0 / (1.0 + exp(-opacity_logits[i]));
   grad_opacity[i] += p.opacity_reg * o * (1.0 - o);  // d sigmoid / d logit
-  for (uint k = 0u; k < 3u; ++k) grad_log_scales[3 * i + k] += p.scale_reg * exp(min(log_scales[3 * i + k], 20.0));
+  for (uint k = 0u; k < 3u; ++k)
+    grad_log_scales[3 * i + k] += p.scale_reg * exp(min(log_scales[3 * i + k], 20.0));
 }

@@ -9,7 +9,9 @@ layout(std430, binding = WEIGHTS_BINDING_LOG_SCALES) readonly buffer LogScales {
 layout(std430, binding = WEIGHTS_BINDING_MEANS) readonly buffer Means { float means[]; };
 layout(std430, binding = WEIGHTS_BINDING_QUATS) readonly buffer Quats { float quats[]; };
 layout(std430, binding = WEIGHTS_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
-layout(std430, binding = WEIGHTS_BINDING_PLANE_DISTANCE) readonly buffer PlaneDistance { float plane_distance[]; };
+layout(std430, binding = WEIGHTS_BINDING_PLANE_DISTANCE) readonly buffer PlaneDistance {
+  float plane_distance[];
+};
 layout(std430, binding = WEIGHTS_BINDING_WEIGHT) writeonly buffer Weight { uint weight[]; };
 layout(std430, binding = WEIGHTS_BINDING_DEAD) writeonly buffer Dead { uint dead[]; };
 layout(std430, binding = WEIGHTS_BINDING_REPORT) buffer Report { uint report[]; };
@@ -19,7 +21,8 @@ void main() {
   const uint i = elementwise_index();
   if (i >= p.count) return;
   bool finite = true;
-  for (uint k = 0u; k < 3u; ++k) finite = finite && finite_bits(means[3 * i + k]) && finite_bits(log_scales[3 * i + k]);
+  for (uint k = 0u; k < 3u; ++k)
+    finite = finite && finite_bits(means[3 * i + k]) && finite_bits(log_scales[3 * i + k]);
   for (uint k = 0u; k < 4u; ++k) finite = finite && finite_bits(quats[4 * i + k]);
   const float logit = opacity_logits[i];
   finite = finite && finite_bits(logit);

@@ -4,7 +4,9 @@
 #include "scan/scan_shared.h"
 
 layout(std430, binding = SCAN_DOWNSWEEP_BINDING_DATA) buffer Data { uint data[]; };
-layout(std430, binding = SCAN_DOWNSWEEP_BINDING_BLOCK_OFFSETS) readonly buffer BlockOffsets { uint block_offsets[]; };
+layout(std430, binding = SCAN_DOWNSWEEP_BINDING_BLOCK_OFFSETS) readonly buffer BlockOffsets {
+  uint block_offsets[];
+};
 layout(push_constant) uniform Push { ScanParams p; };
 
 void main() {

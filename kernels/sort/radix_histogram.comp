@@ -30,5 +30,6 @@ void main() {
     subgroupBarrier();
   }
 
-  for (uint d = lane; d < RADIX_BUCKETS; d += SUBGROUP_SIZE) counts[d * p.block_count + gl_WorkGroupID.x] = s_count[d];
+  for (uint d = lane; d < RADIX_BUCKETS; d += SUBGROUP_SIZE)
+    counts[d * p.block_count + gl_WorkGroupID.x] = s_count[d];
 }

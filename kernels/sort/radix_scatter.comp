@@ -16,7 +16,8 @@ shared uint s_next[RADIX_BUCKETS];
 
 void main() {
   const uint lane = gl_SubgroupInvocationID;
-  for (uint d = lane; d < RADIX_BUCKETS; d += SUBGROUP_SIZE) s_next[d] = offsets[d * p.block_count + gl_WorkGroupID.x];
+  for (uint d = lane; d < RADIX_BUCKETS; d += SUBGROUP_SIZE)
+    s_next[d] = offsets[d * p.block_count + gl_WorkGroupID.x];
   subgroupMemoryBarrierShared();
   subgroupBarrier();
 

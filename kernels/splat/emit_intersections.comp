@@ -11,7 +11,9 @@ layout(std430, binding = EMIT_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 
 layout(std430, binding = EMIT_BINDING_OFFSETS) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = EMIT_BINDING_TILE_KEYS) writeonly buffer TileKeys { uint tile_keys[]; };
 layout(std430, binding = EMIT_BINDING_ISECT_IDS) writeonly buffer IsectIds { uint isect_ids[]; };
-layout(std430, binding = EMIT_BINDING_ISECT_GAUSSIAN) writeonly buffer IsectGaussian { uint isect_gaussian[]; };
+layout(std430, binding = EMIT_BINDING_ISECT_GAUSSIAN) writeonly buffer IsectGaussian {
+  uint isect_gaussian[];
+};
 layout(push_constant) uniform Push { SplatView view; };
 
 void main() {

@@ -3,8 +3,8 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_basic : require
 // Per depth-sorted position: how many tiles that Gaussian touches (0 when culled); the exact total of all
-// counts (two words: the scan of the counts wraps at 2^32, so its last value cannot be trusted for the total);
-// and the rectangle's corners in the 2D difference grid whose prefix sum is each tile's list length.
+// counts (two words: the scan of the counts wraps at 2^32, so its last value cannot be trusted for the
+// total); and the rectangle's corners in the 2D difference grid whose prefix sum is each tile's list length.
 #include "limits.h"
 #include "elementwise.glsl"
 #include "splat/splat_shared.h"

@@ -31,7 +31,8 @@ void main() {
   const vec4 quat = vec4(quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]);
   const Projected pr = project_gaussian(view_geometry(), mean, log_scale, quat, opacity_logits[i]);
   bool sh_finite = true;
-  for (uint k = 0u; k < view.sh_coeffs * CHANNELS; ++k) sh_finite = sh_finite && is_finite_real(sh[i * view.sh_coeffs * CHANNELS + k]);
+  for (uint k = 0u; k < view.sh_coeffs * CHANNELS; ++k)
+    sh_finite = sh_finite && is_finite_real(sh[i * view.sh_coeffs * CHANNELS + k]);
   if (!pr.finite || !sh_finite) atomicAdd(counters[SPLAT_COUNTER_CULLED_NONFINITE], 1u);
 
   uvec4 rect = uvec4(0u);
@@ -61,7 +62,8 @@ void main() {
   for (uint c = 0u; c < CHANNELS; ++c) {
     float sum = 0.5;
     if (kept)
-      for (uint k = 0u; k < view.sh_coeffs; ++k) sum += basis[k] * sh[(i * view.sh_coeffs + k) * CHANNELS + c];
+      for (uint k = 0u; k < view.sh_coeffs; ++k)
+        sum += basis[k] * sh[(i * view.sh_coeffs + k) * CHANNELS + c];
     colors[i * CHANNELS + c] = max(sum, 0.0);
   }
 }

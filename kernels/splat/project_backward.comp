@@ -48,7 +48,8 @@ void main() {
   const vec3 mean = vec3(means[3 * i], means[3 * i + 1], means[3 * i + 2]);
   const vec3 log_scale = vec3(log_scales[3 * i], log_scales[3 * i + 1], log_scales[3 * i + 2]);
   const vec4 quat = vec4(quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]);
-  const ParamGrad p = project_gaussian_backward(view_geometry(), mean, log_scale, quat, opacity_logits[i], pg);
+  const ParamGrad p =
+      project_gaussian_backward(view_geometry(), mean, log_scale, quat, opacity_logits[i], pg);
 
   // Colour = sum_k basis_k c_k + 0.5, clamped at 0; its direction depends on the mean.
   const vec3 ray = mean - camera_centre();

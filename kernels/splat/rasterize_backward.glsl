@@ -3,7 +3,8 @@
 // pixel's upstream gradients into per-Gaussian gradients of (mean2d, conic, opacity, depth, colour).
 //
 // The including .comp defines SPLAT_BWD_MODE:
-//   SPLAT_BWD_FLOAT_ATOMICS  per subgroup: subgroupAdd, then one atomicAdd per value (VK_EXT_shader_atomic_float)
+//   SPLAT_BWD_FLOAT_ATOMICS  per subgroup: subgroupAdd, then one atomicAdd per value
+//                            (VK_EXT_shader_atomic_float)
 //   SPLAT_BWD_CAS_ATOMICS    the same with a compare-and-swap loop, for devices without float atomics
 //   SPLAT_BWD_DETERMINISTIC  the workgroup sums each entry in a fixed order and writes it to the
 //                            intersection's own row; reduce_isect_grads.comp sums rows per Gaussian.
@@ -56,9 +57,9 @@ struct EntryGrad {
 
 // One list entry, walked back to front. `in_walk`: the entry lies within this pixel's forward walk.
 // Updates the running transmittance and the sums of what lies behind. Predicated, not branched.
-EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4 color, float depth, bool in_walk,
-                         float T_final, vec4 dL_dC, float dL_dN, float dL_dA, inout float T, inout vec4 acc_c,
-                         inout float acc_z) {
+EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4 color, float depth,
+                         bool in_walk, float T_final, vec4 dL_dC, float dL_dN, float dL_dA, inout float T,
+                         inout vec4 acc_c, inout float acc_z) {
   const vec2 d = centre - mean_extent.xy;
   const float sigma = gaussian_sigma(conic_opacity.xyz, d);
   const float vis = exp(-min(sigma, SIGMA_CUTOFF));
@@ -68,14 +69,16 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
   const float one_minus = 1.0 - alpha;
   const float Ti = T / one_minus;
   const float w = hit ? alpha * Ti : 0.0;
-  const float dL_dalpha_image = channels_dot(dL_dC, channels_fma(channels_scale(-1.0 / one_minus, acc_c), Ti, color));
+  const float dL_dalpha_image =
+      channels_dot(dL_dC, channels_fma(channels_scale(-1.0 / one_minus, acc_c), Ti, color));
   const bool differentiable = hit && raw <= float(SPLAT_ALPHA_MAX);  // the 0.99 clamp has no gradient
   const float dL_dalpha = differentiable ? dL_dalpha_image + dL_dN * (depth * Ti - acc_z / one_minus) +
                                                dL_dA * T_final / one_minus
                                          : 0.0;
   // Without DEPTH_GRAD_TO_OPACITY the depth and alpha terms reach the footprint (mean, shape) but not the
   // opacity, which only the image decides (RasterizerOptions::depth_gradient_to_opacity).
-  const float dL_dopacity = DEPTH_GRAD_TO_OPACITY != 0u ? dL_dalpha : (differentiable ? dL_dalpha_image : 0.0);
+  const float dL_dopacity =
+      DEPTH_GRAD_TO_OPACITY != 0u ? dL_dalpha : (differentiable ? dL_dalpha_image : 0.0);
   const float dL_dsigma = -dL_dalpha * alpha;
   EntryGrad r;
   r.g0 = vec4(-dL_dsigma * (conic_opacity.x * d.x + conic_opacity.y * d.y),
@@ -90,7 +93,8 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
 }
 
 // Loads list entry `i`'s Gaussian.
-void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity, out vec4 color, out float depth) {
+void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity, out vec4 color,
+                out float depth) {
   g = isect_gaussian[isect_ids[i]];
   const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
   const float opacity = opacities[g];
@@ -176,9 +180,10 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 cent
       const uint bit = uint(findMSB(todo[word]));
       todo[word] &= ~(1u << bit);
       const uint k = 32u * uint(word) + bit;
-      const EntryGrad r = entry_backward(centre, subgroupShuffle(mean_extent, k), subgroupShuffle(conic_opacity, k),
-                                         channels_shuffle(color, k), subgroupShuffle(depth, k),
-                                         chunk_start + k < my_last, T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
+      const EntryGrad r =
+          entry_backward(centre, subgroupShuffle(mean_extent, k), subgroupShuffle(conic_opacity, k),
+                         channels_shuffle(color, k), subgroupShuffle(depth, k), chunk_start + k < my_last,
+                         T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
       vec4 s0 = r.g0, s1 = r.g1, s2 = r.g2;
       subgroup_sum3(s0, s1, s2);
       if (gl_SubgroupInvocationID == k) {
@@ -244,8 +249,8 @@ void main() {
     uint g;
     bool relevant;
     vec4 a0, a1, a2;
-    chunk_backward(range.x, chunk_start, chunk_end, centre, subgroup_lo, subgroup_hi, my_last, T_final, dL_dC, dL_dN,
-                   dL_dA, T, acc_c, acc_z, g, relevant, a0, a1, a2);
+    chunk_backward(range.x, chunk_start, chunk_end, centre, subgroup_lo, subgroup_hi, my_last, T_final, dL_dC,
+                   dL_dN, dL_dA, T, acc_c, acc_z, g, relevant, a0, a1, a2);
     const uint slot = (gl_SubgroupID * S + gl_SubgroupInvocationID) * 3u;
     s_partial[slot] = a0;
     s_partial[slot + 1u] = a1;
@@ -276,14 +281,15 @@ void main() {
     uint g;
     bool relevant;
     vec4 a0, a1, a2;
-    chunk_backward(range.x, chunk_start_below(chunk_end), chunk_end, centre, subgroup_lo, subgroup_hi, my_last,
-                   T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z, g, relevant, a0, a1, a2);
+    chunk_backward(range.x, chunk_start_below(chunk_end), chunk_end, centre, subgroup_lo, subgroup_hi,
+                   my_last, T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z, g, relevant, a0, a1, a2);
     if (relevant) add_entry_grads(g, a0, a1, a2);
   }
   if (chunk_end > segment.begin && subgroupElect()) atomicAdd(counters[SPLAT_COUNTER_BACKWARD_WALKS_CUT], 1u);
 #endif
 
-  // Pixels walked in this pass whose walk goes on in the next pass (the segment before) hand over their state.
+  // Pixels walked in this pass whose walk goes on in the next pass (the segment before) hand over their
+  // state.
   if (segment.begin > 0u && my_last > segment.begin) {
     state[pix] = T;
     state[plane + pix] = acc_z;

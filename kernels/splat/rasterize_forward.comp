@@ -104,7 +104,8 @@ void main() {
   }
   // A driver's loop limit (lavapipe: 65535 iterations per invocation) ends the walk early without an error:
   // count it, so that a pass sized wrongly for a device is seen (SPLAT_COUNTER_FORWARD_WALKS_CUT).
-  if (chunk < end && !subgroupAll(done) && subgroupElect()) atomicAdd(counters[SPLAT_COUNTER_FORWARD_WALKS_CUT], 1u);
+  if (chunk < end && !subgroupAll(done) && subgroupElect())
+    atomicAdd(counters[SPLAT_COUNTER_FORWARD_WALKS_CUT], 1u);
   if (!inside) return;
   for (uint c = 0u; c < CHANNELS; ++c) image[c * plane + pix] = accum[c];
   if (!final_pass) {  // more of the list follows in the next pass
