@@ -266,11 +266,6 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   ensure(ctx, b.order, n, "splat: depth order");
   ensure(ctx, b.counts, n, "splat: tile counts");
   ensure(ctx, b.offsets, n, "splat: tile offsets");
-  ensure(ctx, b.image, pixels * channels_, "splat: image");
-  ensure(ctx, b.depth, pixels, "splat: expected depth");
-  ensure(ctx, b.alpha, pixels, "splat: alpha");
-  ensure(ctx, b.last, pixels, "splat: last");
-  ensure(ctx, b.ranges, 2 * tiles, "splat: tile ranges");
   ensure(ctx, b.corners, corner_cells, "splat: tile corners");
   profile_.clear();
 
@@ -325,6 +320,12 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   longest_tile_list_ = c[SPLAT_COUNTER_MAX_LIST];
   forward_walks_cut_before_ = c[SPLAT_COUNTER_FORWARD_WALKS_CUT];
   forward_passes_ = passes_for(forward_entries_per_pass_);
+  // Per-pixel and per-intersection buffers only now that the render is known to fit.
+  ensure(ctx, b.image, pixels * channels_, "splat: image");
+  ensure(ctx, b.depth, pixels, "splat: expected depth");
+  ensure(ctx, b.alpha, pixels, "splat: alpha");
+  ensure(ctx, b.last, pixels, "splat: last");
+  ensure(ctx, b.ranges, 2 * tiles, "splat: tile ranges");
   ensure(ctx, b.tile_keys, m, "splat: tile keys");
   ensure(ctx, b.isect_ids, m, "splat: intersection ids");
   ensure(ctx, b.isect_gaussian, m, "splat: intersection gaussians");
