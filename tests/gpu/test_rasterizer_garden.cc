@@ -12,11 +12,13 @@
 #include "kernels/splat/reference.h"
 #include "npz_reader.h"
 #include "splat_scenes.h"
+#include "tests/support/test_data.h"
 
 namespace litgs {
 namespace {
 
-const std::string kGarden = std::string(LITGS_SHARED_DATA_DIR) + "/gsplat-garden/test_garden.npz";
+// Throws (the test fails, naming the path) when the archive is missing: never a silent skip.
+std::string garden_path() { return testing::test_data("gsplat-garden/test_garden.npz").string(); }
 
 struct Garden {
   kernels::GaussianModel model;
@@ -26,12 +28,13 @@ struct Garden {
 // Isotropic Gaussians sized by the median nearest-neighbour spacing of a sample of points (as 3DGS sizes
 // its initial Gaussians by neighbour distance), coloured from the points, opacity 0.7.
 Garden load_garden(uint32_t channels, uint32_t degree) {
-  const auto means = testing::read_npz_array(kGarden, "means3d").as_float();
-  const auto colors = testing::read_npz_array(kGarden, "colors").as_float();
-  const auto viewmats = testing::read_npz_array(kGarden, "viewmats").as_float();
-  const auto Ks = testing::read_npz_array(kGarden, "Ks").as_float();
-  const auto width = testing::read_npz_array(kGarden, "width").as_scalar_int();
-  const auto height = testing::read_npz_array(kGarden, "height").as_scalar_int();
+  const std::string path = garden_path();
+  const auto means = testing::read_npz_array(path, "means3d").as_float();
+  const auto colors = testing::read_npz_array(path, "colors").as_float();
+  const auto viewmats = testing::read_npz_array(path, "viewmats").as_float();
+  const auto Ks = testing::read_npz_array(path, "Ks").as_float();
+  const auto width = testing::read_npz_array(path, "width").as_scalar_int();
+  const auto height = testing::read_npz_array(path, "height").as_scalar_int();
   const size_t n = means.size() / 3;
 
   std::mt19937 rng(1);
@@ -90,11 +93,6 @@ Garden load_garden(uint32_t channels, uint32_t degree) {
 
 class RasterizerGarden : public testing::GpuTest {
  protected:
-  void SetUp() override {
-    testing::GpuTest::SetUp();
-    if (!std::filesystem::exists(kGarden)) GTEST_SKIP() << "shared data not found: " << kGarden;
-  }
-
   void check_parity(uint32_t channels, uint32_t degree) {
     const Garden garden = load_garden(channels, degree);
     kernels::DeviceGaussians g(context(), garden.model);
