@@ -106,15 +106,23 @@ class RasterizerGarden : public testing::GpuTest {
       const auto img = testing::compare(got.image, want.image, 1e-4);
       const auto alp = testing::compare(got.alpha, want.alpha, 1e-4);
       const auto dep = testing::compare(got.depth, want.depth, 1e-3);
-      std::printf("garden C=%u view %zu: %llu intersections; image max|d| %.2e, %.4f within 1e-4; alpha %.2e, "
-                  "%.4f; depth %.2e, %.4f within 1e-3\n",
-                  channels, v, static_cast<unsigned long long>(got.intersections), img.max_abs,
-                  img.fraction_within, alp.max_abs, alp.fraction_within, dep.max_abs, dep.fraction_within);
+      const auto outside = [](const testing::Agreement& a) {
+        return static_cast<unsigned long long>(std::llround((1.0 - a.fraction_within) * static_cast<double>(a.count)));
+      };
+      std::printf("garden C=%u view %zu: %llu intersections; image max|d| %.2e, %llu of %zu values off by > 1e-4; "
+                  "alpha %.2e, %llu of %zu; depth %.2e, %llu of %zu off by > 1e-3\n",
+                  channels, v, static_cast<unsigned long long>(got.intersections), img.max_abs, outside(img),
+                  img.count, alp.max_abs, outside(alp), alp.count, dep.max_abs, outside(dep), dep.count);
       // float32 against double over lists of thousands of Gaussians: a few pixels cross the 1/255 or
-      // T = 1e-4 thresholds at a different entry; everything else agrees to 1e-4.
-      EXPECT_GE(img.fraction_within, 0.995) << "view " << v;
-      EXPECT_GE(alp.fraction_within, 0.995) << "view " << v;
-      EXPECT_GE(dep.fraction_within, 0.995) << "view " << v;
+      // T = 1e-4 thresholds at a different entry; everything else agrees to 1e-4. Measured on lavapipe: at
+      // most 38 of 816,480 image values (99.995%), 7 of 272,160 alpha values and 1 depth value outside, the
+      // worst off by 3.9e-3. The README states the figures asserted here: 99.99% within, none off by 5e-3.
+      EXPECT_GE(img.fraction_within, 0.9999) << "view " << v;
+      EXPECT_GE(alp.fraction_within, 0.9999) << "view " << v;
+      EXPECT_GE(dep.fraction_within, 0.9999) << "view " << v;
+      EXPECT_LT(img.max_abs, 5e-3) << "view " << v;
+      EXPECT_LT(alp.max_abs, 5e-3) << "view " << v;
+      EXPECT_LT(dep.max_abs, 5e-3) << "view " << v << " (metres)";
     }
   }
 };
