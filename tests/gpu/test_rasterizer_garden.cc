@@ -107,12 +107,14 @@ class RasterizerGarden : public testing::GpuTest {
       const auto alp = testing::compare(got.alpha, want.alpha, 1e-4);
       const auto dep = testing::compare(got.depth, want.depth, 1e-3);
       const auto outside = [](const testing::Agreement& a) {
-        return static_cast<unsigned long long>(std::llround((1.0 - a.fraction_within) * static_cast<double>(a.count)));
+        return static_cast<unsigned long long>(
+            std::llround((1.0 - a.fraction_within) * static_cast<double>(a.count)));
       };
-      std::printf("garden C=%u view %zu: %llu intersections; image max|d| %.2e, %llu of %zu values off by > 1e-4; "
-                  "alpha %.2e, %llu of %zu; depth %.2e, %llu of %zu off by > 1e-3\n",
-                  channels, v, static_cast<unsigned long long>(got.intersections), img.max_abs, outside(img),
-                  img.count, alp.max_abs, outside(alp), alp.count, dep.max_abs, outside(dep), dep.count);
+      std::printf(
+          "garden C=%u view %zu: %llu intersections; image max|d| %.2e, %llu of %zu values off by > 1e-4; "
+          "alpha %.2e, %llu of %zu; depth %.2e, %llu of %zu off by > 1e-3\n",
+          channels, v, static_cast<unsigned long long>(got.intersections), img.max_abs, outside(img),
+          img.count, alp.max_abs, outside(alp), alp.count, dep.max_abs, outside(dep), dep.count);
       // float32 against double over lists of thousands of Gaussians: a few pixels cross the 1/255 or
       // T = 1e-4 thresholds at a different entry; everything else agrees to 1e-4. Measured on lavapipe: at
       // most 38 of 816,480 image values (99.995%), 7 of 272,160 alpha values and 1 depth value outside, the

@@ -52,8 +52,7 @@ TEST_F(ImportMetashapeTest, ImportsDunrAndReadsItBack) {
   for (const auto& p : scene.poses) EXPECT_LT(p.p_world.norm(), 20.0) << "recentred";
 
   // The decoded pixel values arrive unchanged (the JPEG is decoded once and stored losslessly).
-  EXPECT_EQ(load_frame(o.out, scene, 0).data,
-            read_image(data / "radjpg/22-18-41-880-radiometric.jpg").data);
+  EXPECT_EQ(load_frame(o.out, scene, 0).data, read_image(data / "radjpg/22-18-41-880-radiometric.jpg").data);
 
   // Poses: scene pose + offset equals the XML's camera-to-world, for every camera.
   const MetashapeDocument doc = read_metashape_xml(o.xml);
