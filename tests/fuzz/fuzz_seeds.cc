@@ -1,7 +1,8 @@
 // Writes the generated part of the seed corpora (tests/fuzz/corpus/<target>/gen-*): small valid files
 // from the io writers. Not run in CI; rerun by hand after a format change:
 //   build-fuzz/tests/fuzz/litgs_fuzz_seeds tests/fuzz/corpus
-// The real-data seeds (TUM, M2DGR calibration, Metashape XML, DUNR JPEG) are copied from ../shared/data.
+// The real-data seeds (TUM, M2DGR calibration, Metashape XML, DUNR JPEG) are copies of files in tests/data
+// (licences and provenance there).
 #include <filesystem>
 #include <fstream>
 #include <iostream>
