@@ -74,6 +74,28 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& c) {
   });
 }
 
+std::filesystem::path checkpoint_path(const std::filesystem::path& out_dir, uint32_t iteration) {
+  return out_dir / "checkpoints" / ("iter_" + std::to_string(iteration) + ".ckpt");
+}
+
+std::filesystem::path newest_checkpoint(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  fs::path best;
+  uint32_t best_it = 0;
+  if (!fs::is_directory(dir / "checkpoints")) return best;
+  for (const auto& e : fs::directory_iterator(dir / "checkpoints")) {
+    // iter_<digits>.ckpt only: temporaries of an interrupted write (iter_N.ckpt.tmp-...) and other files are
+    // not checkpoints.
+    const std::string name = e.path().filename().string();
+    if (name.rfind("iter_", 0) != 0 || e.path().extension() != ".ckpt") continue;
+    const std::string digits = name.substr(5, name.size() - 5 - 5);
+    if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const uint32_t it = static_cast<uint32_t>(std::stoul(digits));
+    if (best.empty() || it > best_it) best = e.path(), best_it = it;
+  }
+  return best;
+}
+
 Checkpoint read_checkpoint(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) io::fail(path, 0, "cannot open the checkpoint");

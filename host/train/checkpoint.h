@@ -20,6 +20,10 @@ struct Checkpoint {
 };
 
 void write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint);
+// A run's checkpoint after `iteration` iterations: out_dir/checkpoints/iter_<iteration>.ckpt.
+std::filesystem::path checkpoint_path(const std::filesystem::path& out_dir, uint32_t iteration);
+// The checkpoint of out_dir with the highest iteration; empty if there is none.
+std::filesystem::path newest_checkpoint(const std::filesystem::path& out_dir);
 // io::IoError naming the file and byte on a truncated, foreign or inconsistent file.
 Checkpoint read_checkpoint(const std::filesystem::path& path);
 

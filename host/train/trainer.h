@@ -12,18 +12,12 @@
 
 #include "engine/context.h"
 #include "host/train/lidar_planes.h"
+#include "host/train/run_record.h"
 #include "host/train/train_options.h"
 #include "host/train/training_data.h"
 #include "kernels/splat/splat_types.h"
 
 namespace litgs::host {
-
-struct EvalResult {
-  uint32_t iteration = 0;
-  double psnr_db = 0;   // mean over held-out views
-  double ssim = 0;
-  double depth_plane_rmse_m = -1;  // against ground-truth planes where the scene has them; -1 otherwise
-};
 
 struct TrainReport {
   uint32_t iterations = 0;
