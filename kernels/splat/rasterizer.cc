@@ -324,7 +324,12 @@ void Rasterizer::backward(const RenderGradInput& grad) {
 Rasterizer::DeviceOutputs Rasterizer::device_outputs() const {
   if (!last_gaussians_) throw std::logic_error("Rasterizer::device_outputs before forward");
   const Buffers& b = *buffers_;
-  return {&b.image->buffer(), &b.depth->buffer(), &b.alpha->buffer(), &b.rects->buffer()};
+  return {&b.image->buffer(), &b.depth->buffer(), &b.alpha->buffer(), &b.rects->buffer(), &b.counters->buffer()};
+}
+
+uint64_t Rasterizer::truncated_tile_lists() const {
+  if (!last_gaussians_) return 0;
+  return buffers_->counters->download(1, 1)[0];
 }
 
 Rasterizer::DeviceUpstream Rasterizer::upstream_buffers() {

@@ -77,6 +77,9 @@ class Rasterizer {
     const engine::Buffer* depth;   // [H][W]
     const engine::Buffer* alpha;   // [H][W]
     const engine::Buffer* rects;   // [N][4] uint tile rectangles; empty (x1 <= x0) when culled
+    // [4] uint, the last forward's counters (splat_shared.h): [0] Gaussians culled as non-finite by the
+    // projection, [1] tiles whose intersection list the forward truncated; [2], [3] unused.
+    const engine::Buffer* counters;
   };
   DeviceOutputs device_outputs() const;
   struct DeviceUpstream {
@@ -102,6 +105,9 @@ class Rasterizer {
   // Per-kernel GPU times of the last forward (and backward, if run after it).
   const std::vector<engine::KernelTime>& profile() const { return profile_; }
   uint64_t intersections() const { return intersections_; }
+  // Tiles whose intersection list the last forward truncated (counters[1] of rasterize_forward.comp; one small
+  // download). 0 before any forward.
+  uint64_t truncated_tile_lists() const;
   uint32_t channels() const { return channels_; }
   bool uses_float_atomics() const;
 
