@@ -13,7 +13,9 @@ Evaluator::Evaluator(const TrainingData& data, const TrainOptions& o, const Plan
     if (data.views[i].heldout) views_.push_back(i);
 }
 
-EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32_t iteration) {
+EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32_t iteration,
+                               std::vector<kernels::RenderImages<float>>* renders) {
+  if (renders) renders->clear();
   const uint32_t W = data_->width, H = data_->height;
   EvalResult e;
   e.iteration = iteration;
@@ -43,6 +45,7 @@ EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32
           ++plane_n;
         }
     }
+    if (renders) renders->push_back(img);
   }
   e.psnr_db /= static_cast<double>(views_.size());
   e.ssim /= static_cast<double>(views_.size());

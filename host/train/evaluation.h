@@ -20,8 +20,10 @@ class Evaluator {
             kernels::Rasterizer& rasterizer);
 
   // The held-out views' mean PSNR and SSIM (zero without held-out views) after `iteration` iterations (the
-  // SH degree of that point of the ramp).
-  EvalResult evaluate(const kernels::DeviceGaussians& gaussians, uint32_t iteration);
+  // SH degree of that point of the ramp). `renders` (optional) receives each held-out view's render, in the
+  // order of views().
+  EvalResult evaluate(const kernels::DeviceGaussians& gaussians, uint32_t iteration,
+                      std::vector<kernels::RenderImages<float>>* renders = nullptr);
   const std::vector<uint32_t>& views() const { return views_; }
 
  private:

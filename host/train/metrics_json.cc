@@ -27,6 +27,16 @@ nlohmann::json metrics_json(const TrainReport& report, const TrainingData& data,
   if (report.final_eval.depth_plane_rmse_m >= 0)
     metrics["heldout_depth_plane_rmse_m"] = report.final_eval.depth_plane_rmse_m;
   for (const auto& e : report.evals) metrics["evaluations"].push_back(to_json(e));
+  // Over the whole run (a resumed run continues its checkpoint's); always present, 0 when nothing happened.
+  metrics["counters"] = to_json(report.counters);
+  metrics["resumes"] = nlohmann::json::array();
+  for (const auto& r : report.resumes) metrics["resumes"].push_back(to_json(r));
+  // wall_s, ms_per_iteration and kernel_ms_per_iteration are of this call: iterations
+  // start_iteration..iterations.
+  metrics["start_iteration"] = report.start_iteration;
+  metrics["point_cloud_frame"] = o.recentred_output ? "recentred" : "original";
+  metrics["scene_world_offset_m"] = {data.world_offset_m.x(), data.world_offset_m.y(),
+                                     data.world_offset_m.z()};
   return metrics;
 }
 

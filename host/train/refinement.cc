@@ -50,6 +50,7 @@ void Refinement::after_step(kernels::TrainableGaussians& model, kernels::McmcStr
       const kernels::DensifyReport d = model.densify_and_prune(step_options, extent_, step, plane_distance);
       counters.pruned_plane += d.pruned_plane;
       counters.pruned_nonfinite += d.pruned_nonfinite;
+      counters.densify_capped += d.capped;
     }
   }
   if (!mcmc && step < until && step % o.opacity_reset_every == 0) {

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -61,8 +62,7 @@ struct ResumeRecord {
 // Everything a checkpoint holds besides the training state.
 struct RunRecord {
   // The run's options and the identity of its training data (host/train/run_options.h), compared on resume.
-  // Null in a format-1 checkpoint.
-  nlohmann::json options;
+  nlohmann::json options = nlohmann::json::object();
   TrainingCounters counters;
   std::vector<EvalResult> evaluations;  // in iteration order, up to the checkpoint
   std::vector<ResumeRecord> resumes;
@@ -74,12 +74,16 @@ inline nlohmann::json to_json(const EvalResult& e) {
   if (e.depth_plane_rmse_m >= 0) j["depth_plane_rmse_m"] = e.depth_plane_rmse_m;
   return j;
 }
+// JSON has no NaN or infinity: nlohmann writes them as null, read back as NaN.
+inline double number_or_nan(const nlohmann::json& j) {
+  return j.is_null() ? std::numeric_limits<double>::quiet_NaN() : j.get<double>();
+}
 inline EvalResult eval_from_json(const nlohmann::json& j) {
   EvalResult e;
   e.iteration = j.at("iteration").get<uint32_t>();
-  e.psnr_db = j.at("psnr_db").get<double>();
-  e.ssim = j.at("ssim").get<double>();
-  if (j.contains("depth_plane_rmse_m")) e.depth_plane_rmse_m = j.at("depth_plane_rmse_m").get<double>();
+  e.psnr_db = number_or_nan(j.at("psnr_db"));
+  e.ssim = number_or_nan(j.at("ssim"));
+  if (j.contains("depth_plane_rmse_m")) e.depth_plane_rmse_m = number_or_nan(j.at("depth_plane_rmse_m"));
   return e;
 }
 
@@ -127,6 +131,7 @@ inline nlohmann::json to_json(const RunRecord& r) {
 inline RunRecord run_record_from_json(const nlohmann::json& j) {
   RunRecord r;
   r.options = j.at("options");
+  if (!r.options.is_object()) throw nlohmann::json::type_error::create(302, "options must be an object", &j);
   r.counters = counters_from_json(j.at("counters"));
   for (const auto& e : j.at("evaluations")) r.evaluations.push_back(eval_from_json(e));
   for (const auto& e : j.at("resumes")) r.resumes.push_back(resume_from_json(e));

@@ -54,6 +54,9 @@ struct TrainOptions {
   bool deterministic = false;      // bit-identical gradients (slower)
   uint32_t seed = 0;               // view order and densification noise
   uint32_t progress_every = 50;    // log cadence when stdout is not a terminal
+  // point_cloud.ply in the scene's recentred frame (scene = original - world_offset_m, docs/scene-format.md)
+  // instead of the original world frame. Training and checkpoints always use the scene frame.
+  bool recentred_output = false;
   void check() const;              // throws std::invalid_argument naming the bad field
   // The SH degree rendered after `iterations_done` iterations (the ramp: one more every sh_degree_every).
   uint32_t active_sh_degree(uint32_t iterations_done) const {

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <iostream>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -10,7 +11,9 @@
 #include "host/train/checkpoint.h"
 #include "host/train/evaluation.h"
 #include "host/train/metrics_json.h"
+#include "host/train/output_frame.h"
 #include "host/train/refinement.h"
+#include "host/train/run_options.h"
 #include "host/train/training_step.h"
 #include "host/train/view_sampler.h"
 #include "io/gaussian_ply.h"
@@ -21,6 +24,82 @@
 namespace litgs::host {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// Where a run starts: a fresh model, or the newest checkpoint in the output directory (the model, the view
+// sampler's state, and the run record: evaluations, counters, resumes).
+struct RunStart {
+  std::unique_ptr<kernels::TrainableGaussians> model;
+  uint32_t iteration = 0;
+  RunRecord record;
+};
+
+RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, const TrainOptions& o,
+                   const fs::path& out_dir, const nlohmann::json& options, ViewSampler& sampler,
+                   const std::function<void(const std::string&)>& notice) {
+  RunStart s;
+  if (!o.resume) {
+    s.model = std::make_unique<kernels::TrainableGaussians>(ctx, initial);
+    s.record.options = options;
+    return s;
+  }
+  const fs::path ckpt = newest_checkpoint(out_dir);
+  if (ckpt.empty())
+    throw std::invalid_argument("--resume: no checkpoint in " + (out_dir / "checkpoints").string());
+  Checkpoint c = read_checkpoint(ckpt);
+  if (c.has_record) {
+    for (const std::string& note : check_resume_options(ckpt, c.iteration, c.record.options, options))
+      notice("resume: " + note);
+  } else {
+    notice("resume: warning: " + ckpt.string() +
+           " predates stored options (checkpoint format 1): they cannot be compared, so make sure this run's "
+           "are "
+           "the checkpoint's; its evaluations and counters before iteration " +
+           std::to_string(c.iteration) + " are unknown, and metrics.json counts from there");
+  }
+  if (c.iteration > o.iterations)
+    throw std::invalid_argument(ckpt.string() + ": the checkpoint is at iteration " +
+                                std::to_string(c.iteration) + ", beyond --iterations " +
+                                std::to_string(o.iterations));
+  try {
+    sampler.restore(c);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(ckpt.string() + ": " + e.what());
+  }
+  notice("resume: from " + ckpt.string() + " (iteration " + std::to_string(c.iteration) + " of " +
+         std::to_string(o.iterations) + ")");
+  s.model = std::make_unique<kernels::TrainableGaussians>(ctx, c.state);
+  s.iteration = c.iteration;
+  s.record = std::move(c.record);
+  s.record.options = options;  // later checkpoints store this run's options (an extended --iterations)
+  s.record.resumes.push_back({c.iteration, c.has_record});
+  return s;
+}
+
+void save_checkpoint(const fs::path& out_dir, uint32_t step, const ViewSampler& sampler,
+                     const kernels::TrainableGaussians& model, const RunRecord& record) {
+  Checkpoint c;
+  c.iteration = step;
+  sampler.save(c);
+  c.state = model.download_state();
+  c.record = record;
+  write_checkpoint(checkpoint_path(out_dir, step), c);
+}
+
+// point_cloud.ply in the original world frame (the scene's means + world_offset_m), or with recentred_output
+// in the scene's; its header states which (output_frame.h).
+void write_model(const fs::path& path, const kernels::TrainableGaussians& model, const TrainingData& data,
+                 const TrainOptions& o) {
+  ModelFrame frame;
+  frame.scene_world_offset_m = data.world_offset_m;
+  frame.world_offset_m = o.recentred_output ? data.world_offset_m : Eigen::Vector3d::Zero();
+  kernels::GaussianModel m = model.download();
+  if (!o.recentred_output) m = shift_means(std::move(m), data.world_offset_m);
+  io::write_gaussian_ply(path, m, model_frame_comments(frame));
+}
+
+}  // namespace
 
 void TrainOptions::check() const {
   auto bad = [](const std::string& what) { throw std::invalid_argument("TrainOptions." + what); };
@@ -55,7 +134,8 @@ kernels::McmcOptions TrainOptions::mcmc_options() const {
 
 TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels::GaussianModel& initial,
                   const PlanarMap* planes, const TrainOptions& o, const fs::path& out_dir,
-                  const std::function<void(const TrainProgress&)>& progress, const PlanarMap* gt_planes) {
+                  const std::function<void(const TrainProgress&)>& progress, const PlanarMap* gt_planes,
+                  const std::function<void(const std::string&)>& notice_callback) {
   o.check();
   if (o.lambda_geo > 0 && !planes)
     throw std::invalid_argument("lambda_geo > 0 needs a LiDAR map (the scene has none); use --lambda-geo 0");
@@ -63,6 +143,12 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   for (uint32_t i = 0; i < data.views.size(); ++i)
     if (!data.views[i].heldout) train_views.push_back(i);
   if (train_views.empty()) throw std::invalid_argument("no training views (all held out)");
+  const auto notice = [&](const std::string& line) {
+    if (notice_callback)
+      notice_callback(line);
+    else
+      std::cerr << "train: " << line << "\n";
+  };
   fs::create_directories(out_dir);
   if (o.checkpoint_every > 0) fs::create_directories(out_dir / "checkpoints");
 
@@ -73,73 +159,80 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   kernels::Rasterizer rasterizer(ctx, 1, ropt);
   TrainingStep training_step(ctx, data, planes, o, rasterizer);
   Evaluator evaluator(data, o, gt_planes, rasterizer);
-
-  // The model, fresh or from the newest checkpoint.
-  std::unique_ptr<kernels::TrainableGaussians> model;
   ViewSampler sampler(train_views, o.seed);
-  uint32_t start = 0;
-  if (o.resume) {
-    const fs::path ckpt = newest_checkpoint(out_dir);
-    if (ckpt.empty())
-      throw std::invalid_argument("--resume: no checkpoint in " + (out_dir / "checkpoints").string());
-    const Checkpoint c = read_checkpoint(ckpt);
-    model = std::make_unique<kernels::TrainableGaussians>(ctx, c.state);
-    try {
-      sampler.restore(c);
-    } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(ckpt.string() + ": " + e.what());
-    }
-    start = c.iteration;
-  } else {
-    model = std::make_unique<kernels::TrainableGaussians>(ctx, initial);
-  }
+  RunStart run = start_run(ctx, initial, o, out_dir, run_options_json(o, data), sampler, notice);
+  kernels::TrainableGaussians& model = *run.model;
+  RunRecord& record = run.record;
+  const uint32_t start = run.iteration;
   std::unique_ptr<kernels::McmcStrategy> mcmc;
   if (o.strategy == "mcmc") mcmc = std::make_unique<kernels::McmcStrategy>(ctx);
   Refinement refinement(ctx, o, planes, static_cast<float>(data.scene_extent_m));
 
-  TrainReport report;
-  TrainingCounters counters;
-  double last_psnr = std::numeric_limits<double>::quiet_NaN();
+  // Adam counts its skips per model object: this call's, on top of the checkpoint's.
+  const auto adam_before = record.counters.adam_nonfinite_skips;
+  const auto count_adam_skips = [&] {
+    const auto now = model.nonfinite_grad_counts();
+    for (uint32_t g = 0; g < kernels::kParamGroupCount; ++g)
+      record.counters.adam_nonfinite_skips[g] = adam_before[g] + now[g];
+  };
+  // The final evaluation replaces one the checkpoint may already hold for the same iteration.
+  const auto add_evaluation = [&](const EvalResult& e) {
+    if (!record.evaluations.empty() && record.evaluations.back().iteration == e.iteration)
+      record.evaluations.back() = e;
+    else
+      record.evaluations.push_back(e);
+  };
+
+  double last_psnr = record.evaluations.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                                : record.evaluations.back().psnr_db;
   KernelTimes kernel_ms;
   const auto t0 = std::chrono::steady_clock::now();
+  double wall = 0;
   for (uint32_t it = start; it < o.iterations; ++it) {
     const uint32_t step = it + 1;
-    training_step.run(*model, mcmc.get(), it, sampler.next(), kernel_ms);
-    refinement.after_step(*model, mcmc.get(), step, counters);
+    training_step.run(model, mcmc.get(), it, sampler.next(), kernel_ms, record.counters);
+    refinement.after_step(model, mcmc.get(), step, record.counters);
     const bool last = step == o.iterations;
-    if (o.eval_every > 0 && (step % o.eval_every == 0) && !last) {
-      report.evals.push_back(evaluator.evaluate(model->gaussians(), step));
-      last_psnr = report.evals.back().psnr_db;
+    if (last) wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // At the last step the final evaluation, so that a checkpoint there holds it.
+    if (last || (o.eval_every > 0 && step % o.eval_every == 0)) {
+      add_evaluation(evaluator.evaluate(model.gaussians(), step));
+      last_psnr = record.evaluations.back().psnr_db;
     }
     if (o.checkpoint_every > 0 && step % o.checkpoint_every == 0) {
-      Checkpoint c;
-      c.iteration = step;
-      sampler.save(c);
-      c.state = model->download_state();
-      write_checkpoint(checkpoint_path(out_dir, step), c);
+      count_adam_skips();
+      save_checkpoint(out_dir, step, sampler, model, record);
     }
     if (progress && (step % o.progress_every == 0 || last || step == start + 1)) {
+      count_adam_skips();
       const StepLosses l = training_step.last_losses();
       const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      progress({step, o.iterations, l.total, l.photometric, l.geometric_rms_m, last_psnr, model->size(),
-                (step - start) / std::max(secs, 1e-9)});
+      progress({step, o.iterations, l.total, l.photometric, l.geometric_rms_m, last_psnr, model.size(),
+                (step - start) / std::max(secs, 1e-9), record.counters});
     }
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (start == o.iterations)
+    add_evaluation(evaluator.evaluate(model.gaussians(), o.iterations));  // nothing ran
+  count_adam_skips();
+
+  TrainReport report;
   const double done_iterations = std::max(1.0, static_cast<double>(o.iterations - start));
   for (const auto& [name, ms] : kernel_ms)
     report.kernel_ms_per_iteration.emplace_back(name, ms / done_iterations);
-  report.final_eval = evaluator.evaluate(model->gaussians(), o.iterations);
-  report.evals.push_back(report.final_eval);
+  report.final_eval = record.evaluations.back();
+  report.evals = record.evaluations;
   report.iterations = o.iterations;
+  report.start_iteration = start;
   report.wall_s = wall;
   report.ms_per_iteration = o.iterations > start ? 1000.0 * wall / (o.iterations - start) : 0.0;
-  report.gaussians = model->size();
+  report.gaussians = model.size();
   report.peak_device_bytes = engine::Buffer::peak_bytes();
-  report.nonfinite_pruned = counters.pruned_nonfinite;
-  report.plane_pruned = counters.pruned_plane;
+  report.counters = record.counters;
+  report.nonfinite_pruned = record.counters.pruned_nonfinite;
+  report.plane_pruned = record.counters.pruned_plane;
+  report.resumes = record.resumes;
 
-  io::write_gaussian_ply(out_dir / "point_cloud.ply", model->download());
+  write_model(out_dir / "point_cloud.ply", model, data, o);
   write_metrics_json(out_dir / "metrics.json", report, data, o);
   return report;
 }

@@ -40,7 +40,8 @@ TrainingStep::TrainingStep(engine::Context& ctx, const TrainingData& data, const
                      return p;
                    }()),
       geometric_(ctx),
-      losses_(ctx, "train: losses", kLossSlots, engine::MemoryKind::kHostVisible) {
+      losses_(ctx, "train: losses", kLossSlots, engine::MemoryKind::kHostVisible),
+      render_counters_(ctx, "train: render counters", 2, engine::MemoryKind::kHostVisible) {
   const uint32_t W = data.width, H = data.height;
   const bool geometric = o.lambda_geo > 0;
   if (geometric && !planes) throw std::invalid_argument("TrainingStep: lambda_geo > 0 needs a LiDAR map");
@@ -66,7 +67,7 @@ TrainingStep::TrainingStep(engine::Context& ctx, const TrainingData& data, const
 TrainingStep::~TrainingStep() = default;
 
 void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc, uint32_t it,
-                       uint32_t v, KernelTimes& times) {
+                       uint32_t v, KernelTimes& times, TrainingCounters& counters) {
   const TrainOptions& o = *options_;
   const uint32_t W = data_->width, H = data_->height;
   const uint32_t step = it + 1;
@@ -80,6 +81,7 @@ void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy
   const auto up = rasterizer.upstream_buffers();
 
   engine::Sequence s(*context_);
+  s.copy(*out.counters, render_counters_.buffer(), 2 * sizeof(uint32_t));
   photometric_.record(s, *out.image, views_[v].target->buffer(), W, H, static_cast<float>(1.0 - o.lambda_geo),
                       *up.image, losses_.buffer(), kSlotPhotometric);
   if (geometric)
@@ -103,6 +105,9 @@ void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy
   if (mcmc) mcmc->record_noise(s, model, mcmc_options_, lr.means, step);
   s.submit_and_wait();
   for (const auto& k : s.profile()) times[k.name] += k.ms;
+  const std::vector<uint32_t> c = render_counters_.download();  // host-visible: written by this submit
+  counters.culled_nonfinite += c[0];
+  counters.truncated_tile_lists += c[1];
 }
 
 StepLosses TrainingStep::last_losses() const {

@@ -12,6 +12,7 @@
 #include "engine/buffer.h"
 #include "engine/context.h"
 #include "host/train/lidar_planes.h"
+#include "host/train/run_record.h"
 #include "host/train/train_options.h"
 #include "host/train/training_data.h"
 #include "kernels/loss/geometric_loss.h"
@@ -41,9 +42,10 @@ class TrainingStep {
   ~TrainingStep();
 
   // Iteration `it` (0-based) on training view `view`: one forward, one submit. `mcmc` is the MCMC strategy
-  // (null: ADC). GPU times are added to `times`.
+  // (null: ADC). GPU times are added to `times`, and the render's culled and truncated counts to `counters`
+  // (copied to host-visible memory inside the step's submit: no extra sync).
   void run(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc, uint32_t it, uint32_t view,
-           KernelTimes& times);
+           KernelTimes& times, TrainingCounters& counters);
   StepLosses last_losses() const;
 
  private:
@@ -55,7 +57,8 @@ class TrainingStep {
   kernels::McmcOptions mcmc_options_;
   kernels::PhotometricLoss photometric_;
   kernels::GeometricLoss geometric_;
-  engine::DeviceArray<float> losses_;  // [kLossSlots], host-visible
+  engine::DeviceArray<float> losses_;              // [kLossSlots], host-visible
+  engine::DeviceArray<uint32_t> render_counters_;  // [2] the rasterizer's counters[0..1], host-visible
   std::vector<ViewBuffers> views_;
 };
 
