@@ -99,6 +99,48 @@ void write_model(const fs::path& path, const kernels::TrainableGaussians& model,
   io::write_gaussian_ply(path, m, model_frame_comments(frame));
 }
 
+// The training views' indices; throws std::invalid_argument when the inputs cannot be trained.
+std::vector<uint32_t> check_inputs(const TrainingData& data, const PlanarMap* planes, const TrainOptions& o) {
+  o.check();
+  if (o.lambda_geo > 0 && !planes)
+    throw std::invalid_argument("lambda_geo > 0 needs a LiDAR map (the scene has none); use --lambda-geo 0");
+  std::vector<uint32_t> train_views;
+  for (uint32_t i = 0; i < data.views.size(); ++i)
+    if (!data.views[i].heldout) train_views.push_back(i);
+  if (train_views.empty()) throw std::invalid_argument("no training views (all held out)");
+  return train_views;
+}
+
+// Adds an evaluation; the final one replaces one the checkpoint may already hold for the same iteration.
+void add_evaluation(RunRecord& record, const EvalResult& e) {
+  if (!record.evaluations.empty() && record.evaluations.back().iteration == e.iteration)
+    record.evaluations.back() = e;
+  else
+    record.evaluations.push_back(e);
+}
+
+// The report of a call that ran iterations start..iterations in `wall_s` (GPU times `kernel_ms`).
+TrainReport make_report(const RunRecord& record, const kernels::TrainableGaussians& model,
+                        const TrainOptions& o, uint32_t start, double wall_s, const KernelTimes& kernel_ms) {
+  TrainReport report;
+  const double done_iterations = std::max(1.0, static_cast<double>(o.iterations - start));
+  for (const auto& [name, ms] : kernel_ms)
+    report.kernel_ms_per_iteration.emplace_back(name, ms / done_iterations);
+  report.final_eval = record.evaluations.back();
+  report.evals = record.evaluations;
+  report.iterations = o.iterations;
+  report.start_iteration = start;
+  report.wall_s = wall_s;
+  report.ms_per_iteration = o.iterations > start ? 1000.0 * wall_s / (o.iterations - start) : 0.0;
+  report.gaussians = model.size();
+  report.peak_device_bytes = engine::Buffer::peak_bytes();
+  report.counters = record.counters;
+  report.nonfinite_pruned = record.counters.pruned_nonfinite;
+  report.plane_pruned = record.counters.pruned_plane;
+  report.resumes = record.resumes;
+  return report;
+}
+
 }  // namespace
 
 void TrainOptions::check() const {
@@ -136,13 +178,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
                   const PlanarMap* planes, const TrainOptions& o, const fs::path& out_dir,
                   const std::function<void(const TrainProgress&)>& progress, const PlanarMap* gt_planes,
                   const std::function<void(const std::string&)>& notice_callback) {
-  o.check();
-  if (o.lambda_geo > 0 && !planes)
-    throw std::invalid_argument("lambda_geo > 0 needs a LiDAR map (the scene has none); use --lambda-geo 0");
-  std::vector<uint32_t> train_views;
-  for (uint32_t i = 0; i < data.views.size(); ++i)
-    if (!data.views[i].heldout) train_views.push_back(i);
-  if (train_views.empty()) throw std::invalid_argument("no training views (all held out)");
+  const std::vector<uint32_t> train_views = check_inputs(data, planes, o);
   const auto notice = [&](const std::string& line) {
     if (notice_callback)
       notice_callback(line);
@@ -175,13 +211,6 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     for (uint32_t g = 0; g < kernels::kParamGroupCount; ++g)
       record.counters.adam_nonfinite_skips[g] = adam_before[g] + now[g];
   };
-  // The final evaluation replaces one the checkpoint may already hold for the same iteration.
-  const auto add_evaluation = [&](const EvalResult& e) {
-    if (!record.evaluations.empty() && record.evaluations.back().iteration == e.iteration)
-      record.evaluations.back() = e;
-    else
-      record.evaluations.push_back(e);
-  };
 
   double last_psnr = record.evaluations.empty() ? std::numeric_limits<double>::quiet_NaN()
                                                 : record.evaluations.back().psnr_db;
@@ -196,7 +225,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     if (last) wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     // At the last step the final evaluation, so that a checkpoint there holds it.
     if (last || (o.eval_every > 0 && step % o.eval_every == 0)) {
-      add_evaluation(evaluator.evaluate(model.gaussians(), step));
+      add_evaluation(record, evaluator.evaluate(model.gaussians(), step));
       last_psnr = record.evaluations.back().psnr_db;
     }
     if (o.checkpoint_every > 0 && step % o.checkpoint_every == 0) {
@@ -212,26 +241,10 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     }
   }
   if (start == o.iterations)
-    add_evaluation(evaluator.evaluate(model.gaussians(), o.iterations));  // nothing ran
+    add_evaluation(record, evaluator.evaluate(model.gaussians(), o.iterations));  // nothing ran
   count_adam_skips();
 
-  TrainReport report;
-  const double done_iterations = std::max(1.0, static_cast<double>(o.iterations - start));
-  for (const auto& [name, ms] : kernel_ms)
-    report.kernel_ms_per_iteration.emplace_back(name, ms / done_iterations);
-  report.final_eval = record.evaluations.back();
-  report.evals = record.evaluations;
-  report.iterations = o.iterations;
-  report.start_iteration = start;
-  report.wall_s = wall;
-  report.ms_per_iteration = o.iterations > start ? 1000.0 * wall / (o.iterations - start) : 0.0;
-  report.gaussians = model.size();
-  report.peak_device_bytes = engine::Buffer::peak_bytes();
-  report.counters = record.counters;
-  report.nonfinite_pruned = record.counters.pruned_nonfinite;
-  report.plane_pruned = record.counters.pruned_plane;
-  report.resumes = record.resumes;
-
+  const TrainReport report = make_report(record, model, o, start, wall, kernel_ms);
   write_model(out_dir / "point_cloud.ply", model, data, o);
   write_metrics_json(out_dir / "metrics.json", report, data, o);
   return report;
