@@ -2,6 +2,7 @@
 // field.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 
@@ -53,7 +54,17 @@ struct TrainOptions {
   bool deterministic = false;      // bit-identical gradients (slower)
   uint32_t seed = 0;               // view order and densification noise
   uint32_t progress_every = 50;    // log cadence when stdout is not a terminal
+  // point_cloud.ply in the scene's recentred frame (scene = original - world_offset_m, docs/scene-format.md)
+  // instead of the original world frame. Training and checkpoints always use the scene frame.
+  bool recentred_output = false;
   void check() const;              // throws std::invalid_argument naming the bad field
+  // The SH degree rendered after `iterations_done` iterations (the ramp: one more every sh_degree_every).
+  uint32_t active_sh_degree(uint32_t iterations_done) const {
+    return std::min(sh_degree, iterations_done / sh_degree_every);
+  }
+  // Refinement and opacity resets run while step < refine_until() (3DGS), so never on the last iteration:
+  // Gaussians split, relocated or made transparent there would reach the output unfitted.
+  uint32_t refine_until() const { return std::min(densify_until, iterations); }
   kernels::McmcOptions mcmc_options() const;
   // The photometric loss's weight in L, 1 - lambda_geo (1 when lambda_geo = 1: no photometric term to be
   // relative to). 3DGS-MCMC's regularizers, calibrated against a photometric loss at unit weight, are scaled

@@ -414,7 +414,7 @@ void Rasterizer::backward(const RenderGradInput& grad) {
 Rasterizer::DeviceOutputs Rasterizer::device_outputs() const {
   if (!last_gaussians_) throw std::logic_error("Rasterizer::device_outputs before forward");
   const Buffers& b = *buffers_;
-  return {&b.image->buffer(), &b.depth->buffer(), &b.alpha->buffer(), &b.rects->buffer()};
+  return {&b.image->buffer(), &b.depth->buffer(), &b.alpha->buffer(), &b.rects->buffer(), &b.counters->buffer()};
 }
 
 Rasterizer::DeviceUpstream Rasterizer::upstream_buffers() {
