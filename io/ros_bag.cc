@@ -147,8 +147,12 @@ PointCloud to_cloud(const sensor_msgs::PointCloud2& m, const std::string& where)
                       f[k]->datatype != sensor_msgs::PointField::FLOAT64))
       throw std::runtime_error(where + ": field '" + names[k] + "' has datatype " +
                                std::to_string(f[k]->datatype) + " (x y z must be float32 or float64)");
-    if (f[k]->offset + size > m.point_step)
-      throw std::runtime_error(where + ": field '" + std::string(names[k]) + "' lies beyond point_step");
+    // Subtraction, not offset + size: both are uint32_t, and a forged offset near 2^32 would wrap the sum
+    // below point_step and send the reads 4 GiB past the point.
+    if (f[k]->offset > m.point_step || static_cast<uint32_t>(size) > m.point_step - f[k]->offset)
+      throw std::runtime_error(where + ": field '" + std::string(names[k]) + "' (offset " +
+                               std::to_string(f[k]->offset) + ", " + std::to_string(size) +
+                               " bytes) lies beyond point_step " + std::to_string(m.point_step));
   }
   const size_t n = static_cast<size_t>(m.width) * m.height;
   if (m.row_step < static_cast<size_t>(m.width) * m.point_step ||

@@ -125,6 +125,57 @@ TEST_F(ImportBagTest, BadBagsAreNamed) {
   EXPECT_FALSE(std::filesystem::exists(o.out / "scene.yaml"));
 }
 
+// A PointCloud2 whose field offset is forged to 2^32 - 4 (the issue-12 review): offset + 4 wraps to 0 in
+// 32-bit arithmetic, which passed the old "offset + size > point_step" check and read 4 GiB past each point.
+// The bag is written by rosbag_storage and the one serialized PointField is patched in place (same length,
+// so the bag's records stay consistent).
+TEST_F(ImportBagTest, PointCloudFieldOffsetThatWouldWrapIsAnError) {
+  PointCloud c;
+  c.positions = {{1, 2, 3}, {4, 5, 6}};
+  c.intensity = {7, 8};
+  {
+    RosBagWriter w(dir_ / "cloud.bag");
+    w.cloud("/velodyne_points", 100.0, c);
+    w.close();
+  }
+  const std::string good = read_file_bytes(dir_ / "cloud.bag");
+  RosBagTopics topics;
+  topics.thermal = topics.imu = "";
+  size_t points = 0;
+  RosBagHandlers h;
+  h.lidar = [&](double, PointCloud cloud) { points += cloud.size(); };
+  read_ros_bag(dir_ / "cloud.bag", topics, h);
+  ASSERT_EQ(points, 2u);  // the unpatched bag reads
+
+  // Serialized sensor_msgs/PointField: string name (uint32 length + bytes), uint32 offset, uint8 datatype
+  // (7 = FLOAT32), uint32 count; little-endian.
+  for (const auto& [name, offset] : {std::pair<std::string, uint32_t>{"x", 0}, {"z", 8}, {"intensity", 12}}) {
+    for (uint32_t forged : {0xFFFFFFFCu, 0xFFFFFFFFu}) {
+      std::string field(4, '\0');
+      field[0] = static_cast<char>(name.size());
+      field += name;
+      const auto put_u32 = [](std::string& s, uint32_t v) {
+        for (int b = 0; b < 4; ++b) s += static_cast<char>((v >> (8 * b)) & 0xff);
+      };
+      std::string original = field, patched = field;
+      put_u32(original, offset);
+      put_u32(patched, forged);
+      original += '\x07';
+      patched += '\x07';
+      const size_t at = good.find(original);
+      ASSERT_NE(at, std::string::npos) << name;
+      ASSERT_EQ(good.find(original, at + 1), std::string::npos) << name << ": the field must occur once";
+      std::string bad = good;
+      bad.replace(at, patched.size(), patched);
+      std::ofstream(dir_ / "forged.bag", std::ios::binary | std::ios::trunc) << bad;
+      testing::expect_io_error(
+          [&] { read_ros_bag(dir_ / "forged.bag", topics, h); },
+          {"forged.bag", "/velodyne_points", "field '" + name + "'", "beyond point_step 16"});
+    }
+  }
+  EXPECT_EQ(points, 2u);  // no forged message reached the handler
+}
+
 // Truncations and byte flips of a valid bag: read_ros_bag reads something or throws IoError, never another
 // exception (rosbag_storage's own exceptions are translated).
 TEST_F(ImportBagTest, CorruptBagsThrowIoErrorOnly) {
