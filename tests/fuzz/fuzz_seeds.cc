@@ -1,6 +1,6 @@
 // Writes the generated part of the seed corpora (tests/fuzz/corpus/<target>/gen-*): small valid files
 // from the io writers. Not run in CI; rerun by hand after a format change:
-//   build-fuzz/tests/fuzz/litgs_fuzz_seeds tests/fuzz/corpus
+//   build-fuzz/litgs_fuzz_seeds tests/fuzz/corpus   (executables land in the build directory's root)
 // The ROS bags need a build with rosbag_storage (ci/setup). The real-data seeds (TUM, M2DGR calibration,
 // Metashape XML, DUNR JPEG) are copied from ../shared/data.
 #include <cmath>
