@@ -222,7 +222,7 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--holdout-every", o->data.holdout_every, "Hold out every Nth frame (0: none)")->capture_default_str();
   cmd->add_option("--intensity", o->intensity, "auto | percentile | linear")->capture_default_str();
   cmd->add_option("--plane-prune-k", o->train.plane_prune_k,
-                  "Prune Gaussians beyond median + k MAD of their LiDAR-plane distances (0: off)")
+                  "Prune Gaussians beyond median + k * 1.4826 * MAD of their LiDAR-plane distances (at least 10 cm; 0: off)")
       ->capture_default_str();
   cmd->add_option("--poses", o->poses, "estimated (poses.txt) or truth (gt/poses.txt of synthetic scenes)")
       ->capture_default_str();
@@ -230,7 +230,7 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--densify-until", o->train.densify_until, "Last densification iteration")->capture_default_str();
   cmd->add_option("--densify-every", o->train.densify_every, "Densification cadence")->capture_default_str();
   cmd->add_option("--densify-grad-threshold", o->train.densify_grad_threshold,
-                  "Screen-space gradient threshold, for the photometric loss at unit weight (3DGS units)")
+                  "Densify where the screen-space gradient of the total loss exceeds this (3DGS units; not scaled by 1 - lambda_geo)")
       ->capture_default_str();
   cmd->add_option("--opacity-reset-every", o->train.opacity_reset_every, "Opacity reset cadence")->capture_default_str();
   cmd->add_option("--progress-every", o->train.progress_every, "Progress cadence")->capture_default_str();

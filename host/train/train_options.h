@@ -32,7 +32,7 @@ struct TrainOptions {
   // Of the averaged screen-space mean gradient of the total loss, in 3DGS units. Not scaled by
   // photometric_weight(): the geometric term's gradient lands in the same statistic, and on the synthetic
   // facade (lambda_geo 0.6, true poses) scaling it by 0.4 densified where depth, not appearance, was off,
-  // and cost 2.1 dB of held-out PSNR (README, Training).
+  // and lost held-out PSNR (commit a08255b; the figure was not recorded).
   float densify_grad_threshold = 0.0002f;
   // The geometric outlier prune: Gaussians farther from their LiDAR plane than median + k 1.4826 MAD of all
   // such distances (at least 10 cm) are pruned at each refinement; 0 turns it off.
