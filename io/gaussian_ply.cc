@@ -75,8 +75,26 @@ kernels::GaussianModel read_gaussian_ply(const std::filesystem::path& path) {
   return m;
 }
 
-void write_gaussian_ply(const std::filesystem::path& path, const kernels::GaussianModel& m) {
+std::vector<std::string> read_gaussian_ply_comments(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, 0, "cannot open the file");
+  std::vector<std::string> comments;
+  std::string line;
+  for (int i = 1; i <= 1000 && std::getline(in, line); ++i) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (i == 1 && line != "ply") fail(path, 1, "not a PLY file (no 'ply' line)");
+    if (line == "end_header") return comments;
+    if (line.rfind("comment ", 0) == 0) comments.push_back(line.substr(8));
+  }
+  fail(path, 0, "PLY header without end_header in its first 1000 lines");
+}
+
+void write_gaussian_ply(const std::filesystem::path& path, const kernels::GaussianModel& m,
+                        const std::vector<std::string>& comments) {
   m.check();
+  for (const auto& c : comments)
+    if (c.find_first_of("\r\n") != std::string::npos)
+      throw std::invalid_argument("write_gaussian_ply: a header comment holds a line break: '" + c + "'");
   if (m.channels != 1 && m.channels != 3)
     throw std::invalid_argument("write_gaussian_ply: the 3DGS PLY holds 1 (as gray) or 3 channels, not " +
                                 std::to_string(m.channels));
@@ -85,6 +103,7 @@ void write_gaussian_ply(const std::filesystem::path& path, const kernels::Gaussi
   write_file_atomic(path, [&](std::ostream& out) {
     out << "ply\nformat binary_little_endian 1.0\n";
     if (C == 1) out << "comment litgs_channels 1\n";
+    for (const auto& c : comments) out << "comment " << c << "\n";
     out << "element vertex " << n << "\n";
     for (const char* p : {"x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"})
       out << "property float " << p << "\n";

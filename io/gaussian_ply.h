@@ -8,6 +8,8 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "kernels/splat/splat_types.h"
 
@@ -17,8 +19,13 @@ namespace litgs::io {
 // property, an f_rest count that is not 3 * (K - 1) for K in {1, 4, 9, 16}, a one-channel comment on a
 // file whose colour slots differ.
 kernels::GaussianModel read_gaussian_ply(const std::filesystem::path& path);
+// The header's comment lines, without "comment " (litgs_channels included), in order; IoError naming the file
+// if it cannot be opened or is not a PLY.
+std::vector<std::string> read_gaussian_ply_comments(const std::filesystem::path& path);
 
-// Writes atomically (temporary file, then rename). Models with 1 or 3 channels.
-void write_gaussian_ply(const std::filesystem::path& path, const kernels::GaussianModel& model);
+// Writes atomically (temporary file, then rename). Models with 1 or 3 channels. `comments` become header lines
+// "comment TEXT" (one line each: std::invalid_argument on a line break).
+void write_gaussian_ply(const std::filesystem::path& path, const kernels::GaussianModel& model,
+                        const std::vector<std::string>& comments = {});
 
 }  // namespace litgs::io

@@ -1,10 +1,13 @@
-// ROS 1 bags through Debian's rosbag_storage library: the four message types a LiDAR-inertial-thermal
-// scene needs, converted to io/ types. No ROS header leaks out of io/ros_bag.cc.
+// ROS 1 bags: the four message types a LiDAR-inertial-thermal scene needs, converted to io/ types.
 //
-// Built only when the ROS packages are found (ci/setup installs librosbag-storage-dev, libsensor-msgs-dev,
-// libnav-msgs-dev); ros_bag_available() says so at run time. This header (and the .cc) stay C++17: the
-// generated ROS 1 message headers use std::allocator<void>::rebind, removed in C++20, so ros_bag.cc is
-// compiled as C++17 in its own target.
+// Reading (ros_bag_read.cc) is our own parser of the bag format 2.0 and of the messages' serialization,
+// which checks every length and offset before it reads or allocates (rosbag_storage's reader trusts them:
+// see the .cc), and needs no ROS library. Writing (RosBagWriter, for tests and fuzz seeds) goes through
+// Debian's rosbag_storage, built only when the ROS packages are found (ci/setup installs
+// librosbag-storage-dev, libsensor-msgs-dev, libnav-msgs-dev); ros_bag_writer_available() says so at run
+// time. This header stays C++17 and no ROS header leaks out of ros_bag.cc: the generated ROS 1 message
+// headers use std::allocator<void>::rebind, removed in C++20, so ros_bag.cc is compiled as C++17 in its own
+// target.
 #pragma once
 
 #include <filesystem>
@@ -19,8 +22,8 @@
 
 namespace litgs::io {
 
-// True when this build can read and write bags.
-bool ros_bag_available();
+// True when this build can write bags (RosBagWriter); reading is always available.
+bool ros_bag_writer_available();
 
 struct RosBagTopics {
   std::string thermal = "/thermal_image_raw";  // sensor_msgs/Image
@@ -42,18 +45,26 @@ struct RosBagCounts {
   size_t thermal = 0, lidar = 0, imu = 0, odom = 0;
 };
 
-// Reads the topics of `topics` (empty names are skipped). IoError naming the bag (and the message's topic,
-// index and time) on a missing or corrupt bag, a topic whose type is not the expected one, or a message
-// that cannot be converted (unknown image encoding, short data, a point cloud without x y z float fields
-// or in big-endian). Topics absent from the bag give no messages (check the counts).
+// Reads the topics of `topics` (empty names are skipped) through the bag's index, in time order (ties in
+// file order), like rosbag::View. Chunks may be uncompressed, bz2 or lz4. IoError naming the bag (and the
+// byte, or the message's index, topic and time) on a missing, unindexed (unfinished recording), corrupt or
+// truncated bag, a bag format other than 2.0, a topic whose type (or definition MD5) is not the expected
+// one, or a message that cannot be converted (its bytes do not match its type's layout, unknown image
+// encoding, short data, a point cloud without x y z float fields, a field beyond point_step or in
+// big-endian, a non-finite IMU value or odometry position, a non-unit orientation). Topics absent from the
+// bag give no messages (check the counts).
 RosBagCounts read_ros_bag(const std::filesystem::path& bag, const RosBagTopics& topics,
                           const RosBagHandlers& handlers);
 
-// Writes a bag with rosbag_storage (for tests and exports). Images: 1 channel -> mono8/mono16, 3 -> rgb8/
-// rgb16; clouds: x y z float32 [intensity float32]. IoError on library errors.
+enum class RosBagCompression { kNone, kBz2, kLz4 };
+
+// Writes a bag with rosbag_storage (for tests and fuzz seeds). Images: 1 channel -> mono8/mono16, 3 -> rgb8/
+// rgb16; clouds: x y z float32 [intensity float32]. IoError on library errors, or when the build has none
+// (ros_bag_writer_available()).
 class RosBagWriter {
  public:
-  explicit RosBagWriter(const std::filesystem::path& bag);
+  explicit RosBagWriter(const std::filesystem::path& bag,
+                        RosBagCompression compression = RosBagCompression::kNone);
   ~RosBagWriter();
   RosBagWriter(const RosBagWriter&) = delete;
   RosBagWriter& operator=(const RosBagWriter&) = delete;

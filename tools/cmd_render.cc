@@ -1,5 +1,12 @@
 // `litgs-engine render`: one view of a 3DGS PLY model, on the device (or with the double-precision CPU
 // reference), to PNG: the image, and optionally expected depth and accumulated alpha.
+//
+// Frames: poses are in the scene's frame, the frame of its poses.txt (recentred: original world - world_offset_m),
+// whenever the scene's offset is known (--scene, or the PLY's litgs_scene_world_offset_m header line that train
+// writes); the model is moved into that frame in double precision before it is rendered, so a model trained on
+// a scene renders at the scene's poses whatever frame its PLY is in (host/train/output_frame.h). --pose-frame
+// original takes poses in original world coordinates (export tum/colmap's default), --pose-frame model in the
+// PLY's own coordinates (the only choice for a PLY from elsewhere without --scene).
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -8,10 +15,15 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
 #include <stdexcept>
 
 #include "engine/context.h"
+#include "host/train/output_frame.h"
+#include "host/train/training_data.h"
 #include "io/gaussian_ply.h"
+#include "io/scene.h"
 #include "io/image.h"
 #include "kernels/splat/rasterizer.h"
 #include "kernels/splat/reference.h"
@@ -33,6 +45,11 @@ struct RenderOptions {
   double depth_scale = 1000.0;       // depth PNG value per metre (1000: millimetres, up to 65.535 m)
   std::string alpha_out;             // accumulated alpha, 8-bit PNG
   bool reference = false;            // render with the double-precision CPU reference instead of the device
+  std::string scene;                 // scene directory: its world_offset_m, and its cameras for --time
+  std::string time;                  // render the scene's view at this time (s), as training sees it
+  double downscale = 1.0;            // --time: the training resolution (train's --downscale)
+  std::string poses = "estimated";   // --time: estimated (poses.txt) | truth (gt/poses.txt)
+  std::string pose_frame = "auto";   // auto | scene | original | model (see the top of this file)
 };
 
 glm::dmat3 rotation_from_quat(double w, double x, double y, double z) {
@@ -88,9 +105,50 @@ io::Image to_image(const std::vector<float>& planes, uint32_t w, uint32_t h, uin
   return img;
 }
 
+std::string vector_text(const Eigen::Vector3d& v) {
+  std::ostringstream s;
+  s << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+  return s.str();
+}
+
+// The camera of the scene's view at time `text` (seconds), as training builds it.
+kernels::SplatCamera scene_camera(const RenderOptions& o, const io::Scene& scene) {
+  if (!o.camera_json.empty() || !o.pose.empty())
+    throw std::invalid_argument("give --time, or --camera, or --pose: not more than one");
+  if (o.pose_frame != "auto" && o.pose_frame != "scene")
+    throw std::invalid_argument("--time renders the scene's camera, in the scene frame: --pose-frame " + o.pose_frame +
+                                " does not apply");
+  if (o.poses != "estimated" && o.poses != "truth")
+    throw std::invalid_argument("--poses must be estimated or truth, not '" + o.poses + "'");
+  double t = 0;
+  try {
+    size_t used = 0;
+    t = std::stod(o.time, &used);
+    if (used != o.time.size()) throw std::invalid_argument("trailing characters");
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--time '" + o.time + "' is not a number of seconds");
+  }
+  host::TrainingDataOptions data;
+  data.downscale = o.downscale;
+  data.true_poses = o.poses == "truth";
+  return host::training_camera(o.scene, scene, t, data);
+}
+
 void run_render(const RenderOptions& o) {
+  if (o.pose_frame != "auto" && o.pose_frame != "scene" && o.pose_frame != "original" && o.pose_frame != "model")
+    throw std::invalid_argument("--pose-frame must be auto, scene, original or model, not '" + o.pose_frame + "'");
+  if (!o.time.empty() && o.scene.empty()) throw std::invalid_argument("--time needs --scene (the scene's cameras)");
+  std::optional<io::Scene> scene;
+  if (!o.scene.empty()) {
+    io::SceneReadOptions read;
+    read.check_images = false;
+    read.load_map = false;
+    scene = io::read_scene(o.scene, read);
+  }
   kernels::SplatCamera camera;
-  if (!o.camera_json.empty()) {
+  if (!o.time.empty()) {
+    camera = scene_camera(o, *scene);
+  } else if (!o.camera_json.empty()) {
     camera = camera_from_json(o.camera_json);
   } else {
     if (o.pose.size() != 7 || o.intrinsics.size() != 4 || o.width == 0 || o.height == 0)
@@ -105,18 +163,41 @@ void run_render(const RenderOptions& o) {
     camera.height = o.height;
   }
   if (o.bit_depth != 8 && o.bit_depth != 16) throw std::invalid_argument("--bit-depth must be 8 or 16");
-  const kernels::GaussianModel model = io::read_gaussian_ply(o.model);
+  kernels::GaussianModel model = io::read_gaussian_ply(o.model);
   camera.sh_degree = o.sh_degree < 0 ? model.sh_degree : static_cast<uint32_t>(o.sh_degree);
   camera.check();
 
+  // The frame of the poses, and the model moved into it.
+  const host::ModelFrame model_frame = host::read_model_frame(o.model);
+  std::optional<Eigen::Vector3d> scene_offset = model_frame.scene_world_offset_m;
+  if (scene) {
+    if (scene_offset && *scene_offset != scene->config.world_offset_m)
+      std::cerr << "render: note: the model was trained on a scene with world_offset_m " << vector_text(*scene_offset)
+                << "; poses are taken in " << o.scene << "'s frame (world_offset_m "
+                << vector_text(scene->config.world_offset_m) << ")\n";
+    scene_offset = scene->config.world_offset_m;
+  }
+  const std::string frame = o.pose_frame == "auto" ? (scene_offset ? "scene" : "model") : o.pose_frame;
+  Eigen::Vector3d frame_offset = Eigen::Vector3d::Zero();  // pose-frame coordinates + this = original world
+  if (frame == "scene") {
+    if (!scene_offset)
+      throw std::invalid_argument(o.model + " does not state the scene it was trained on (no "
+                                  "litgs_scene_world_offset_m header line): give --scene DIR for --pose-frame scene");
+    frame_offset = *scene_offset;
+  } else if (frame == "model") {
+    frame_offset = model_frame.world_offset_m;
+  }
+  model = host::shift_means(std::move(model), model_frame.world_offset_m - frame_offset);
+
   std::vector<float> image, depth, alpha;
-  uint64_t intersections = 0;
+  uint64_t intersections = 0, culled = 0, walks_cut = 0;
   if (o.reference) {
     const auto r = kernels::reference_forward(model, camera);
     image.assign(r.image.begin(), r.image.end());
     depth.assign(r.depth.begin(), r.depth.end());
     alpha.assign(r.alpha.begin(), r.alpha.end());
     intersections = r.intersections;
+    culled = r.culled_nonfinite;
   } else {
     engine::Context context;
     kernels::DeviceGaussians gaussians(context, model);
@@ -127,15 +208,25 @@ void run_render(const RenderOptions& o) {
     depth = r.depth;
     alpha = r.alpha;
     intersections = r.intersections;
+    culled = r.culled_nonfinite;
+    walks_cut = r.walks_cut_short;
   }
   const double full = o.bit_depth == 16 ? 65535.0 : 255.0;
   io::write_image(o.out, to_image(image, camera.width, camera.height, model.channels, o.bit_depth, full));
   if (!o.depth_out.empty())
     io::write_image(o.depth_out, to_image(depth, camera.width, camera.height, 1, 16, o.depth_scale));
   if (!o.alpha_out.empty()) io::write_image(o.alpha_out, to_image(alpha, camera.width, camera.height, 1, 8, 255.0));
+  const std::string frame_text = frame == "scene"      ? "scene frame (world_offset_m " + vector_text(frame_offset) + ")"
+                                 : frame == "original" ? "original world frame"
+                                                       : "model's frame";
   std::cout << "render: " << model.size() << " Gaussians, " << intersections << " tile intersections, "
-            << camera.width << "x" << camera.height << (o.reference ? " (CPU reference)" : "") << " -> " << o.out
-            << "\n";
+            << camera.width << "x" << camera.height << (o.reference ? " (CPU reference)" : "") << ", poses in the "
+            << frame_text << " -> " << o.out << "\n";
+  if (culled > 0)
+    std::cout << "render: warning: " << culled << " Gaussians culled for a non-finite parameter (not drawn)\n";
+  if (walks_cut > 0)
+    std::cout << "render: warning: " << walks_cut
+              << " tile-list walks cut short by the driver's loop limit (the render is incomplete there)\n";
 }
 
 }  // namespace
@@ -146,7 +237,7 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--model", o->model, "3DGS PLY model")->required()->check(CLI::ExistingFile);
   cmd->add_option("--camera", o->camera_json, "Camera JSON: width height fx fy cx cy q_cam_world t_cam_world")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--pose", o->pose, "qw qx qy qz tx ty tz, world-to-camera (COLMAP images.txt order)")->expected(7);
+  cmd->add_option("--pose", o->pose, "qw qx qy qz tx ty tz, world-to-camera (COLMAP images.txt order), in --pose-frame's world")->expected(7);
   cmd->add_option("--intrinsics", o->intrinsics, "fx fy cx cy in pixels")->expected(4);
   cmd->add_option("--width", o->width, "Image width");
   cmd->add_option("--height", o->height, "Image height");
@@ -157,6 +248,16 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--depth-scale", o->depth_scale, "Depth PNG value per metre")->capture_default_str();
   cmd->add_option("--alpha", o->alpha_out, "Accumulated alpha as 8-bit PNG");
   cmd->add_flag("--reference", o->reference, "Use the double-precision CPU reference (slow)");
+  cmd->add_option("--scene", o->scene, "Scene directory: poses in its frame (poses.txt's), and its cameras for --time")
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--time", o->time, "Render the scene's view at this time (s) as training does (needs --scene)");
+  cmd->add_option("--downscale", o->downscale, "--time: divide image size and intrinsics by this (train's --downscale)")
+      ->capture_default_str();
+  cmd->add_option("--poses", o->poses, "--time: estimated (poses.txt) or truth (gt/poses.txt)")->capture_default_str();
+  cmd->add_option("--pose-frame", o->pose_frame,
+                  "Frame of --pose/--camera: scene (poses.txt's; the default when the scene is known), original "
+                  "(original world), model (the PLY's coordinates; the default otherwise)")
+      ->capture_default_str();
   cmd->callback([o] { run_render(*o); });
 }
 

@@ -34,6 +34,25 @@ struct TrainCliOptions {
   host::TrainOptions train;
 };
 
+// The counters of events that should not happen (host/train/run_record.h), only those that did: "" in a healthy
+// run.
+std::string anomaly_text(const host::TrainingCounters& c) {
+  std::string s;
+  if (c.adam_nonfinite_total() > 0) {
+    s += "  adam non-finite skips " + std::to_string(c.adam_nonfinite_total()) + " (";
+    bool first = true;
+    for (uint32_t g = 0; g < kernels::kParamGroupCount; ++g)
+      if (c.adam_nonfinite_skips[g] > 0) {
+        s += std::string(first ? "" : ", ") + kernels::kParamGroupNames[g] + " " + std::to_string(c.adam_nonfinite_skips[g]);
+        first = false;
+      }
+    s += ")";
+  }
+  if (c.culled_nonfinite > 0) s += "  culled non-finite " + std::to_string(c.culled_nonfinite);
+  if (c.walks_cut_short > 0) s += "  walks cut short " + std::to_string(c.walks_cut_short);
+  return s;
+}
+
 std::string format_eta(double s) {
   if (!std::isfinite(s) || s < 0) return "?";
   char buf[32];
@@ -60,7 +79,7 @@ void run_train(TrainCliOptions o) {
   read.check_images = false;
   const io::Scene scene = io::read_scene(o.scene, read);
   if (scene.map) map_points = scene.map->positions;
-  const bool init_from_map = o.init == "auto" && !map_points.empty();
+  const bool init_from_map = !o.train.resume && o.init == "auto" && !map_points.empty();
   std::unique_ptr<host::PlanarMap> planes;
   if ((o.train.lambda_geo > 0 || init_from_map) && !map_points.empty())
     planes = std::make_unique<host::PlanarMap>(host::fit_planes(map_points, host::PlaneFitOptions{}));
@@ -95,7 +114,10 @@ void run_train(TrainCliOptions o) {
   init.sh_degree = o.train.sh_degree;
   kernels::GaussianModel model;
   std::string init_what;
-  if (o.init == "random" || (o.init == "auto" && map_points.empty())) {
+  if (o.train.resume) {
+    // The model comes from the checkpoint: --init and its options do not apply.
+    init_what = "the newest checkpoint in " + o.out;
+  } else if (o.init == "random" || (o.init == "auto" && map_points.empty())) {
     model = host::init_random(data, o.random_count, o.train.seed, init);
     init_what = std::to_string(o.random_count) + " random points";
   } else if (init_from_map) {
@@ -129,7 +151,9 @@ void run_train(TrainCliOptions o) {
   engine::Context context;
   const bool tty = ::isatty(STDOUT_FILENO);
   std::cout << "train: " << data.views.size() << " views (" << data.width << "x" << data.height << ", "
-            << data.frozen_skipped << " frozen skipped), init " << model.size() << " Gaussians from " << init_what
+            << data.frozen_skipped << " frozen skipped), "
+            << (o.train.resume ? "resuming from " : "init " + std::to_string(model.size()) + " Gaussians from ")
+            << init_what
             << ", lambda_geo " << o.train.lambda_geo << ", on " << context.info().name << "\n";
   auto progress = [&](const host::TrainProgress& p) {
     const double eta = (p.total - p.iteration) / std::max(p.iterations_per_s, 1e-9);
@@ -140,14 +164,18 @@ void run_train(TrainCliOptions o) {
     std::snprintf(line, sizeof line, "[%6u/%u] loss %.4f%s  psnr %s  gaussians %zu  %.2f it/s  eta %s", p.iteration,
                   p.total, p.loss, terms, std::isfinite(p.psnr_db) ? std::to_string(p.psnr_db).substr(0, 5).c_str() : "-",
                   p.gaussians, p.iterations_per_s, format_eta(eta).c_str());
-    std::cout << (tty ? "\r" : "") << line << (tty ? "" : "\n") << std::flush;
+    std::cout << (tty ? "\r" : "") << line << anomaly_text(p.counters) << (tty ? "" : "\n") << std::flush;
   };
+  // Resume notes and warnings on their own line, not inside a progress line being redrawn.
+  auto notice = [&](const std::string& line) { std::cerr << "train: " << line << "\n"; };
   const host::TrainReport r =
-      host::train(context, data, model, planes.get(), o.train, o.out, progress, gt_planes.get());
+      host::train(context, data, model, planes.get(), o.train, o.out, progress, gt_planes.get(), notice);
   if (tty) std::cout << "\n";
   std::cout << "train: " << r.iterations << " iterations in " << r.wall_s << " s (" << r.ms_per_iteration
             << " ms/iteration), " << r.gaussians << " Gaussians; held-out PSNR " << r.final_eval.psnr_db
-            << " dB, SSIM " << r.final_eval.ssim << "; wrote " << o.out << "/point_cloud.ply and metrics.json\n";
+            << " dB, SSIM " << r.final_eval.ssim << "; wrote " << o.out << "/point_cloud.ply ("
+            << (o.train.recentred_output ? "recentred scene frame" : "original world frame") << ") and metrics.json\n";
+  if (r.counters.any_anomaly()) std::cout << "train: counters:" << anomaly_text(r.counters) << " (metrics.json)\n";
 }
 
 }  // namespace
@@ -175,7 +203,12 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--random-count", o->random_count, "Gaussians of --init random")->capture_default_str();
   cmd->add_option("--eval-every", o->train.eval_every, "Evaluate held-out views every K iterations (0: at the end)");
   cmd->add_option("--checkpoint-every", o->train.checkpoint_every, "Checkpoint every K iterations (0: none)");
-  cmd->add_flag("--resume", o->train.resume, "Continue from the newest checkpoint in --out");
+  cmd->add_flag("--resume", o->train.resume,
+                "Continue from the newest checkpoint in --out, with its options (only --iterations, --eval-every, "
+                "--checkpoint-every, --progress-every, --recentred-output may change)");
+  cmd->add_flag("--recentred-output", o->train.recentred_output,
+                "Write point_cloud.ply in the scene's recentred frame (poses.txt's) instead of the original world "
+                "frame (scene + world_offset_m)");
   cmd->add_option("--max-gaussians", o->train.max_gaussians, "Cap of the model size (the MCMC budget)")->capture_default_str();
   cmd->add_option("--strategy", o->train.strategy, "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")
       ->check(CLI::IsMember({"adc", "mcmc"}))
@@ -189,7 +222,7 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--holdout-every", o->data.holdout_every, "Hold out every Nth frame (0: none)")->capture_default_str();
   cmd->add_option("--intensity", o->intensity, "auto | percentile | linear")->capture_default_str();
   cmd->add_option("--plane-prune-k", o->train.plane_prune_k,
-                  "Prune Gaussians beyond median + k MAD of their LiDAR-plane distances (0: off)")
+                  "Prune Gaussians beyond median + k * 1.4826 * MAD of their LiDAR-plane distances (at least 10 cm; 0: off)")
       ->capture_default_str();
   cmd->add_option("--poses", o->poses, "estimated (poses.txt) or truth (gt/poses.txt of synthetic scenes)")
       ->capture_default_str();
@@ -197,7 +230,7 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--densify-until", o->train.densify_until, "Last densification iteration")->capture_default_str();
   cmd->add_option("--densify-every", o->train.densify_every, "Densification cadence")->capture_default_str();
   cmd->add_option("--densify-grad-threshold", o->train.densify_grad_threshold,
-                  "Screen-space gradient threshold, for the photometric loss at unit weight (3DGS units)")
+                  "Densify where the screen-space gradient of the total loss exceeds this (3DGS units; not scaled by 1 - lambda_geo)")
       ->capture_default_str();
   cmd->add_option("--opacity-reset-every", o->train.opacity_reset_every, "Opacity reset cadence")->capture_default_str();
   cmd->add_option("--progress-every", o->train.progress_every, "Progress cadence")->capture_default_str();

@@ -2,12 +2,15 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <string>
 
 #include "engine/vk_check.h"
 #include "tools/commands.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"litgs-engine: LiDAR-inertial-thermal Gaussian splatting on any Vulkan device"};
+  // LITGS_VERSION comes from CMake's project(VERSION); --version needs no subcommand and no device.
+  app.set_version_flag("--version", std::string("litgs-engine ") + LITGS_VERSION);
   app.require_subcommand(1);
   litgs::tools::add_info_command(app);
   litgs::tools::add_bench_command(app);

@@ -37,7 +37,7 @@ Eigen::Isometry3d lidar_mount(const Vector3d& t_imu_lidar, Rng& rng) {
 }
 
 // The radiances below are written relative to 3500 counts and shifted by this: the Workswell frames of
-// ../shared/data/thermitage-dunr (a facade) sit around 4000 counts (1st..99th percentile ~3900..4200),
+// the Thermitage DUNR set (a facade; tests/data/thermitage-dunr holds 3 of them) sit around 4000 counts (1st..99th percentile ~3900..4200),
 // their sky near 3050.
 constexpr double kSceneOffsetRaw = 550;
 

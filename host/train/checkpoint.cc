@@ -10,7 +10,8 @@
 namespace litgs::host {
 namespace {
 
-constexpr char kMagic[8] = {'L', 'I', 'T', 'G', 'S', 'C', 'K', '1'};
+constexpr char kMagicV1[8] = {'L', 'I', 'T', 'G', 'S', 'C', 'K', '1'};  // without the run record
+constexpr char kMagic[8] = {'L', 'I', 'T', 'G', 'S', 'C', 'K', '2'};
 
 template <class T>
 void put(std::ostream& out, const T& v) {
@@ -39,8 +40,10 @@ struct Reader {
   std::vector<T> get_vector(uint64_t expected = UINT64_MAX) {
     const uint64_t n = get<uint64_t>();
     if (expected != UINT64_MAX && n != expected)
-      io::fail_at_byte(path, at, "array of " + std::to_string(n) + " values, expected " + std::to_string(expected));
-    if (n > (bytes.size() - at) / sizeof(T)) io::fail_at_byte(path, at, "checkpoint truncated (array of " + std::to_string(n) + ")");
+      io::fail_at_byte(path, at,
+                       "array of " + std::to_string(n) + " values, expected " + std::to_string(expected));
+    if (n > (bytes.size() - at) / sizeof(T))
+      io::fail_at_byte(path, at, "checkpoint truncated (array of " + std::to_string(n) + ")");
     std::vector<T> v(n);
     if (n > 0) std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));  // data() may be null when empty
     at += n * sizeof(T);
@@ -71,14 +74,41 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& c) {
     put_vector(out, c.state.grad_accum);
     put_vector(out, c.state.denom);
     put_vector(out, c.state.max_radius);
+    const std::string record = to_json(c.record).dump();
+    put_vector(out, std::vector<char>(record.begin(), record.end()));
   });
+}
+
+std::filesystem::path checkpoint_path(const std::filesystem::path& out_dir, uint32_t iteration) {
+  return out_dir / "checkpoints" / ("iter_" + std::to_string(iteration) + ".ckpt");
+}
+
+std::filesystem::path newest_checkpoint(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  fs::path best;
+  uint32_t best_it = 0;
+  if (!fs::is_directory(dir / "checkpoints")) return best;
+  for (const auto& e : fs::directory_iterator(dir / "checkpoints")) {
+    // iter_<digits>.ckpt only: temporaries of an interrupted write (iter_N.ckpt.tmp-...) and other files are
+    // not checkpoints.
+    const std::string name = e.path().filename().string();
+    if (name.rfind("iter_", 0) != 0 || e.path().extension() != ".ckpt") continue;
+    const std::string digits = name.substr(5, name.size() - 5 - 5);
+    if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+      continue;
+    const uint32_t it = static_cast<uint32_t>(std::stoul(digits));
+    if (best.empty() || it > best_it) best = e.path(), best_it = it;
+  }
+  return best;
 }
 
 Checkpoint read_checkpoint(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) io::fail(path, 0, "cannot open the checkpoint");
   const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+  const bool v1 =
+      bytes.size() >= sizeof kMagicV1 && std::memcmp(bytes.data(), kMagicV1, sizeof kMagicV1) == 0;
+  if (!v1 && (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0))
     io::fail_at_byte(path, 0, "not a LIT-GS checkpoint (bad magic)");
   Reader r{path, bytes, sizeof kMagic};
   Checkpoint c;
@@ -90,7 +120,8 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   auto& m = c.state.model;
   m.channels = r.get<uint32_t>();
   m.sh_degree = r.get<uint32_t>();
-  if (m.channels < 1 || m.channels > 4 || m.sh_degree > 3) io::fail_at_byte(path, r.at, "bad channels or SH degree");
+  if (m.channels < 1 || m.channels > 4 || m.sh_degree > 3)
+    io::fail_at_byte(path, r.at, "bad channels or SH degree");
   m.means = r.get_vector<float>();
   const uint64_t n = m.means.size() / 3;
   m.log_scales = r.get_vector<float>(3 * n);
@@ -102,6 +133,16 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   c.state.grad_accum = r.get_vector<float>(n);
   c.state.denom = r.get_vector<uint32_t>(n);
   c.state.max_radius = r.get_vector<float>(n);
+  c.has_record = !v1;
+  if (!v1) {
+    const size_t record_at = r.at;
+    const auto text = r.get_vector<char>();
+    try {
+      c.record = run_record_from_json(nlohmann::json::parse(text.begin(), text.end()));
+    } catch (const nlohmann::json::exception& e) {
+      io::fail_at_byte(path, record_at, std::string("bad run record: ") + e.what());
+    }
+  }
   if (r.at != bytes.size()) io::fail_at_byte(path, r.at, "trailing bytes after the checkpoint");
   try {
     c.state.check();

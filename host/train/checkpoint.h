@@ -1,5 +1,10 @@
 // Training checkpoints: everything a resumed run needs to continue exactly (parameters, Adam moments,
-// densification statistics, iteration, view order and random state). One binary file, written atomically.
+// densification statistics, iteration, view order and random state) and to report as one run (its options,
+// evaluations, counters and earlier resumes: the run record). One binary file, written atomically; the model
+// is in the scene's recentred frame, as training sees it.
+//
+// Format 2 ("LITGSCK2"): format 1's fields, then the run record as JSON text (run_record.h). Format 1
+// ("LITGSCK1", before run records) is still read: its record is empty and `has_record` false.
 #pragma once
 
 #include <cstdint>
@@ -7,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "host/train/run_record.h"
 #include "kernels/optim/training_state.h"
 
 namespace litgs::host {
@@ -17,10 +23,17 @@ struct Checkpoint {
   uint32_t order_position = 0;        // next index into view_order
   std::string rng_state;              // std::mt19937 state as text (operator<<)
   kernels::TrainingState state;
+  RunRecord record;
+  bool has_record = true;  // false: read from a format-1 file (no options, evaluations or counters stored)
 };
 
 void write_checkpoint(const std::filesystem::path& path, const Checkpoint& checkpoint);
-// io::IoError naming the file and byte on a truncated, foreign or inconsistent file.
+// A run's checkpoint after `iteration` iterations: out_dir/checkpoints/iter_<iteration>.ckpt.
+std::filesystem::path checkpoint_path(const std::filesystem::path& out_dir, uint32_t iteration);
+// The checkpoint of out_dir with the highest iteration; empty if there is none.
+std::filesystem::path newest_checkpoint(const std::filesystem::path& out_dir);
+// io::IoError naming the file and byte on a truncated, foreign or inconsistent file (a run record that is not
+// JSON of the expected shape included).
 Checkpoint read_checkpoint(const std::filesystem::path& path);
 
 }  // namespace litgs::host

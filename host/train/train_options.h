@@ -2,6 +2,7 @@
 // field.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 
@@ -31,7 +32,7 @@ struct TrainOptions {
   // Of the averaged screen-space mean gradient of the total loss, in 3DGS units. Not scaled by
   // photometric_weight(): the geometric term's gradient lands in the same statistic, and on the synthetic
   // facade (lambda_geo 0.6, true poses) scaling it by 0.4 densified where depth, not appearance, was off,
-  // and cost 2.1 dB of held-out PSNR (README, Training).
+  // and lost held-out PSNR (commit a08255b; the figure was not recorded).
   float densify_grad_threshold = 0.0002f;
   // The geometric outlier prune: Gaussians farther from their LiDAR plane than median + k 1.4826 MAD of all
   // such distances (at least 10 cm) are pruned at each refinement; 0 turns it off.
@@ -53,7 +54,17 @@ struct TrainOptions {
   bool deterministic = false;      // bit-identical gradients (slower)
   uint32_t seed = 0;               // view order and densification noise
   uint32_t progress_every = 50;    // log cadence when stdout is not a terminal
+  // point_cloud.ply in the scene's recentred frame (scene = original - world_offset_m, docs/scene-format.md)
+  // instead of the original world frame. Training and checkpoints always use the scene frame.
+  bool recentred_output = false;
   void check() const;              // throws std::invalid_argument naming the bad field
+  // The SH degree rendered after `iterations_done` iterations (the ramp: one more every sh_degree_every).
+  uint32_t active_sh_degree(uint32_t iterations_done) const {
+    return std::min(sh_degree, iterations_done / sh_degree_every);
+  }
+  // Refinement and opacity resets run while step < refine_until() (3DGS), so never on the last iteration:
+  // Gaussians split, relocated or made transparent there would reach the output unfitted.
+  uint32_t refine_until() const { return std::min(densify_until, iterations); }
   kernels::McmcOptions mcmc_options() const;
   // The photometric loss's weight in L, 1 - lambda_geo (1 when lambda_geo = 1: no photometric term to be
   // relative to). 3DGS-MCMC's regularizers, calibrated against a photometric loss at unit weight, are scaled

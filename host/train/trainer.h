@@ -1,6 +1,18 @@
 // The training loop: which kernels run when. Views sampled without replacement, SH degree ramp,
-// densification window and cadence, evaluation, atomic checkpoints and exact resume, one small readback
-// per iteration (the rasterizer's intersection count).
+// densification window and cadence, evaluation, atomic checkpoints and resume, one small readback per
+// iteration (the rasterizer's intersection count).
+//
+// What a resume promises (`resume`: continue from the newest checkpoint in the output directory):
+// - The options must be the checkpoint's, but for those host/train/run_options.h lets change (iterations,
+//   eval_every, checkpoint_every, progress_every, recentred_output); any other difference is refused with a
+//   message that names each option with both values. Checkpoints written before options were stored
+//   (format 1) are resumed with a warning, their options unchecked.
+// - With `deterministic`, a run interrupted after a checkpoint and resumed with the same options writes the
+//   same bits (point_cloud.ply, and metrics.json but for timings) as the run that was never interrupted.
+// - With float atomics (the default) the gradient sums' order varies run to run, so a resumed run is another
+//   sample of the same training, not the same bits: held-out PSNR within 0.5 dB of an uninterrupted run on the
+//   test scene (tests/gpu/test_train_resume.cc), the spread of two uninterrupted runs.
+// - metrics.json of a resumed run carries the evaluations, counters and resumes of the checkpoint's run.
 #pragma once
 
 #include <filesystem>
@@ -12,18 +24,12 @@
 
 #include "engine/context.h"
 #include "host/train/lidar_planes.h"
+#include "host/train/run_record.h"
 #include "host/train/train_options.h"
 #include "host/train/training_data.h"
 #include "kernels/splat/splat_types.h"
 
 namespace litgs::host {
-
-struct EvalResult {
-  uint32_t iteration = 0;
-  double psnr_db = 0;   // mean over held-out views
-  double ssim = 0;
-  double depth_plane_rmse_m = -1;  // against ground-truth planes where the scene has them; -1 otherwise
-};
 
 struct TrainReport {
   uint32_t iterations = 0;
@@ -33,8 +39,11 @@ struct TrainReport {
   uint64_t peak_device_bytes = 0;
   EvalResult final_eval;
   std::vector<EvalResult> evals;
-  size_t nonfinite_pruned = 0;
-  size_t plane_pruned = 0;  // Gaussians pruned for their distance to the LiDAR plane
+  size_t nonfinite_pruned = 0;  // = counters.pruned_nonfinite
+  size_t plane_pruned = 0;      // = counters.pruned_plane: pruned for their distance to the LiDAR plane
+  TrainingCounters counters;    // over the whole run, resumed runs included
+  std::vector<ResumeRecord> resumes;  // every resume of the run, oldest first
+  uint32_t start_iteration = 0;       // where this call started (the checkpoint's iteration, or 0)
   std::vector<std::pair<std::string, double>> kernel_ms_per_iteration;  // GPU timestamps, training steps only
 };
 
@@ -46,15 +55,19 @@ struct TrainProgress {
   double psnr_db;   // last evaluation (or NaN)
   size_t gaussians;
   double iterations_per_s;
+  TrainingCounters counters;  // so far, over the whole run
 };
 
-// Trains `initial` on `data` and writes `out_dir/point_cloud.ply` and `out_dir/metrics.json` (atomically).
-// `planes` (optional) drives the geometric loss; without it lambda_geo must be 0.
+// Trains `initial` (unused when resuming) on `data` and writes `out_dir/point_cloud.ply` (in the original world
+// frame, or the scene's with options.recentred_output: host/train/output_frame.h) and `out_dir/metrics.json`
+// (atomically). `planes` (optional) drives the geometric loss; without it lambda_geo must be 0.
 // `gt_planes` (optional): the scene's true planes, sampled as points with their plane's normal; evaluation
 // then also reports the RMSE of the rendered depth's point-to-plane residual against them.
+// `notice` receives the resume's notes and warnings, one line each (default: std::cerr).
 TrainReport train(engine::Context& context, const TrainingData& data, const kernels::GaussianModel& initial,
                   const PlanarMap* planes, const TrainOptions& options, const std::filesystem::path& out_dir,
                   const std::function<void(const TrainProgress&)>& progress = {},
-                  const PlanarMap* gt_planes = nullptr);
+                  const PlanarMap* gt_planes = nullptr,
+                  const std::function<void(const std::string&)>& notice = {});
 
 }  // namespace litgs::host

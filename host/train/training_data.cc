@@ -72,7 +72,59 @@ double sample(const std::vector<float>& img, int w, int h, double u, double v) {
   return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
 }
 
+// The training resolution and its pinhole intrinsics (pixel centres at +0.5, the rasterizer's convention).
+struct Pinhole {
+  uint32_t W, H;
+  double sx, sy;  // original pixels per training pixel
+  double fx, fy, cx, cy;
+};
+
+Pinhole training_pinhole(const io::CameraIntrinsics& k, double downscale) {
+  Pinhole p;
+  p.W = static_cast<uint32_t>(std::max(1.0, std::round(k.width / downscale)));
+  p.H = static_cast<uint32_t>(std::max(1.0, std::round(k.height / downscale)));
+  p.sx = static_cast<double>(k.width) / p.W;
+  p.sy = static_cast<double>(k.height) / p.H;
+  p.fx = k.fx / p.sx;
+  p.fy = k.fy / p.sy;
+  p.cx = (k.cx + 0.5) / p.sx;
+  p.cy = (k.cy + 0.5) / p.sy;
+  return p;
+}
+
+kernels::SplatCamera make_camera(const Eigen::Isometry3d& T_world_cam, const Pinhole& p) {
+  kernels::SplatCamera camera;
+  const Eigen::Matrix3d R = T_world_cam.linear().transpose();
+  const Eigen::Vector3d t = -R * T_world_cam.translation();
+  for (int c = 0; c < 3; ++c) {
+    for (int r = 0; r < 3; ++r) camera.R_cam_world[c][r] = R(r, c);
+    camera.t_cam_world[c] = t[c];
+  }
+  camera.fx = p.fx;
+  camera.fy = p.fy;
+  camera.cx = p.cx;
+  camera.cy = p.cy;
+  camera.width = p.W;
+  camera.height = p.H;
+  return camera;
+}
+
+const std::vector<io::TumPose>& training_poses(const std::filesystem::path& dir, const io::Scene& scene,
+                                               bool true_poses) {
+  if (true_poses && (!scene.gt || scene.gt->poses.empty()))
+    throw std::invalid_argument(dir.string() + ": training on true poses needs gt/poses.txt, which the scene lacks");
+  return true_poses ? scene.gt->poses : scene.poses;
+}
+
 }  // namespace
+
+kernels::SplatCamera training_camera(const std::filesystem::path& scene_dir, const io::Scene& scene, double t_s,
+                                     const TrainingDataOptions& o) {
+  o.check();
+  const std::vector<io::TumPose>& poses = training_poses(scene_dir, scene, o.true_poses);
+  return make_camera(pose_at(scene, poses, t_s, o.pose_match_tolerance_s),
+                     training_pinhole(scene.config.camera, o.downscale));
+}
 
 void TrainingDataOptions::check() const {
   if (!(downscale >= 1.0) || !std::isfinite(downscale))
@@ -89,9 +141,7 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
   const io::Scene scene = io::read_scene(dir, read);
   const io::CameraIntrinsics& k = scene.config.camera;
   if (scene.frames.empty()) throw std::invalid_argument(dir.string() + ": the scene has no thermal frames");
-  if (o.true_poses && (!scene.gt || scene.gt->poses.empty()))
-    throw std::invalid_argument(dir.string() + ": training on true poses needs gt/poses.txt, which the scene lacks");
-  const std::vector<io::TumPose>& poses = o.true_poses ? scene.gt->poses : scene.poses;
+  const std::vector<io::TumPose>& poses = training_poses(dir, scene, o.true_poses);
 
   // Raw frames, and the intensity mapping shared by all of them.
   std::vector<std::vector<float>> raw(scene.frames.size());
@@ -106,6 +156,7 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
     }
   }
   TrainingData out;
+  out.options = o;
   const bool percentile = o.mapping == IntensityMapping::kPercentile ||
                           (o.mapping == IntensityMapping::kAuto && k.bit_depth == 16);
   if (percentile) {
@@ -132,10 +183,10 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
     for (float& v : frame) v = static_cast<float>(std::clamp((v - out.stretch_low) / range, 0.0, 1.0));
 
   // Training resolution and pinhole camera (pixel centres at +0.5, the rasterizer's convention).
-  const uint32_t W = static_cast<uint32_t>(std::max(1.0, std::round(k.width / o.downscale)));
-  const uint32_t H = static_cast<uint32_t>(std::max(1.0, std::round(k.height / o.downscale)));
-  const double sx = static_cast<double>(k.width) / W, sy = static_cast<double>(k.height) / H;
-  const double fx = k.fx / sx, fy = k.fy / sy, cx = (k.cx + 0.5) / sx, cy = (k.cy + 0.5) / sy;
+  const Pinhole pinhole = training_pinhole(k, o.downscale);
+  const uint32_t W = pinhole.W, H = pinhole.H;
+  const double sx = pinhole.sx, sy = pinhole.sy;
+  const double fx = pinhole.fx, fy = pinhole.fy, cx = pinhole.cx, cy = pinhole.cy;
   out.width = W;
   out.height = H;
   out.world_offset_m = scene.config.world_offset_m;
@@ -159,18 +210,7 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
     view.t_s = scene.frames[i].t_s;
     view.heldout = o.holdout_every > 0 && i % o.holdout_every == 0;
     const Eigen::Isometry3d T_world_cam = pose_at(scene, poses, view.t_s, o.pose_match_tolerance_s);
-    const Eigen::Matrix3d R = T_world_cam.linear().transpose();
-    const Eigen::Vector3d t = -R * T_world_cam.translation();
-    for (int c = 0; c < 3; ++c) {
-      for (int r = 0; r < 3; ++r) view.camera.R_cam_world[c][r] = R(r, c);
-      view.camera.t_cam_world[c] = t[c];
-    }
-    view.camera.fx = fx;
-    view.camera.fy = fy;
-    view.camera.cx = cx;
-    view.camera.cy = cy;
-    view.camera.width = W;
-    view.camera.height = H;
+    view.camera = make_camera(T_world_cam, pinhole);
     centres.push_back(T_world_cam.translation());
 
     view.image.assign(static_cast<size_t>(W) * H, 0.0f);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "io/scene.h"
 #include "kernels/splat/splat_types.h"
 
 namespace litgs::host {
@@ -44,6 +45,7 @@ struct TrainingView {
 };
 
 struct TrainingData {
+  TrainingDataOptions options;  // what load_training_data was given (stored in checkpoints, compared on resume)
   std::vector<TrainingView> views;
   double stretch_low = 0, stretch_high = 1;  // raw values mapped to 0 and 1
   Eigen::Vector3d world_offset_m = Eigen::Vector3d::Zero();  // scene world = original world - offset
@@ -55,5 +57,13 @@ struct TrainingData {
 // Reads the scene directory, maps intensities, undistorts (radtan k1 k2 p1 p2 [k3]) and downscales.
 // Throws io::IoError / std::invalid_argument naming the file or the problem.
 TrainingData load_training_data(const std::filesystem::path& scene_dir, const TrainingDataOptions& options);
+
+// The camera training uses for the frame at `t_s` of `scene` (read from `scene_dir`), in the scene's
+// (recentred) frame: the pose at that time in poses.txt (gt/poses.txt with options.true_poses), matched
+// within pose_match_tolerance_s or interpolated and moved from the IMU to the camera where the poses are the
+// IMU's; the undistorted pinhole intrinsics at the training resolution (options.downscale). Throws
+// std::invalid_argument for a time outside the trajectory.
+kernels::SplatCamera training_camera(const std::filesystem::path& scene_dir, const io::Scene& scene, double t_s,
+                                     const TrainingDataOptions& options);
 
 }  // namespace litgs::host

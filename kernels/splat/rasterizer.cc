@@ -255,11 +255,6 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   grow(ctx, b.order, n, "splat: depth order");
   grow(ctx, b.counts, n, "splat: tile counts");
   grow(ctx, b.offsets, n, "splat: tile offsets");
-  grow(ctx, b.image, pixels * channels_, "splat: image");
-  grow(ctx, b.depth, pixels, "splat: expected depth");
-  grow(ctx, b.alpha, pixels, "splat: alpha");
-  grow(ctx, b.last, pixels, "splat: last");
-  grow(ctx, b.ranges, 2 * tiles, "splat: tile ranges");
   grow(ctx, b.corners, corner_cells, "splat: tile corners");
   profile_.clear();
 
@@ -314,6 +309,12 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   longest_tile_list_ = c[SPLAT_COUNTER_MAX_LIST];
   forward_walks_cut_before_ = c[SPLAT_COUNTER_FORWARD_WALKS_CUT];
   forward_passes_ = passes_for(forward_entries_per_pass_);
+  // Per-pixel and per-intersection buffers only now that the render is known to fit.
+  grow(ctx, b.image, pixels * channels_, "splat: image");
+  grow(ctx, b.depth, pixels, "splat: expected depth");
+  grow(ctx, b.alpha, pixels, "splat: alpha");
+  grow(ctx, b.last, pixels, "splat: last");
+  grow(ctx, b.ranges, 2 * tiles, "splat: tile ranges");
   grow(ctx, b.tile_keys, m, "splat: tile keys");
   grow(ctx, b.isect_ids, m, "splat: intersection ids");
   grow(ctx, b.isect_gaussian, m, "splat: intersection gaussians");
@@ -402,7 +403,7 @@ void Rasterizer::backward(const RenderGradInput& grad) {
 Rasterizer::DeviceOutputs Rasterizer::device_outputs() const {
   if (!last_gaussians_) throw std::logic_error("Rasterizer::device_outputs before forward");
   const Buffers& b = *buffers_;
-  return {&b.image->buffer(), &b.depth->buffer(), &b.alpha->buffer(), &b.rects->buffer()};
+  return {&b.image->buffer(), &b.depth->buffer(), &b.alpha->buffer(), &b.rects->buffer(), &b.counters->buffer()};
 }
 
 Rasterizer::DeviceUpstream Rasterizer::upstream_buffers() {

@@ -25,7 +25,7 @@ struct RasterizerOptions {
   // false: the gradients of the expected depth and of the alpha map move Gaussians (mean, scale, rotation,
   // through the depth and the footprint) but do not reach their opacity, which only the image decides.
   // Training with the LiDAR term uses it: through opacity the depth loss can reweight which Gaussians are
-  // seen instead of moving them, and that trades against the image (README, Training). true: the exact
+  // seen instead of moving them, and that trades against the image (docs/experiments.md). true: the exact
   // gradient.
   bool depth_gradient_to_opacity = true;
   // List entries one rasterize pass walks per tile (kernels/splat/splat_shared.h); 0: derived per kernel from
@@ -91,6 +91,9 @@ class Rasterizer {
     const engine::Buffer* depth;   // [H][W]
     const engine::Buffer* alpha;   // [H][W]
     const engine::Buffer* rects;   // [N][4] uint tile rectangles; empty (x1 <= x0) when culled
+    // [SPLAT_COUNTER_COUNT] uint (splat_shared.h, SPLAT_COUNTER_*): the last forward's culls, and the running
+    // totals of walks cut short, for a copy inside a training step's submit.
+    const engine::Buffer* counters;
   };
   DeviceOutputs device_outputs() const;
   struct DeviceUpstream {

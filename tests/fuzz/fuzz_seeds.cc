@@ -1,7 +1,9 @@
 // Writes the generated part of the seed corpora (tests/fuzz/corpus/<target>/gen-*): small valid files
 // from the io writers. Not run in CI; rerun by hand after a format change:
-//   build-fuzz/tests/fuzz/litgs_fuzz_seeds tests/fuzz/corpus
-// The real-data seeds (TUM, M2DGR calibration, Metashape XML, DUNR JPEG) are copied from ../shared/data.
+//   build-fuzz/litgs_fuzz_seeds tests/fuzz/corpus   (executables land in the build directory's root)
+// The ROS bags need a build with rosbag_storage (ci/setup). The real-data seeds (TUM, M2DGR calibration,
+// Metashape XML, DUNR JPEG) are copies of files in tests/data (licences and provenance there).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,6 +14,7 @@
 #include "io/gaussian_ply.h"
 #include "io/image.h"
 #include "io/pcd.h"
+#include "io/ros_bag.h"
 #include "io/scene_yaml.h"
 #include "tests/fuzz/fuzz_colmap.h"
 
@@ -57,7 +60,8 @@ int main(int argc, char** argv) {
     im.height = 3;
     im.channels = c;
     im.bit_depth = depth;
-    for (int i = 0; i < 15 * c; ++i) im.data.push_back(static_cast<uint16_t>((i * 37) % (depth == 8 ? 256 : 65536)));
+    for (int i = 0; i < 15 * c; ++i)
+      im.data.push_back(static_cast<uint16_t>((i * 37) % (depth == 8 ? 256 : 65536)));
     const std::string stem = "gen-c" + std::to_string(c) + "-" + std::to_string(depth);
     io::write_png(out / "png" / (stem + ".png"), im);
     io::write_tiff(out / "tiff" / (stem + ".tif"), im);
@@ -76,10 +80,12 @@ int main(int argc, char** argv) {
   // PLY points: ascii and binary little endian.
   put(out / "ply_points" / "gen-ascii.ply",
       "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
-      "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n1 2 3 255 0 0\n4 5 6 0 255 0\n");
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n1 2 3 255 0 0\n4 5 6 0 255 "
+      "0\n");
   {
-    std::string b = "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty double x\nproperty double y\n"
-                    "property double z\nproperty float intensity\nend_header\n";
+    std::string b =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty double x\nproperty double y\n"
+        "property double z\nproperty float intensity\nend_header\n";
     for (int i = 0; i < 2; ++i) {
       const double xyz[3] = {i + 0.5, 2.0 * i, -1.0};
       const float f = 3.f * static_cast<float>(i);
@@ -124,6 +130,42 @@ int main(int argc, char** argv) {
   ck.state.exp_avg[0].assign(ck.state.exp_avg[0].size(), 0.5f);
   ck.state.denom = {1, 2};
   host::write_checkpoint(out / "checkpoint" / "gen.ckpt", ck);
+
+  // ROS bags: the four message types fuzz_ros_bag reads (/thermal: mono8 and rgb16 images, /lidar: clouds
+  // with and without intensity, one point NaN, /imu, /odom), with uncompressed, bz2 and lz4 chunks.
+  if (!io::ros_bag_writer_available()) {
+    std::cerr << "litgs_fuzz_seeds: this build cannot write ROS bags (ci/setup); ros_bag seeds not written\n";
+    return 1;
+  }
+  fs::create_directories(out / "ros_bag");
+  for (auto [name, compression] :
+       {std::pair{"none", io::RosBagCompression::kNone}, std::pair{"bz2", io::RosBagCompression::kBz2},
+        std::pair{"lz4", io::RosBagCompression::kLz4}}) {
+    io::RosBagWriter w(out / "ros_bag" / ("gen-" + std::string(name) + ".bag"), compression);
+    for (auto [channels, depth] : {std::pair{1, 8}, std::pair{3, 16}}) {
+      io::Image im;
+      im.width = 3;
+      im.height = 2;
+      im.channels = channels;
+      im.bit_depth = depth;
+      for (int i = 0; i < 6 * channels; ++i)
+        im.data.push_back(static_cast<uint16_t>(i * 41 % (depth == 8 ? 256 : 65536)));
+      w.image("/thermal", 10.0 + channels, im);
+    }
+    io::PointCloud pc;
+    pc.positions = {{1, 2, 3}, {NAN, 0, 0}, {-4, 5, 0.5}};
+    w.cloud("/lidar", 10.5, pc);
+    pc.intensity = {1, 2, 3};
+    w.cloud("/lidar", 11.5, pc);
+    for (int i = 0; i < 2; ++i) {
+      w.imu("/imu", {10.0 + i, {0.1, -0.2, 0.3 * i}, {0, 9.8, 0.1}});
+      io::TumPose p;
+      p.t_s = 10.25 + i;
+      p.p_world = {i * 1.0, 2.0, -3.0};
+      w.odom("/odom", p);
+    }
+    w.close();
+  }
 
   fs::remove_all(tmp);
   return 0;

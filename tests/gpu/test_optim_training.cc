@@ -1,8 +1,11 @@
 // A training-like smoke test: the device rasterizer, a host L2 loss, and the trainable model's statistics,
-// Adam steps and one densification in the middle: the loss must fall.
+// Adam steps and one densification in the middle: the loss must fall. And the same loop with rows whose
+// parameters are not finite: every counter on their way (culled, skipped by Adam, pruned) says exactly how
+// many, and the rest trains as if they were not there.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -78,6 +81,132 @@ TEST_F(TrainingSmokeTest, FiftyAdamStepsReduceAnImageLoss) {
   // the image darkens/brightens where they overlap: the loss jumps at step 26, then falls).
   EXPECT_LT(losses[24], 0.5 * losses[0]);
   EXPECT_LT(losses.back(), 0.7 * losses[25]);
+}
+
+// The smoke test's loop (50 steps, one densification at 25), deterministic, recording every counter.
+struct Trace {
+  std::vector<double> losses;
+  std::vector<uint32_t> culled_nonfinite;  // per step, by the forward
+  std::array<uint32_t, kParamGroupCount> adam_skips_at_25{}, adam_skips{};
+  DensifyReport densified;
+  GaussianModel final_model;
+};
+
+Trace train_smoke(engine::Context& ctx, const GaussianModel& start, const std::vector<float>& target,
+                  const SplatCamera& camera) {
+  const uint32_t W = camera.width, H = camera.height;
+  RasterizerOptions ro;
+  ro.deterministic = true;
+  Rasterizer raster(ctx, 1, ro);
+  TrainableGaussians model(ctx, start);
+  const AdamOptions& adam = model.adam_options();
+  const float extent = 5.0f;
+  const size_t pixels = size_t{W} * H;
+  Trace t;
+  for (uint32_t step = 1; step <= 50; ++step) {
+    raster.forward(model.gaussians(), camera);
+    const RenderImages<float> out = raster.download_images();
+    t.culled_nonfinite.push_back(out.culled_nonfinite);
+    std::vector<float> grad(pixels);
+    double loss = 0;
+    const auto npix = static_cast<double>(pixels);
+    for (size_t p = 0; p < pixels; ++p) {
+      const double r = double{out.image[p]} - target[p];
+      loss += r * r / npix;
+      grad[p] = static_cast<float>(2.0 * r / npix);
+    }
+    t.losses.push_back(loss);
+    const Rasterizer::DeviceUpstream up = raster.upstream_buffers();
+    const_cast<engine::Buffer*>(up.image)->upload(grad.data(), grad.size() * sizeof(float));
+    engine::Sequence s(ctx);
+    s.fill(*up.depth, 0u, pixels * 4);
+    s.fill(*up.alpha, 0u, pixels * 4);
+    const Rasterizer::DeviceGrads grads = raster.record_backward(s);
+    model.record_accumulate_stats(s, grads, *raster.device_outputs().rects, camera);
+    model.record_adam_step(s, grads, adam.rates(step - 1, 50, extent), step);
+    s.submit_and_wait();
+    if (step == 25) {
+      t.adam_skips_at_25 = model.nonfinite_grad_counts();
+      DensifyOptions o;
+      o.grad_threshold = 1e-6f;
+      t.densified = model.densify_and_prune(o, extent, step);
+    }
+  }
+  t.adam_skips = model.nonfinite_grad_counts();
+  t.final_model = model.download();
+  return t;
+}
+
+// Five rows appended to the smoke test's model, one non-finite parameter each (NaN mean, +Inf log-scale,
+// NaN quaternion, NaN opacity, -Inf SH). Each forward culls exactly 5 and renders the rest as without them;
+// their gradients are zero, so Adam skips exactly their one non-finite element per group each step (x not
+// finite): 25 per group by the densification at 25, which prunes exactly those 5. Appended last, they leave
+// every other row's index (on which split sampling depends) unchanged, so the deterministic run with them
+// must match the run without them bit for bit: every loss, and the final model. The loss falls by the smoke
+// test's factors.
+TEST_F(TrainingSmokeTest, NonFiniteRowsAreCountedSkippedAndPrunedWhileTheRestTrains) {
+  const uint32_t W = 64, H = 48;
+  SplatCamera camera = testing::camera_looking_down_z(W, H);
+  camera.sh_degree = 1;
+  const GaussianModel target_model = testing::random_scene(150, 1, 1, 31);
+  std::vector<float> target;
+  {
+    Rasterizer raster(context(), 1);
+    DeviceGaussians target_gaussians(context(), target_model);
+    raster.forward(target_gaussians, camera);
+    target = raster.download_images().image;
+  }
+  GaussianModel clean = target_model;
+  std::mt19937 rng(5);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  for (auto& x : clean.means) x += 0.05f * normal(rng);
+  for (size_t i = 0; i < clean.size(); ++i) {
+    clean.sh[i * clean.sh_coeffs()] += 0.3f * normal(rng);
+    clean.opacity_logits[i] += 0.5f * normal(rng);
+  }
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  GaussianModel bad = clean;
+  const size_t n = clean.size(), k = clean.sh_coeffs();
+  bad.resize(n + 5);
+  for (size_t r = n; r < n + 5; ++r) {  // visible copies of row 0, then one parameter broken
+    for (int a = 0; a < 3; ++a)
+      bad.means[3 * r + a] = clean.means[a], bad.log_scales[3 * r + a] = clean.log_scales[a];
+    for (int a = 0; a < 4; ++a) bad.quats[4 * r + a] = clean.quats[a];
+    bad.opacity_logits[r] = clean.opacity_logits[0];
+    for (size_t c = 0; c < k; ++c) bad.sh[r * k + c] = clean.sh[c];
+  }
+  bad.means[3 * n + 1] = nan;
+  bad.log_scales[3 * (n + 1)] = inf;
+  bad.quats[4 * (n + 2) + 3] = nan;
+  bad.opacity_logits[n + 3] = nan;
+  bad.sh[(n + 4) * k + 2] = -inf;
+  bad.check();
+
+  const Trace want = train_smoke(context(), clean, target, camera);
+  const Trace got = train_smoke(context(), bad, target, camera);
+  ASSERT_EQ(got.losses.size(), 50u);
+  for (size_t s = 0; s < 50; ++s) {
+    EXPECT_EQ(want.culled_nonfinite[s], 0u) << "step " << s + 1;
+    EXPECT_EQ(got.culled_nonfinite[s], s < 25 ? 5u : 0u) << "step " << s + 1;
+    EXPECT_EQ(got.losses[s], want.losses[s]) << "step " << s + 1;
+  }
+  for (uint32_t g = 0; g < kParamGroupCount; ++g) {
+    EXPECT_EQ(want.adam_skips[g], 0u) << kParamGroupNames[g];
+    EXPECT_EQ(got.adam_skips_at_25[g], 25u) << kParamGroupNames[g];
+    EXPECT_EQ(got.adam_skips[g], 25u) << kParamGroupNames[g] << ": nothing skipped after the prune";
+  }
+  EXPECT_EQ(want.densified.pruned_nonfinite, 0u);
+  EXPECT_EQ(got.densified.pruned_nonfinite, 5u) << got.densified.to_string();
+  EXPECT_EQ(got.densified.pruned(), want.densified.pruned() + 5) << got.densified.to_string();
+  EXPECT_EQ(got.densified.cloned, want.densified.cloned);
+  EXPECT_EQ(got.densified.split, want.densified.split);
+  EXPECT_GT(got.densified.cloned + got.densified.split, 0u);
+  ASSERT_EQ(got.final_model.size(), want.final_model.size());
+  EXPECT_EQ(got.final_model.means, want.final_model.means);
+  EXPECT_EQ(got.final_model.sh, want.final_model.sh);
+  EXPECT_EQ(got.final_model.opacity_logits, want.final_model.opacity_logits);
+  EXPECT_LT(got.losses[24], 0.5 * got.losses[0]);
+  EXPECT_LT(got.losses.back(), 0.7 * got.losses[25]);
 }
 
 }  // namespace

@@ -12,11 +12,13 @@
 #include "kernels/splat/reference.h"
 #include "npz_reader.h"
 #include "splat_scenes.h"
+#include "tests/support/test_data.h"
 
 namespace litgs {
 namespace {
 
-const std::string kGarden = std::string(LITGS_SHARED_DATA_DIR) + "/gsplat-garden/test_garden.npz";
+// Throws (the test fails, naming the path) when the archive is missing: never a silent skip.
+std::string garden_path() { return testing::test_data("gsplat-garden/test_garden.npz").string(); }
 
 struct Garden {
   kernels::GaussianModel model;
@@ -26,12 +28,13 @@ struct Garden {
 // Isotropic Gaussians sized by the median nearest-neighbour spacing of a sample of points (as 3DGS sizes
 // its initial Gaussians by neighbour distance), coloured from the points, opacity 0.7.
 Garden load_garden(uint32_t channels, uint32_t degree) {
-  const auto means = testing::read_npz_array(kGarden, "means3d").as_float();
-  const auto colors = testing::read_npz_array(kGarden, "colors").as_float();
-  const auto viewmats = testing::read_npz_array(kGarden, "viewmats").as_float();
-  const auto Ks = testing::read_npz_array(kGarden, "Ks").as_float();
-  const auto width = testing::read_npz_array(kGarden, "width").as_scalar_int();
-  const auto height = testing::read_npz_array(kGarden, "height").as_scalar_int();
+  const std::string path = garden_path();
+  const auto means = testing::read_npz_array(path, "means3d").as_float();
+  const auto colors = testing::read_npz_array(path, "colors").as_float();
+  const auto viewmats = testing::read_npz_array(path, "viewmats").as_float();
+  const auto Ks = testing::read_npz_array(path, "Ks").as_float();
+  const auto width = testing::read_npz_array(path, "width").as_scalar_int();
+  const auto height = testing::read_npz_array(path, "height").as_scalar_int();
   const size_t n = means.size() / 3;
 
   std::mt19937 rng(1);
@@ -90,11 +93,6 @@ Garden load_garden(uint32_t channels, uint32_t degree) {
 
 class RasterizerGarden : public testing::GpuTest {
  protected:
-  void SetUp() override {
-    testing::GpuTest::SetUp();
-    if (!std::filesystem::exists(kGarden)) GTEST_SKIP() << "shared data not found: " << kGarden;
-  }
-
   void check_parity(uint32_t channels, uint32_t degree) {
     const Garden garden = load_garden(channels, degree);
     kernels::DeviceGaussians g(context(), garden.model);
@@ -108,15 +106,25 @@ class RasterizerGarden : public testing::GpuTest {
       const auto img = testing::compare(got.image, want.image, 1e-4);
       const auto alp = testing::compare(got.alpha, want.alpha, 1e-4);
       const auto dep = testing::compare(got.depth, want.depth, 1e-3);
-      std::printf("garden C=%u view %zu: %llu intersections; image max|d| %.2e, %.4f within 1e-4; alpha %.2e, "
-                  "%.4f; depth %.2e, %.4f within 1e-3\n",
-                  channels, v, static_cast<unsigned long long>(got.intersections), img.max_abs,
-                  img.fraction_within, alp.max_abs, alp.fraction_within, dep.max_abs, dep.fraction_within);
+      const auto outside = [](const testing::Agreement& a) {
+        return static_cast<unsigned long long>(
+            std::llround((1.0 - a.fraction_within) * static_cast<double>(a.count)));
+      };
+      std::printf(
+          "garden C=%u view %zu: %llu intersections; image max|d| %.2e, %llu of %zu values off by > 1e-4; "
+          "alpha %.2e, %llu of %zu; depth %.2e, %llu of %zu off by > 1e-3\n",
+          channels, v, static_cast<unsigned long long>(got.intersections), img.max_abs, outside(img),
+          img.count, alp.max_abs, outside(alp), alp.count, dep.max_abs, outside(dep), dep.count);
       // float32 against double over lists of thousands of Gaussians: a few pixels cross the 1/255 or
-      // T = 1e-4 thresholds at a different entry; everything else agrees to 1e-4.
-      EXPECT_GE(img.fraction_within, 0.995) << "view " << v;
-      EXPECT_GE(alp.fraction_within, 0.995) << "view " << v;
-      EXPECT_GE(dep.fraction_within, 0.995) << "view " << v;
+      // T = 1e-4 thresholds at a different entry; everything else agrees to 1e-4. Measured on lavapipe: at
+      // most 38 of 816,480 image values (99.995%), 7 of 272,160 alpha values and 1 depth value outside, the
+      // worst off by 3.9e-3. The README states the figures asserted here: 99.99% within, none off by 5e-3.
+      EXPECT_GE(img.fraction_within, 0.9999) << "view " << v;
+      EXPECT_GE(alp.fraction_within, 0.9999) << "view " << v;
+      EXPECT_GE(dep.fraction_within, 0.9999) << "view " << v;
+      EXPECT_LT(img.max_abs, 5e-3) << "view " << v;
+      EXPECT_LT(alp.max_abs, 5e-3) << "view " << v;
+      EXPECT_LT(dep.max_abs, 5e-3) << "view " << v << " (metres)";
     }
   }
 };

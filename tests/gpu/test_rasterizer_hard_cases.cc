@@ -43,7 +43,8 @@ void append(GaussianModel& dst, const GaussianModel& src) {
 
 template <class T>
 void expect_all_finite(const std::vector<T>& v, const std::string& name) {
-  for (size_t i = 0; i < v.size(); ++i) ASSERT_TRUE(std::isfinite(static_cast<double>(v[i]))) << name << "[" << i << "]";
+  for (size_t i = 0; i < v.size(); ++i)
+    ASSERT_TRUE(std::isfinite(static_cast<double>(v[i]))) << name << "[" << i << "]";
 }
 
 struct Outcome {
@@ -53,9 +54,12 @@ struct Outcome {
 
 class RasterizerHardCase : public testing::GpuTest {
  protected:
-  // Forward and backward with random upstream gradients; asserts finiteness everywhere. With
-  // `compare_reference`, the forward must also agree with the reference within 1e-4 on 99.5% of values.
-  Outcome run(const GaussianModel& model, const SplatCamera& camera, bool compare_reference = true) {
+  // Forward and backward with random upstream gradients; asserts finiteness everywhere, and that exactly
+  // `nonfinite` Gaussians were culled as non-finite (their count of non-finite parameters: a degenerate but
+  // finite Gaussian is not one). With `compare_reference`, the forward must also agree with the reference
+  // within 1e-4 on 99.5% of values, and count the same.
+  Outcome run(const GaussianModel& model, const SplatCamera& camera, bool compare_reference = true,
+              uint32_t nonfinite = 0) {
     DeviceGaussians g(context(), model);
     Rasterizer r(context(), model.channels);
     r.forward(g, camera);
@@ -81,8 +85,10 @@ class RasterizerHardCase : public testing::GpuTest {
     expect_all_finite(o.grads.opacity_logits, "grad opacity_logits");
     expect_all_finite(o.grads.sh, "grad sh");
     expect_all_finite(o.grads.means2d, "grad means2d");
+    EXPECT_EQ(o.images.culled_nonfinite, nonfinite);
     if (compare_reference) {
       const auto want = kernels::reference_forward(model, camera);
+      EXPECT_EQ(want.culled_nonfinite, nonfinite);
       EXPECT_EQ(o.images.intersections, want.intersections);
       EXPECT_GE(testing::compare(o.images.image, want.image, 1e-4).fraction_within, 0.995);
       EXPECT_GE(testing::compare(o.images.alpha, want.alpha, 1e-4).fraction_within, 0.995);
@@ -137,8 +143,8 @@ TEST_F(RasterizerHardCase, StraddlesNearPlane) {
 
 TEST_F(RasterizerHardCase, AtImageBorder) {
   GaussianModel m = one_gaussian(-0.5f * 3.0f, -0.5f * 3.0f * 48.0f / 64.0f, 3.0f, -2.5f);  // image corner
-  append(m, one_gaussian(0.5f * 3.0f + 0.05f, 0.0f, 3.0f, -2.0f));                          // just outside right
-  append(m, one_gaussian(0.0f, 0.5f * 3.0f * 48.0f / 64.0f - 0.001f, 3.0f, -2.5f));         // bottom edge
+  append(m, one_gaussian(0.5f * 3.0f + 0.05f, 0.0f, 3.0f, -2.0f));                   // just outside right
+  append(m, one_gaussian(0.0f, 0.5f * 3.0f * 48.0f / 64.0f - 0.001f, 3.0f, -2.5f));  // bottom edge
   const auto o = run(m, kCamera);
   EXPECT_GT(o.images.intersections, 0u);
 }
@@ -185,9 +191,21 @@ TEST_F(RasterizerHardCase, NonFiniteParametersAreCulledAndCounted) {
     return g;
   };
   for (int f = 0; f < 5; ++f) append(m, bad(f));
-  const auto o = run(m, kCamera);
-  EXPECT_EQ(o.images.culled_nonfinite, 5u);
+  const auto o = run(m, kCamera, true, 5);
   EXPECT_GT(sum(o.images.alpha), 1.0);
+  // The culled rows get zero gradients, and the render is the good Gaussian's alone, bit for bit.
+  for (size_t i = 1; i < 6; ++i) {
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(o.grads.means[3 * i + a], 0.0f) << i;
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(o.grads.log_scales[3 * i + a], 0.0f) << i;
+    for (int a = 0; a < 4; ++a) EXPECT_EQ(o.grads.quats[4 * i + a], 0.0f) << i;
+    EXPECT_EQ(o.grads.opacity_logits[i], 0.0f) << i;
+    for (size_t k = 0; k < m.sh_coeffs(); ++k) EXPECT_EQ(o.grads.sh[i * m.sh_coeffs() + k], 0.0f) << i;
+  }
+  const auto alone = run(one_gaussian(0.0f, 0.0f, 3.0f, -1.5f), kCamera);
+  EXPECT_EQ(o.images.image, alone.images.image);
+  EXPECT_EQ(o.images.alpha, alone.images.alpha);
+  EXPECT_EQ(o.images.depth, alone.images.depth);
+  EXPECT_EQ(o.images.intersections, alone.images.intersections);
 }
 
 TEST_F(RasterizerHardCase, ZeroQuaternion) {

@@ -227,5 +227,35 @@ TEST_F(RasterizerLongLists, OversizedPassIsCountedWhereTheDriverCutsIt) {
               got.walks_cut_short, n);
 }
 
+// More than 2^32 tile intersections: the exact 64-bit total (the scan of the counts wraps) in the error,
+// before any intersection buffer is made. 70,000 Gaussians, each over all 65,536 tiles of a 4096x4096 view.
+TEST_F(RasterizerLongLists, MoreThan2To32IntersectionsIsAClearError) {
+  const size_t n = 70'000;
+  GaussianModel m;
+  m.channels = 1;
+  m.sh_degree = 0;
+  m.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    m.means[3 * i + 2] = 10.0f + 1e-4f * static_cast<float>(i);
+    for (int a = 0; a < 3; ++a) m.log_scales[3 * i + a] = std::log(100.0f);
+    m.quats[4 * i] = 1.0f;
+    m.opacity_logits[i] = 2.0f;
+  }
+  SplatCamera cam;
+  cam.width = cam.height = 4096;
+  cam.fx = cam.fy = 2048.0;
+  cam.cx = cam.cy = 2048.0;
+  cam.sh_degree = 0;
+  DeviceGaussians g(context(), m);
+  Rasterizer r(context(), 1);
+  const std::string expected_total = std::to_string(uint64_t{n} * 65536);  // 4,587,520,000
+  try {
+    r.forward(g, cam);
+    FAIL() << "a render of " << expected_total << " intersections must not proceed";
+  } catch (const std::length_error& e) {
+    EXPECT_NE(std::string(e.what()).find(expected_total + " tile intersections"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace litgs

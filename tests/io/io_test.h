@@ -9,16 +9,12 @@
 #include <string>
 
 #include "io/error.h"
+#include "tests/support/test_data.h"
 
 namespace litgs::testing {
 
-// The shared real-data folder; a test that needs it fails (never skips) when it is missing.
-inline std::filesystem::path data_dir() {
-  const std::filesystem::path dir = LITGS_DATA_DIR;
-  if (!std::filesystem::is_directory(dir))
-    throw std::runtime_error("real-data folder missing: " + dir.string() + " (set -DLITGS_DATA_DIR)");
-  return dir;
-}
+// The real-data folder (tests/data); a test that needs it fails (never skips) when it is missing.
+inline std::filesystem::path data_dir() { return test_data_dir(); }
 
 // A fresh directory under the system temp folder, removed after the test.
 class TempDirTest : public ::testing::Test {

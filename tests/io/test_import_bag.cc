@@ -20,7 +20,7 @@ class ImportBagTest : public testing::TempDirTest {
  protected:
   void SetUp() override {
     TempDirTest::SetUp();
-    if (!ros_bag_available()) GTEST_FAIL() << "this build has no ROS bag support (ci/setup)";
+    if (!ros_bag_writer_available()) GTEST_FAIL() << "this build cannot write ROS bags (ci/setup)";
   }
   static Image thermal(int seed, int channels) {
     Image im;
@@ -30,6 +30,28 @@ class ImportBagTest : public testing::TempDirTest {
     for (int i = 0; i < 640 * 512; ++i)
       for (int c = 0; c < channels; ++c) im.data.push_back(static_cast<uint16_t>((i + seed) % 251));
     return im;
+  }
+  static std::string u32le(uint32_t v) {
+    std::string s;
+    for (int b = 0; b < 4; ++b) s += static_cast<char>((v >> (8 * b)) & 0xff);
+    return s;
+  }
+  // `bytes` with the one occurrence of `from` replaced by `to` (same length, so the bag's records stay
+  // consistent); fails the test unless `from` occurs exactly once.
+  static std::string patch_once(const std::string& bytes, const std::string& from, const std::string& to) {
+    EXPECT_EQ(from.size(), to.size());
+    const size_t at = bytes.find(from);
+    if (at == std::string::npos || bytes.find(from, at + 1) != std::string::npos) {
+      ADD_FAILURE() << "the patched bytes must occur exactly once";
+      return bytes;
+    }
+    std::string out = bytes;
+    out.replace(at, to.size(), to);
+    return out;
+  }
+  std::filesystem::path write_bytes(const std::string& name, const std::string& bytes) const {
+    std::ofstream(dir_ / name, std::ios::binary | std::ios::trunc) << bytes;
+    return dir_ / name;
   }
   // A tiny M2DGR-like bag written by rosbag_storage itself: 2 thermal frames (3-channel, as M2DGR
   // publishes them), 2 Velodyne scans (one point NaN), 3 IMU samples, 3 odometry poses.
@@ -125,8 +147,173 @@ TEST_F(ImportBagTest, BadBagsAreNamed) {
   EXPECT_FALSE(std::filesystem::exists(o.out / "scene.yaml"));
 }
 
+// A PointCloud2 whose field offset is forged to 2^32 - 4 (the issue-12 review): offset + 4 wraps to 0 in
+// 32-bit arithmetic, which passed the old "offset + size > point_step" check and read 4 GiB past each point.
+// The bag is written by rosbag_storage and the one serialized PointField is patched in place (same length,
+// so the bag's records stay consistent).
+TEST_F(ImportBagTest, PointCloudFieldOffsetThatWouldWrapIsAnError) {
+  PointCloud c;
+  c.positions = {{1, 2, 3}, {4, 5, 6}};
+  c.intensity = {7, 8};
+  {
+    RosBagWriter w(dir_ / "cloud.bag");
+    w.cloud("/velodyne_points", 100.0, c);
+    w.close();
+  }
+  const std::string good = read_file_bytes(dir_ / "cloud.bag");
+  RosBagTopics topics;
+  topics.thermal = topics.imu = "";
+  size_t points = 0;
+  RosBagHandlers h;
+  h.lidar = [&](double, PointCloud cloud) { points += cloud.size(); };
+  read_ros_bag(dir_ / "cloud.bag", topics, h);
+  ASSERT_EQ(points, 2u);  // the unpatched bag reads
+
+  // Serialized sensor_msgs/PointField: string name (uint32 length + bytes), uint32 offset, uint8 datatype
+  // (7 = FLOAT32), uint32 count; little-endian.
+  for (const auto& [name, offset] : {std::pair<std::string, uint32_t>{"x", 0}, {"z", 8}, {"intensity", 12}}) {
+    for (uint32_t forged : {0xFFFFFFFCu, 0xFFFFFFFFu}) {
+      const std::string field = u32le(static_cast<uint32_t>(name.size())) + name;
+      const auto bag = write_bytes(
+          "forged.bag", patch_once(good, field + u32le(offset) + '\x07', field + u32le(forged) + '\x07'));
+      testing::expect_io_error(
+          [&] { read_ros_bag(bag, topics, h); },
+          {"forged.bag", "/velodyne_points", "field '" + name + "'", "beyond point_step 16"});
+    }
+  }
+  EXPECT_EQ(points, 2u);  // no forged message reached the handler
+}
+
+// The reader (ros_bag_read.cc, our own parser) against the writer (rosbag_storage): every message type, with
+// uncompressed, bz2 and lz4 chunks, comes back as written and in time order (written out of order; two
+// 640x512x3 frames make the bag span several chunks).
+TEST_F(ImportBagTest, EveryMessageTypeAndCompressionReadsAsWritten) {
+  Image mono16;
+  mono16.width = 3;
+  mono16.height = 2;
+  mono16.bit_depth = 16;
+  mono16.data = {0, 1, 255, 256, 40000, 65535};
+  PointCloud cloud;  // float32-exact positions
+  cloud.positions = {{1.5, -2.25, 3}, {NAN, 0, 0}, {1024, 0.125, -7}};
+  cloud.intensity = {1, 2, 3};
+  const ImuSample imu{11.5, {0.25, -0.5, 1.0 / 3}, {0.1, 9.81, -0.2}};
+  TumPose odom;
+  odom.t_s = 12.0;
+  odom.p_world = {1.0 / 7, -2, 1e3};
+  odom.q_world_body = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
+  const std::vector<double> expected_times = {10.5, 11.0, 11.5, 12.0, 13.0, 14.0};
+
+  for (auto compression : {RosBagCompression::kNone, RosBagCompression::kBz2, RosBagCompression::kLz4}) {
+    SCOPED_TRACE(static_cast<int>(compression));
+    const auto path = dir_ / "all.bag";
+    {
+      RosBagWriter w(path, compression);
+      w.odom("/o", odom);
+      w.image("/t", 13.0, thermal(1, 3));
+      w.image("/t", 11.0, mono16);
+      w.cloud("/l", 10.5, cloud);
+      w.image("/t", 14.0, thermal(2, 3));
+      w.imu("/i", imu);
+      w.close();
+    }
+    RosBagTopics topics{"/t", "/l", "/i", "/o"};
+    std::vector<double> times;
+    std::vector<Image> images;
+    std::vector<PointCloud> clouds;
+    std::vector<ImuSample> imus;
+    std::vector<TumPose> poses;
+    RosBagHandlers h;
+    h.thermal = [&](double t, Image im) { times.push_back(t), images.push_back(std::move(im)); };
+    h.lidar = [&](double t, PointCloud c) { times.push_back(t), clouds.push_back(std::move(c)); };
+    h.imu = [&](const ImuSample& x) { times.push_back(x.t_s), imus.push_back(x); };
+    h.odom = [&](const TumPose& x) { times.push_back(x.t_s), poses.push_back(x); };
+    const RosBagCounts n = read_ros_bag(path, topics, h);
+    EXPECT_EQ(n.thermal, 3u);
+    EXPECT_EQ(n.lidar, 1u);
+    EXPECT_EQ(n.imu, 1u);
+    EXPECT_EQ(n.odom, 1u);
+    EXPECT_EQ(times, expected_times);
+    ASSERT_EQ(images.size(), 3u);
+    EXPECT_EQ(images[0].bit_depth, 16);
+    EXPECT_EQ(images[0].channels, 1);
+    EXPECT_EQ(images[0].data, mono16.data);
+    EXPECT_EQ(images[1].channels, 3);
+    EXPECT_EQ(images[1].data, thermal(1, 3).data);
+    EXPECT_EQ(images[2].data, thermal(2, 3).data);
+    ASSERT_EQ(clouds.size(), 1u);
+    ASSERT_EQ(clouds[0].size(), 2u);  // the NaN point dropped
+    EXPECT_EQ(clouds[0].positions[0], cloud.positions[0]);
+    EXPECT_EQ(clouds[0].positions[1], cloud.positions[2]);
+    EXPECT_EQ(clouds[0].intensity, std::vector<float>({1, 3}));
+    ASSERT_EQ(imus.size(), 1u);
+    EXPECT_EQ(imus[0].gyro_rad_s, imu.gyro_rad_s);
+    EXPECT_EQ(imus[0].accel_m_s2, imu.accel_m_s2);
+    ASSERT_EQ(poses.size(), 1u);
+    EXPECT_EQ(poses[0].p_world, odom.p_world);
+    EXPECT_LT(poses[0].q_world_body.angularDistance(odom.q_world_body), 1e-12);
+  }
+}
+
+// Lengths and offsets that rosbag_storage and roscpp_serialization trusted (a vector resized to a forged
+// length before its bytes were checked; a record read wherever an index entry pointed) are errors that name
+// what is wrong, before anything is allocated or read out of bounds.
+TEST_F(ImportBagTest, ForgedLengthsAndOffsetsAreErrors) {
+  PointCloud c;
+  c.positions = {{1, 2, 3}, {4, 5, 6}};
+  {
+    RosBagWriter w(dir_ / "cloud.bag");
+    w.cloud("/velodyne_points", 100.5, c);  // stamp: 100 s + 500000000 ns
+    w.close();
+  }
+  const std::string good = read_file_bytes(dir_ / "cloud.bag");
+  RosBagTopics topics;
+  topics.thermal = topics.imu = "";
+  RosBagHandlers h;
+  size_t delivered = 0;
+  h.lidar = [&](double, PointCloud) { ++delivered; };
+  ASSERT_EQ(read_ros_bag(dir_ / "cloud.bag", topics, h).lidar, 1u);
+  ASSERT_EQ(delivered, 1u);
+  const auto expect_error = [&](const std::string& bytes, std::initializer_list<std::string> parts) {
+    const auto bag = write_bytes("forged.bag", bytes);
+    testing::expect_io_error([&] { read_ros_bag(bag, topics, h); }, parts);
+  };
+
+  // The message: ... height 1, width 2, 3 fields, "x" ...; point_step 12, row_step 24, data of 24 bytes.
+  const std::string fields = u32le(1) + u32le(2) + u32le(3) + u32le(1) + "x";
+  expect_error(patch_once(good, fields, u32le(1) + u32le(2) + u32le(0xFFFFFFFF) + u32le(1) + "x"),
+               {"/velodyne_points", "ends inside fields"});
+  const std::string steps = u32le(12) + u32le(24) + u32le(24);
+  expect_error(patch_once(good, steps, u32le(12) + u32le(24) + u32le(0xFFFFFFF0)), {"ends inside data"});
+  expect_error(patch_once(good, steps, u32le(12) + u32le(12) + u32le(24)), {"row_step < width * point_step"});
+  // The index entry after the chunk: data length 12 (one entry), time (sec, nsec), offset in the chunk.
+  const std::string entry = u32le(12) + u32le(100) + u32le(500000000);
+  const size_t at = good.find(entry);
+  ASSERT_NE(at, std::string::npos);
+  ASSERT_EQ(good.find(entry, at + 1), std::string::npos);
+  const std::string offset = good.substr(at + entry.size(), 4);
+  const uint32_t off = static_cast<uint8_t>(offset[0]) | static_cast<uint8_t>(offset[1]) << 8 |
+                       static_cast<uint8_t>(offset[2]) << 16 |
+                       static_cast<uint32_t>(static_cast<uint8_t>(offset[3])) << 24;
+  expect_error(patch_once(good, entry + offset, entry + u32le(0xFFFFFF00)),
+               {"index entry 0 points at byte 4294967040 of a chunk of"});
+  // Misaligned into the message record: whatever it reads there is checked against the chunk.
+  for (uint32_t d : {1u, 5u, 9u})
+    expect_error(patch_once(good, entry + offset, entry + u32le(off + d)), {"chunk at byte"});
+  // The header record's index position: 0 is an unfinished recording.
+  expect_error(patch_once(good, std::string("index_pos=") + good.substr(good.find("index_pos=") + 10, 8),
+                          std::string("index_pos=") + std::string(8, '\0')),
+               {"not indexed"});
+  // Another definition of the type (its MD5 in both connection records).
+  std::string md5 = good;
+  for (size_t p = 0; (p = md5.find("1158d486dd51d683ce2f1be655c3c181", p)) != std::string::npos;)
+    md5.replace(p, 32, std::string(32, '0'));
+  expect_error(md5, {"definition MD5 00000000000000000000000000000000"});
+  expect_error("#ROSBAG V1.2\n" + good.substr(13), {"V1.2", "not supported"});
+  EXPECT_EQ(delivered, 1u);  // none of the forged messages reached the handler
+}
+
 // Truncations and byte flips of a valid bag: read_ros_bag reads something or throws IoError, never another
-// exception (rosbag_storage's own exceptions are translated).
+// exception (every length and offset is checked).
 TEST_F(ImportBagTest, CorruptBagsThrowIoErrorOnly) {
   const std::string good = read_file_bytes(write_bag());
   RosBagTopics topics;

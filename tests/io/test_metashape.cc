@@ -58,7 +58,8 @@ TEST_F(MetashapeTest, ReadsControlPointsCsv) {
   EXPECT_DOUBLE_EQ(points[11].accuracy_m, 0.003);
 }
 
-// The control points through the stored poses with a plain pinhole model: the data README says about 3 px.
+// The control points through the stored poses with a plain pinhole model: about 3 px
+// (tests/data/thermitage-dunr/PROVENANCE.md).
 TEST_F(MetashapeTest, ControlPointsReprojectWithinAFewPixels) {
   const MetashapeDocument d = read_metashape_xml(dunr() / "DUNR-ImgCoords-TIR.xml");
   const auto points = read_control_points_csv(dunr() / "DUNR-GeomControl.csv");

@@ -1,0 +1,56 @@
+#include "host/train/evaluation.h"
+
+#include <cmath>
+
+#include "kernels/loss/loss_reference.h"
+
+namespace litgs::host {
+
+Evaluator::Evaluator(const TrainingData& data, const TrainOptions& o, const PlanarMap* gt_planes,
+                     kernels::Rasterizer& rasterizer)
+    : data_(&data), options_(&o), gt_planes_(gt_planes), rasterizer_(&rasterizer) {
+  for (uint32_t i = 0; i < data.views.size(); ++i)
+    if (data.views[i].heldout) views_.push_back(i);
+}
+
+EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32_t iteration,
+                               std::vector<kernels::RenderImages<float>>* renders) {
+  if (renders) renders->clear();
+  const uint32_t W = data_->width, H = data_->height;
+  EvalResult e;
+  e.iteration = iteration;
+  if (views_.empty()) return e;
+  double plane_sq = 0;
+  size_t plane_n = 0;
+  for (uint32_t i : views_) {
+    kernels::SplatCamera cam = data_->views[i].camera;
+    cam.sh_degree = options_->active_sh_degree(iteration);
+    rasterizer_->forward(gaussians, cam);
+    const auto img = rasterizer_->download_images();
+    e.psnr_db += kernels::psnr(img.image, data_->views[i].image);
+    e.ssim += kernels::ssim_reference(img.image, data_->views[i].image, 1, W, H);
+    if (gt_planes_) {
+      // Point-to-plane residual of the rendered depth along each pixel's ray, where a true plane is seen and
+      // the render is opaque enough to have a depth.
+      const ViewPlaneMaps truth = project_planes(*gt_planes_, cam);
+      for (uint32_t y = 0; y < H; ++y)
+        for (uint32_t x = 0; x < W; ++x) {
+          const size_t p = size_t{y} * W + x;
+          if (truth.points[4 * p + 3] != 1.0f || img.alpha[p] < 0.5f) continue;
+          const double rx = (x + 0.5 - cam.cx) / cam.fx, ry = (y + 0.5 - cam.cy) / cam.fy, D = img.depth[p];
+          const double r = truth.normals[4 * p] * (truth.points[4 * p] - D * rx) +
+                           truth.normals[4 * p + 1] * (truth.points[4 * p + 1] - D * ry) +
+                           truth.normals[4 * p + 2] * (truth.points[4 * p + 2] - D);
+          plane_sq += r * r;
+          ++plane_n;
+        }
+    }
+    if (renders) renders->push_back(img);
+  }
+  e.psnr_db /= static_cast<double>(views_.size());
+  e.ssim /= static_cast<double>(views_.size());
+  if (gt_planes_ && plane_n > 0) e.depth_plane_rmse_m = std::sqrt(plane_sq / static_cast<double>(plane_n));
+  return e;
+}
+
+}  // namespace litgs::host

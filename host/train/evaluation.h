@@ -1,0 +1,37 @@
+// Evaluation of a model on the held-out views: PSNR and SSIM against the targets, and where the scene has
+// true planes, the RMSE of the rendered depth's point-to-plane residual against them.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "host/train/lidar_planes.h"
+#include "host/train/run_record.h"
+#include "host/train/train_options.h"
+#include "host/train/training_data.h"
+#include "kernels/splat/rasterizer.h"
+
+namespace litgs::host {
+
+class Evaluator {
+ public:
+  // `gt_planes` (optional): the scene's true planes, sampled as points with their plane's normal.
+  Evaluator(const TrainingData& data, const TrainOptions& options, const PlanarMap* gt_planes,
+            kernels::Rasterizer& rasterizer);
+
+  // The held-out views' mean PSNR and SSIM (zero without held-out views) after `iteration` iterations (the
+  // SH degree of that point of the ramp). `renders` (optional) receives each held-out view's render, in the
+  // order of views().
+  EvalResult evaluate(const kernels::DeviceGaussians& gaussians, uint32_t iteration,
+                      std::vector<kernels::RenderImages<float>>* renders = nullptr);
+  const std::vector<uint32_t>& views() const { return views_; }
+
+ private:
+  const TrainingData* data_;
+  const TrainOptions* options_;
+  const PlanarMap* gt_planes_;
+  kernels::Rasterizer* rasterizer_;
+  std::vector<uint32_t> views_;  // indices of the held-out views
+};
+
+}  // namespace litgs::host
