@@ -39,8 +39,12 @@ void count_allocation(uint64_t bytes) {
 
 }  // namespace
 
-uint64_t Buffer::live_bytes() { return g_live_bytes.load(); }
-uint64_t Buffer::peak_bytes() { return g_peak_bytes.load(); }
+uint64_t Buffer::live_bytes() {
+  return g_live_bytes.load();
+}
+uint64_t Buffer::peak_bytes() {
+  return g_peak_bytes.load();
+}
 
 Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKind kind)
     : context_(&context), name_(std::move(name)), size_bytes_(size_bytes) {
@@ -61,11 +65,13 @@ Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKi
   try {
     VkMemoryRequirements req{};
     vkGetBufferMemoryRequirements(dev, buffer_, &req);
-    const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    const VkMemoryPropertyFlags host =
+        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
     // Device-local memory that is also host-visible (CPU drivers, resizable BAR) is mapped: no staging.
-    const uint32_t type = kind == MemoryKind::kDeviceLocal
-                              ? context.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, host)
-                              : context.find_memory_type(req.memoryTypeBits, host, VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+    const uint32_t type =
+        kind == MemoryKind::kDeviceLocal
+            ? context.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, host)
+            : context.find_memory_type(req.memoryTypeBits, host, VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
     VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     ai.allocationSize = req.size;
     ai.memoryTypeIndex = type;
@@ -85,7 +91,9 @@ Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKi
   }
 }
 
-Buffer::~Buffer() { release(); }
+Buffer::~Buffer() {
+  release();
+}
 
 Buffer::Buffer(Buffer&& other) noexcept
     : context_(other.context_),

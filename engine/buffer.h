@@ -79,7 +79,8 @@ class DeviceArray {
   std::vector<T> download(size_t first = 0, size_t count = SIZE_MAX) const {
     if (count == SIZE_MAX) count = first < count_ ? count_ - first : 0;
     std::vector<T> out(count);
-    buffer_.download(out.data(), static_cast<uint64_t>(count) * sizeof(T), static_cast<uint64_t>(first) * sizeof(T));
+    buffer_.download(out.data(), static_cast<uint64_t>(count) * sizeof(T),
+                     static_cast<uint64_t>(first) * sizeof(T));
     return out;
   }
 

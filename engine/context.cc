@@ -15,11 +15,13 @@ namespace {
 
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 constexpr const char* kInstallHint =
-    "install a Vulkan driver: on Debian `apt-get install mesa-vulkan-drivers` (lavapipe, software) or your GPU "
+    "install a Vulkan driver: on Debian `apt-get install mesa-vulkan-drivers` (lavapipe, software) or your "
+    "GPU "
     "vendor's driver; `vulkaninfo --summary` (package vulkan-tools) lists what the loader sees";
 
 std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
 }
 
@@ -85,7 +87,8 @@ Candidate describe(VkPhysicalDevice pd) {
   c.queue_family = compute_queue_family(pd);
 
   const bool api13 = base.apiVersion >= VK_API_VERSION_1_3;
-  const bool ext_size_control = !api13 && has_device_extension(pd, VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
+  const bool ext_size_control =
+      !api13 && has_device_extension(pd, VK_EXT_SUBGROUP_SIZE_CONTROL_EXTENSION_NAME);
   c.atomic_float_ext = has_device_extension(pd, VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME);
 
   VkPhysicalDeviceSubgroupSizeControlProperties size_props{
@@ -131,7 +134,8 @@ Candidate describe(VkPhysicalDevice pd) {
   d.max_subgroup_size = size_control ? size_props.maxSubgroupSize : props11.subgroupSize;
   d.compute_full_subgroups = size_control;
   const bool compute_subgroups = props11.subgroupSupportedStages & VK_SHADER_STAGE_COMPUTE_BIT;
-  d.subgroup_ballot = compute_subgroups && (props11.subgroupSupportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT);
+  d.subgroup_ballot =
+      compute_subgroups && (props11.subgroupSupportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT);
   d.subgroup_arithmetic =
       compute_subgroups && (props11.subgroupSupportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT);
   d.float_atomic_add = c.atomic_float_ext && atomic_features.shaderBufferFloat32AtomicAdd;
@@ -155,7 +159,8 @@ Candidate describe(VkPhysicalDevice pd) {
   VkPhysicalDeviceMemoryProperties mem{};
   vkGetPhysicalDeviceMemoryProperties(pd, &mem);
   for (uint32_t i = 0; i < mem.memoryHeapCount; ++i)
-    d.memory_heaps.push_back({mem.memoryHeaps[i].size, (mem.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) != 0});
+    d.memory_heaps.push_back(
+        {mem.memoryHeaps[i].size, (mem.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT) != 0});
   return c;
 }
 
@@ -167,8 +172,9 @@ bool usable(const Candidate& c) {
 VkInstance create_instance(bool validation, VkDebugUtilsMessengerCreateInfoEXT* messenger_info) {
   uint32_t loader_version = VK_API_VERSION_1_0;
   if (vkEnumerateInstanceVersion(&loader_version) != VK_SUCCESS || loader_version < VK_API_VERSION_1_2)
-    throw NoDeviceError("the Vulkan loader supports only Vulkan " + version_string(loader_version) +
-                        "; the engine needs 1.2 or newer: `apt-get install libvulkan1` from a current release");
+    throw NoDeviceError(
+        "the Vulkan loader supports only Vulkan " + version_string(loader_version) +
+        "; the engine needs 1.2 or newer: `apt-get install libvulkan1` from a current release");
 
   std::vector<const char*> layers;
   std::vector<const char*> extensions;
@@ -210,8 +216,9 @@ VkInstance create_instance(bool validation, VkDebugUtilsMessengerCreateInfoEXT* 
   VkInstance instance = VK_NULL_HANDLE;
   const VkResult r = vkCreateInstance(&ci, nullptr, &instance);
   if (r == VK_ERROR_INCOMPATIBLE_DRIVER)
-    throw NoDeviceError(std::string("no Vulkan driver found (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER): ") +
-                        kInstallHint);
+    throw NoDeviceError(
+        std::string("no Vulkan driver found (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER): ") +
+        kInstallHint);
   LITGS_VK_CHECK(r);
   return instance;
 }
@@ -235,10 +242,12 @@ std::vector<Candidate> enumerate(VkInstance instance) {
 
 const Candidate& choose(const std::vector<Candidate>& candidates, const std::string& selector) {
   if (candidates.empty())
-    throw NoDeviceError(std::string("no Vulkan 1.2+ device with compute and subgroup ballot/arithmetic found: ") +
-                        kInstallHint);
+    throw NoDeviceError(
+        std::string("no Vulkan 1.2+ device with compute and subgroup ballot/arithmetic found: ") +
+        kInstallHint);
   if (!selector.empty()) {
-    const bool numeric = std::all_of(selector.begin(), selector.end(), [](char ch) { return std::isdigit(ch); });
+    const bool numeric =
+        std::all_of(selector.begin(), selector.end(), [](char ch) { return std::isdigit(ch); });
     if (numeric) {
       const unsigned long idx = std::stoul(selector);
       if (idx >= candidates.size())
@@ -263,7 +272,8 @@ const Candidate& choose(const std::vector<Candidate>& candidates, const std::str
 struct ContextCallbacks {
   static VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                                    VkDebugUtilsMessageTypeFlagsEXT /*types*/,
-                                                   const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+                                                   const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                   void* user) {
     auto* ctx = static_cast<Context*>(user);
     const bool is_error = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
     ctx->record_validation_message(is_error, data && data->pMessage ? data->pMessage : "(no message)");
@@ -299,7 +309,8 @@ Context::Context(const ContextOptions& options) : validation_(options.validation
     if (validation_) {
       auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
           vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-      if (!create) throw std::runtime_error("validation requested but vkCreateDebugUtilsMessengerEXT is missing");
+      if (!create)
+        throw std::runtime_error("validation requested but vkCreateDebugUtilsMessengerEXT is missing");
       LITGS_VK_CHECK(create(instance_, &messenger_info, nullptr, &messenger_));
     }
 
@@ -365,7 +376,9 @@ Context::Context(const ContextOptions& options) : validation_(options.validation
   }
 }
 
-Context::~Context() { release(); }
+Context::~Context() {
+  release();
+}
 
 void Context::release() {
   if (device_) {

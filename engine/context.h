@@ -33,20 +33,20 @@ struct MemoryHeapInfo {
 
 // What the engine and its kernels need to know about the chosen device.
 struct DeviceInfo {
-  uint32_t index = 0;            // position among the usable (Vulkan 1.2+) devices
-  std::string name;              // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
-  std::string type;              // "discrete", "integrated", "virtual", "cpu", "other"
-  std::string driver_name;       // e.g. "llvmpipe"
-  std::string driver_info;       // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
-  std::string api_version;       // "1.3.230"
+  uint32_t index = 0;       // position among the usable (Vulkan 1.2+) devices
+  std::string name;         // e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string type;         // "discrete", "integrated", "virtual", "cpu", "other"
+  std::string driver_name;  // e.g. "llvmpipe"
+  std::string driver_info;  // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
+  std::string api_version;  // "1.3.230"
   uint32_t vendor_id = 0;
   uint32_t subgroup_size = 0;      // default subgroup size of compute shaders
   uint32_t min_subgroup_size = 0;  // with subgroup size control; equal to subgroup_size otherwise
   uint32_t max_subgroup_size = 0;
-  bool compute_full_subgroups = false;  // a pipeline can require full subgroups of a chosen size
-  bool subgroup_ballot = false;         // GL_KHR_shader_subgroup_ballot in compute
-  bool subgroup_arithmetic = false;     // GL_KHR_shader_subgroup_arithmetic in compute
-  bool float_atomic_add = false;        // VK_EXT_shader_atomic_float: shaderBufferFloat32AtomicAdd
+  bool compute_full_subgroups = false;    // a pipeline can require full subgroups of a chosen size
+  bool subgroup_ballot = false;           // GL_KHR_shader_subgroup_ballot in compute
+  bool subgroup_arithmetic = false;       // GL_KHR_shader_subgroup_arithmetic in compute
+  bool float_atomic_add = false;          // VK_EXT_shader_atomic_float: shaderBufferFloat32AtomicAdd
   uint64_t max_storage_buffer_range = 0;  // bytes one storage-buffer binding may span
   uint64_t max_memory_allocation_size = 0;
   uint32_t max_push_constants_size = 0;
@@ -54,8 +54,8 @@ struct DeviceInfo {
   uint32_t max_per_stage_storage_buffers = 0;  // storage-buffer bindings one kernel may have
   uint32_t max_compute_workgroup_invocations = 0;
   uint32_t max_compute_workgroup_count[3] = {0, 0, 0};
-  bool timestamps = false;            // compute queue supports timestamps
-  double timestamp_period_ns = 0.0;   // nanoseconds per timestamp tick
+  bool timestamps = false;           // compute queue supports timestamps
+  double timestamp_period_ns = 0.0;  // nanoseconds per timestamp tick
   std::vector<MemoryHeapInfo> memory_heaps;
 };
 

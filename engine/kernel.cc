@@ -12,9 +12,9 @@ Kernel::Kernel(Context& context, KernelDesc desc) : context_(&context), desc_(st
   if (desc_.spirv.empty() || desc_.spirv[0] != 0x07230203u)
     throw std::invalid_argument("kernel '" + desc_.name + "': SPIR-V is empty or lacks the magic number");
   if (desc_.push_constant_bytes > info.max_push_constants_size)
-    throw std::invalid_argument("kernel '" + desc_.name + "': push constants of " +
-                                std::to_string(desc_.push_constant_bytes) + " bytes exceed maxPushConstantsSize " +
-                                std::to_string(info.max_push_constants_size));
+    throw std::invalid_argument(
+        "kernel '" + desc_.name + "': push constants of " + std::to_string(desc_.push_constant_bytes) +
+        " bytes exceed maxPushConstantsSize " + std::to_string(info.max_push_constants_size));
   if (desc_.binding_count > info.max_per_stage_storage_buffers)
     throw std::invalid_argument("kernel '" + desc_.name + "': " + std::to_string(desc_.binding_count) +
                                 " storage buffers exceed maxPerStageDescriptorStorageBuffers " +
@@ -23,10 +23,10 @@ Kernel::Kernel(Context& context, KernelDesc desc) : context_(&context), desc_(st
   const bool fixed_size = info.min_subgroup_size == info.max_subgroup_size && sg == info.subgroup_size;
   if (sg != 0 && !fixed_size &&
       (!info.compute_full_subgroups || sg < info.min_subgroup_size || sg > info.max_subgroup_size))
-    throw std::invalid_argument("kernel '" + desc_.name + "' needs subgroups of exactly " + std::to_string(sg) +
-                                " invocations, which " + info.name + " cannot guarantee (subgroup size " +
-                                std::to_string(info.min_subgroup_size) + ".." +
-                                std::to_string(info.max_subgroup_size) + ", subgroup size control " +
+    throw std::invalid_argument("kernel '" + desc_.name + "' needs subgroups of exactly " +
+                                std::to_string(sg) + " invocations, which " + info.name +
+                                " cannot guarantee (subgroup size " + std::to_string(info.min_subgroup_size) +
+                                ".." + std::to_string(info.max_subgroup_size) + ", subgroup size control " +
                                 (info.compute_full_subgroups ? "yes" : "no") + ")");
 
   VkDevice dev = context.device();
@@ -86,7 +86,9 @@ Kernel::Kernel(Context& context, KernelDesc desc) : context_(&context), desc_(st
   }
 }
 
-Kernel::~Kernel() { release(); }
+Kernel::~Kernel() {
+  release();
+}
 
 void Kernel::release() {
   VkDevice dev = context_->device();

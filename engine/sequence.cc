@@ -14,8 +14,12 @@ constexpr uint32_t kSetsPerPool = 128;
 constexpr uint32_t kMaxBindingsPerKernel = 32;
 constexpr uint32_t kQueriesPerPool = 512;  // 256 dispatches
 
-bool reads(Access a) { return a != Access::kWrite; }
-bool writes(Access a) { return a != Access::kRead; }
+bool reads(Access a) {
+  return a != Access::kWrite;
+}
+bool writes(Access a) {
+  return a != Access::kRead;
+}
 
 }  // namespace
 
@@ -34,7 +38,9 @@ Sequence::Sequence(Context& context, bool timestamps)
   }
 }
 
-Sequence::~Sequence() { release(); }
+Sequence::~Sequence() {
+  release();
+}
 
 void Sequence::release() {
   VkDevice dev = context_->device();
@@ -75,17 +81,18 @@ void Sequence::before_command(const std::vector<std::pair<const Buffer*, Access>
   bool hazard = false;
   for (const auto& [buffer, access] : accesses) {
     const VkBuffer b = buffer->handle();
-    if (written_since_barrier_.count(b)) hazard = true;                       // read/write after write
-    if (writes(access) && read_since_barrier_.count(b)) hazard = true;        // write after read
+    if (written_since_barrier_.count(b)) hazard = true;                 // read/write after write
+    if (writes(access) && read_since_barrier_.count(b)) hazard = true;  // write after read
   }
   if (hazard) {
     VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
     barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
-                            VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
+    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
+                            VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT |
+                            VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
     const VkPipelineStageFlags stages = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
-    vkCmdPipelineBarrier(cmd_, stages, stages | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, 0, 1, &barrier, 0, nullptr,
-                         0, nullptr);
+    vkCmdPipelineBarrier(cmd_, stages, stages | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, 0, 1, &barrier, 0,
+                         nullptr, 0, nullptr);
     written_since_barrier_.clear();
     read_since_barrier_.clear();
     ++barriers_;
@@ -130,10 +137,12 @@ void Sequence::dispatch_raw(const Kernel& kernel, Groups groups, std::initialize
                                 std::to_string(params_bytes) + " bytes, the kernel declares " +
                                 std::to_string(kernel.push_constant_bytes()));
   if (kernel.binding_count() > kMaxBindingsPerKernel)
-    throw std::invalid_argument("kernel '" + kernel.name() + "' has more than " + std::to_string(kMaxBindingsPerKernel) + " bindings");
+    throw std::invalid_argument("kernel '" + kernel.name() + "' has more than " +
+                                std::to_string(kMaxBindingsPerKernel) + " bindings");
   if (bindings.size() != kernel.binding_count())
     throw std::invalid_argument("dispatch of '" + kernel.name() + "': " + std::to_string(bindings.size()) +
-                                " bindings given, the kernel declares " + std::to_string(kernel.binding_count()));
+                                " bindings given, the kernel declares " +
+                                std::to_string(kernel.binding_count()));
   std::vector<bool> seen(kernel.binding_count(), false);
   for (const Binding& b : bindings) {
     if (b.index >= kernel.binding_count() || seen[b.index] || b.buffer == nullptr)
@@ -145,7 +154,8 @@ void Sequence::dispatch_raw(const Kernel& kernel, Groups groups, std::initialize
   for (int i = 0; i < 3; ++i)
     if (g[i] > info.max_compute_workgroup_count[i])
       throw std::invalid_argument("dispatch of '" + kernel.name() + "': " + std::to_string(g[i]) +
-                                  " workgroups in dimension " + std::to_string(i) + " exceed the device limit " +
+                                  " workgroups in dimension " + std::to_string(i) +
+                                  " exceed the device limit " +
                                   std::to_string(info.max_compute_workgroup_count[i]));
   if (groups.x == 0 || groups.y == 0 || groups.z == 0) return;
 
@@ -168,7 +178,8 @@ void Sequence::dispatch_raw(const Kernel& kernel, Groups groups, std::initialize
     writes_[i].pBufferInfo = &infos[i];
     ++i;
   }
-  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes_.size()), writes_.data(), 0, nullptr);
+  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes_.size()), writes_.data(), 0,
+                         nullptr);
 
   const uint32_t query = static_cast<uint32_t>(dispatch_names_.size()) * 2;
   VkQueryPool qpool = VK_NULL_HANDLE;
@@ -190,7 +201,8 @@ void Sequence::dispatch_raw(const Kernel& kernel, Groups groups, std::initialize
   if (params_bytes > 0)
     vkCmdPushConstants(cmd_, kernel.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, params_bytes, params);
   vkCmdDispatch(cmd_, groups.x, groups.y, groups.z);
-  if (timestamps_) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, qpool, query % kQueriesPerPool + 1);
+  if (timestamps_)
+    vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, qpool, query % kQueriesPerPool + 1);
   dispatch_names_.push_back(kernel.name());
 }
 
@@ -252,7 +264,8 @@ std::vector<KernelTime> Sequence::profile() const {
   const double ns = context_->info().timestamp_period_ns;
   for (size_t i = 0; i < dispatch_names_.size(); ++i) {
     const double ms = static_cast<double>(ticks_[2 * i + 1] - ticks_[2 * i]) * ns * 1e-6;
-    auto it = std::find_if(out.begin(), out.end(), [&](const KernelTime& k) { return k.name == dispatch_names_[i]; });
+    auto it = std::find_if(out.begin(), out.end(),
+                           [&](const KernelTime& k) { return k.name == dispatch_names_[i]; });
     if (it == out.end()) {
       out.push_back({dispatch_names_[i], ms, 1});
     } else {

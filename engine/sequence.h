@@ -31,7 +31,7 @@ struct Groups {
 
 struct KernelTime {
   std::string name;
-  double ms = 0.0;          // summed over this kernel's dispatches in the last submit
+  double ms = 0.0;  // summed over this kernel's dispatches in the last submit
   uint32_t dispatches = 0;
 };
 
@@ -56,7 +56,8 @@ class Sequence {
   void dispatch_raw(const Kernel& kernel, Groups groups, std::initializer_list<Binding> bindings,
                     const void* params, uint32_t params_bytes);
 
-  void copy(const Buffer& src, const Buffer& dst, uint64_t bytes, uint64_t src_offset = 0, uint64_t dst_offset = 0);
+  void copy(const Buffer& src, const Buffer& dst, uint64_t bytes, uint64_t src_offset = 0,
+            uint64_t dst_offset = 0);
   // Fills `bytes` (a multiple of 4) from `offset` with the 32-bit `value`.
   void fill(const Buffer& dst, uint32_t value, uint64_t bytes, uint64_t offset = 0);
 

@@ -30,9 +30,9 @@ const char* to_string(VkResult result);
 
 }  // namespace litgs::engine
 
-#define LITGS_VK_CHECK(call)                                                     \
-  do {                                                                           \
-    const VkResult litgs_vk_result_ = (call);                                    \
-    if (litgs_vk_result_ != VK_SUCCESS)                                          \
+#define LITGS_VK_CHECK(call)                                                            \
+  do {                                                                                  \
+    const VkResult litgs_vk_result_ = (call);                                           \
+    if (litgs_vk_result_ != VK_SUCCESS)                                                 \
       ::litgs::engine::throw_vulkan_error(litgs_vk_result_, #call, __FILE__, __LINE__); \
   } while (0)

@@ -2,8 +2,8 @@
 
 #include <bit>
 #include <cstring>
-#include <stdexcept>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -69,8 +69,9 @@ kernels::GaussianModel read_gaussian_ply(const std::filesystem::path& path) {
         m.sh[(i * K + k) * m.channels + c] = static_cast<float>((*rest_fields[c * (K - 1) + (k - 1)])[i]);
     }
     if (one && ((*dc[1])[i] != (*dc[0])[i] || (*dc[2])[i] != (*dc[0])[i]))
-      fail(path, 0, "vertex " + std::to_string(i) +
-                        " has different f_dc_0..2 but the header says litgs_channels 1 (a gray model)");
+      fail(path, 0,
+           "vertex " + std::to_string(i) +
+               " has different f_dc_0..2 but the header says litgs_channels 1 (a gray model)");
   }
   return m;
 }
@@ -124,7 +125,8 @@ void write_gaussian_ply(const std::filesystem::path& path, const kernels::Gaussi
       for (int a = 0; a < 4; ++a) row.push_back(m.quats[4 * i + a]);
       // The PLY is little-endian; so is every machine this engine targets (checked at compile time).
       static_assert(std::endian::native == std::endian::little);
-      out.write(reinterpret_cast<const char*>(row.data()), static_cast<std::streamsize>(row.size() * sizeof(float)));
+      out.write(reinterpret_cast<const char*>(row.data()),
+                static_cast<std::streamsize>(row.size() * sizeof(float)));
     }
   });
 }

@@ -23,8 +23,8 @@ kernels::GaussianModel read_gaussian_ply(const std::filesystem::path& path);
 // if it cannot be opened or is not a PLY.
 std::vector<std::string> read_gaussian_ply_comments(const std::filesystem::path& path);
 
-// Writes atomically (temporary file, then rename). Models with 1 or 3 channels. `comments` become header lines
-// "comment TEXT" (one line each: std::invalid_argument on a line break).
+// Writes atomically (temporary file, then rename). Models with 1 or 3 channels. `comments` become header
+// lines "comment TEXT" (one line each: std::invalid_argument on a line break).
 void write_gaussian_ply(const std::filesystem::path& path, const kernels::GaussianModel& model,
                         const std::vector<std::string>& comments = {});
 

@@ -29,7 +29,8 @@ bool label_time(const std::string& label, double& t_s) {
 }
 
 fs::path find_image(const fs::path& dir, const std::string& label) {
-  for (const char* ext : {".tiff", ".tif", ".png", ".jpg", ".jpeg", ".TIFF", ".TIF", ".PNG", ".JPG", ".JPEG"}) {
+  for (const char* ext :
+       {".tiff", ".tif", ".png", ".jpg", ".jpeg", ".TIFF", ".TIF", ".PNG", ".JPG", ".JPEG"}) {
     const fs::path p = dir / (label + ext);
     if (fs::exists(p)) return p;
   }

@@ -2,10 +2,10 @@
 // the engine writes PNG or TIFF). libjpeg reports errors by longjmp: they become IoError naming the file.
 #include <cstddef>
 #include <cstdio>
+// jpeglib.h uses size_t and FILE without including their headers: it comes after <cstddef> and <cstdio>.
 #include <jpeglib.h>
 
 #include <csetjmp>
-#include <cstdio>
 #include <memory>
 #include <string>
 
@@ -84,6 +84,8 @@ Image read_jpeg(const std::filesystem::path& path) {
   return img;
 }
 
-ImageInfo read_jpeg_info(const std::filesystem::path& path) { return decode(path, nullptr); }
+ImageInfo read_jpeg_info(const std::filesystem::path& path) {
+  return decode(path, nullptr);
+}
 
 }  // namespace litgs::io

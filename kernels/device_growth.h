@@ -21,9 +21,9 @@ inline size_t grown_capacity(size_t current, size_t needed) {
   return std::max({needed, current + current / 2, size_t{1}});
 }
 
-// Makes `array` hold at least `count` elements (at least 1): keeps it when it is large enough, else replaces it
-// with a new array named `name` of grown_capacity() elements. The contents are not kept. The outgrown array is
-// freed, or moved to `retired` (kept alive) when sequences recorded earlier may still use it.
+// Makes `array` hold at least `count` elements (at least 1): keeps it when it is large enough, else replaces
+// it with a new array named `name` of grown_capacity() elements. The contents are not kept. The outgrown
+// array is freed, or moved to `retired` (kept alive) when sequences recorded earlier may still use it.
 template <class T>
 void grow(engine::Context& context, std::unique_ptr<engine::DeviceArray<T>>& array, size_t count,
           const std::string& name, std::vector<std::unique_ptr<engine::DeviceArray<T>>>* retired = nullptr) {

@@ -13,8 +13,8 @@ const std::vector<std::pair<std::string_view, std::span<const uint32_t>>>& spirv
 std::span<const uint32_t> spirv(std::string_view name) {
   for (const auto& [key, words] : detail::spirv_table())
     if (key == name) return words;
-  throw std::out_of_range("no embedded shader named '" + std::string(name) + "' (kernels/" + std::string(name) +
-                          ".comp)");
+  throw std::out_of_range("no embedded shader named '" + std::string(name) + "' (kernels/" +
+                          std::string(name) + ".comp)");
 }
 
 std::vector<std::string_view> spirv_names() {

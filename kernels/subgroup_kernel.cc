@@ -15,7 +15,8 @@ uint32_t subgroup_width(const engine::Context& context) {
 }
 
 namespace {
-engine::KernelDesc kernel_desc(const std::string& name, uint32_t binding_count, uint32_t push_constant_bytes) {
+engine::KernelDesc kernel_desc(const std::string& name, uint32_t binding_count,
+                               uint32_t push_constant_bytes) {
   engine::KernelDesc desc;
   desc.name = name;
   desc.spirv = spirv(name);

@@ -27,8 +27,8 @@ kernels::GaussianModel bench_scene(uint32_t n, uint32_t channels, uint32_t sh_de
   m.resize(n);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0), sym(-1.0, 1.0);
-  const double radius_px = std::clamp(
-      std::sqrt(8.0 * width * height / (std::numbers::pi * std::max<uint32_t>(n, 1))), 0.5, 64.0);
+  const double radius_px =
+      std::clamp(std::sqrt(8.0 * width * height / (std::numbers::pi * std::max<uint32_t>(n, 1))), 0.5, 64.0);
   const uint32_t K = m.sh_coeffs();
   for (uint32_t i = 0; i < n; ++i) {
     const double z = 2.0 + 8.0 * unit(rng);

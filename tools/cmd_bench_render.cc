@@ -1,6 +1,5 @@
 // `litgs-engine bench render`: forward and forward+backward of the rasterizer on a seeded random scene.
 #include <CLI/CLI.hpp>
-
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -40,7 +39,8 @@ struct BenchRenderOptions {
 void run_bench_render(const BenchRenderOptions& o) {
   o.check();
   engine::Context context;
-  const kernels::GaussianModel model = bench_scene(o.gaussians, o.channels, o.sh_degree, o.width, o.height, o.seed);
+  const kernels::GaussianModel model =
+      bench_scene(o.gaussians, o.channels, o.sh_degree, o.width, o.height, o.seed);
   const kernels::SplatCamera camera = bench_camera(o.width, o.height, o.sh_degree);
   kernels::DeviceGaussians gaussians(context, model);
   kernels::RasterizerOptions options;
@@ -65,13 +65,19 @@ void run_bench_render(const BenchRenderOptions& o) {
   }
   const auto& profile = rasterizer.profile();
   const kernels::RasterizerCounters counters = rasterizer.read_counters();
-  const double per_gaussian = o.gaussians ? static_cast<double>(rasterizer.intersections()) / o.gaussians : 0.0;
+  const double per_gaussian =
+      o.gaussians ? static_cast<double>(rasterizer.intersections()) / o.gaussians : 0.0;
   if (o.json) {
-    nlohmann::json j = {{"gaussians", o.gaussians},       {"width", o.width},
-                        {"height", o.height},             {"sh_degree", o.sh_degree},
-                        {"channels", o.channels},         {"runs", o.runs},
-                        {"forward_ms", median(forward_ms)}, {"intersections", rasterizer.intersections()},
-                        {"kernels", kernel_profile_json(profile)}, {"device", device_json(context.info())},
+    nlohmann::json j = {{"gaussians", o.gaussians},
+                        {"width", o.width},
+                        {"height", o.height},
+                        {"sh_degree", o.sh_degree},
+                        {"channels", o.channels},
+                        {"runs", o.runs},
+                        {"forward_ms", median(forward_ms)},
+                        {"intersections", rasterizer.intersections()},
+                        {"kernels", kernel_profile_json(profile)},
+                        {"device", device_json(context.info())},
                         {"intersections_per_gaussian", per_gaussian},
                         {"longest_tile_list", counters.longest_tile_list},
                         {"forward_passes", counters.forward_passes},
@@ -81,19 +87,23 @@ void run_bench_render(const BenchRenderOptions& o) {
     std::cout << j.dump(2) << "\n";
     return;
   }
-  std::cout << std::fixed << std::setprecision(2) << "bench render: " << o.gaussians << " Gaussians, " << o.width
-            << "x" << o.height << ", " << o.channels << " channel(s), SH degree " << o.sh_degree << ", median of "
-            << o.runs << " runs after a warm-up, on " << context.info().name << "\n"
-            << "  intersections        " << rasterizer.intersections() << " (" << per_gaussian << " per Gaussian)\n"
-            << "  longest tile list    " << counters.longest_tile_list << " entries: " << counters.forward_passes
-            << " forward pass(es) of " << rasterizer.forward_entries_per_pass() << ", " << counters.backward_passes
+  std::cout << std::fixed << std::setprecision(2) << "bench render: " << o.gaussians << " Gaussians, "
+            << o.width << "x" << o.height << ", " << o.channels << " channel(s), SH degree " << o.sh_degree
+            << ", median of " << o.runs << " runs after a warm-up, on " << context.info().name << "\n"
+            << "  intersections        " << rasterizer.intersections() << " (" << per_gaussian
+            << " per Gaussian)\n"
+            << "  longest tile list    " << counters.longest_tile_list
+            << " entries: " << counters.forward_passes << " forward pass(es) of "
+            << rasterizer.forward_entries_per_pass() << ", " << counters.backward_passes
             << " backward pass(es) of " << rasterizer.backward_entries_per_pass() << "\n"
-            << "  walks cut short      " << counters.walks_cut_short << " (a driver's loop limit; must be 0)\n"
+            << "  walks cut short      " << counters.walks_cut_short
+            << " (a driver's loop limit; must be 0)\n"
             << "  forward              " << median(forward_ms) << " ms\n";
   if (o.backward)
     std::cout << "  forward + backward   " << median(total_ms) << " ms"
-              << (o.deterministic ? " (deterministic)" : rasterizer.uses_float_atomics() ? " (float atomics)"
-                                                                                        : " (CAS atomics)")
+              << (o.deterministic                   ? " (deterministic)"
+                  : rasterizer.uses_float_atomics() ? " (float atomics)"
+                                                    : " (CAS atomics)")
               << "\n";
   print_kernel_profile(std::cout, profile);
 }
@@ -102,7 +112,8 @@ void run_bench_render(const BenchRenderOptions& o) {
 
 void add_bench_render_command(CLI::App& bench) {
   auto o = std::make_shared<BenchRenderOptions>();
-  CLI::App* cmd = bench.add_subcommand("render", "Rasterizer forward (and backward) on a seeded random scene");
+  CLI::App* cmd =
+      bench.add_subcommand("render", "Rasterizer forward (and backward) on a seeded random scene");
   cmd->add_option("--gaussians", o->gaussians, "Number of Gaussians")->capture_default_str();
   cmd->add_option("--width", o->width, "Image width")->capture_default_str();
   cmd->add_option("--height", o->height, "Image height")->capture_default_str();

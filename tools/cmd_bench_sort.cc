@@ -1,6 +1,5 @@
 // `litgs-engine bench sort`: the device radix sort against std::stable_sort on the same pairs, same process.
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <iomanip>
 #include <iostream>
@@ -30,7 +29,8 @@ struct BenchSortOptions {
   uint32_t seed = 1;      // key generator seed
   bool json = false;
   void check() const {
-    if (bits < 1 || bits > 32) throw std::invalid_argument("--bits must be in 1..32, got " + std::to_string(bits));
+    if (bits < 1 || bits > 32)
+      throw std::invalid_argument("--bits must be in 1..32, got " + std::to_string(bits));
     if (runs < 5) throw std::invalid_argument("--runs must be at least 5, got " + std::to_string(runs));
   }
 };
@@ -51,7 +51,8 @@ void run_bench_sort(const BenchSortOptions& o) {
   for (uint32_t r = 0; r <= o.runs; ++r) {
     for (uint32_t i = 0; i < o.n; ++i) pairs[i] = {keys[i], values[i]};
     const double ms = time_ms([&] {
-      std::stable_sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      std::stable_sort(pairs.begin(), pairs.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
     });
     if (r > 0) cpu_times.push_back(ms);  // run 0 warms caches and the allocator
   }
@@ -120,7 +121,8 @@ void run_bench_sort(const BenchSortOptions& o) {
 
 void add_bench_sort_command(CLI::App& bench) {
   auto o = std::make_shared<BenchSortOptions>();
-  CLI::App* sort = bench.add_subcommand("sort", "Device radix sort of random key-value pairs vs std::stable_sort");
+  CLI::App* sort =
+      bench.add_subcommand("sort", "Device radix sort of random key-value pairs vs std::stable_sort");
   sort->add_option("--n", o->n, "Pairs to sort")->capture_default_str();
   sort->add_option("--bits", o->bits, "Low key bits to sort on (1..32)")->capture_default_str();
   sort->add_option("--runs", o->runs, "Timed runs (at least 5) after one warm-up")->capture_default_str();

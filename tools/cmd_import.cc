@@ -1,5 +1,5 @@
-// `litgs-engine import metashape|colmap|livo2|bag ... --out SCENE`: other tools' outputs into a scene directory
-// (docs/scene-format.md). CPU only: no Vulkan device is created.
+// `litgs-engine import metashape|colmap|livo2|bag ... --out SCENE`: other tools' outputs into a scene
+// directory (docs/scene-format.md). CPU only: no Vulkan device is created.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <memory>

@@ -1,6 +1,5 @@
 // `litgs-engine info [--json]`: the Vulkan devices and the facts the engine uses about the chosen one.
 #include <CLI/CLI.hpp>
-
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -24,12 +23,13 @@ void print_text(const engine::DeviceInfo& d, const std::vector<engine::DeviceInf
             << "vulkan        " << d.api_version << "\n"
             << "subgroup      " << d.subgroup_size << " (range " << d.min_subgroup_size << ".."
             << d.max_subgroup_size << ", size control " << (d.compute_full_subgroups ? "yes" : "no") << ")\n"
-            << "float atomics " << (d.float_atomic_add ? "yes (shaderBufferFloat32AtomicAdd)" : "no (CAS fallback)")
-            << "\n"
+            << "float atomics "
+            << (d.float_atomic_add ? "yes (shaderBufferFloat32AtomicAdd)" : "no (CAS fallback)") << "\n"
             << "max storage buffer range " << d.max_storage_buffer_range / (1024 * 1024) << " MiB\n"
             << "max shared memory        " << d.max_compute_shared_memory_size / 1024 << " KiB\n"
             << "storage buffers / kernel " << d.max_per_stage_storage_buffers << "\n"
-            << "timestamps    " << (d.timestamps ? "yes" : "no") << ", " << d.timestamp_period_ns << " ns/tick\n";
+            << "timestamps    " << (d.timestamps ? "yes" : "no") << ", " << d.timestamp_period_ns
+            << " ns/tick\n";
   for (size_t i = 0; i < d.memory_heaps.size(); ++i)
     std::cout << "heap " << i << "        " << std::fixed << std::setprecision(1)
               << static_cast<double>(d.memory_heaps[i].size_bytes) / (1024.0 * 1024.0 * 1024.0) << " GiB"
@@ -53,7 +53,8 @@ void add_info_command(CLI::App& app) {
     if (options->json) {
       nlohmann::json j = device_json(context.info());
       j["devices"] = nlohmann::json::array();
-      for (const auto& d : all) j["devices"].push_back({{"index", d.index}, {"name", d.name}, {"type", d.type}});
+      for (const auto& d : all)
+        j["devices"].push_back({{"index", d.index}, {"name", d.name}, {"type", d.type}});
       std::cout << j.dump(2) << "\n";
     } else {
       print_text(context.info(), all);

@@ -1,14 +1,14 @@
 // `litgs-engine render`: one view of a 3DGS PLY model, on the device (or with the double-precision CPU
 // reference), to PNG: the image, and optionally expected depth and accumulated alpha.
 //
-// Frames: poses are in the scene's frame, the frame of its poses.txt (recentred: original world - world_offset_m),
-// whenever the scene's offset is known (--scene, or the PLY's litgs_scene_world_offset_m header line that train
-// writes); the model is moved into that frame in double precision before it is rendered, so a model trained on
-// a scene renders at the scene's poses whatever frame its PLY is in (host/train/output_frame.h). --pose-frame
-// original takes poses in original world coordinates (export tum/colmap's default), --pose-frame model in the
-// PLY's own coordinates (the only choice for a PLY from elsewhere without --scene).
+// Frames: poses are in the scene's frame, the frame of its poses.txt (recentred: original world -
+// world_offset_m), whenever the scene's offset is known (--scene, or the PLY's litgs_scene_world_offset_m
+// header line that train writes); the model is moved into that frame in double precision before it is
+// rendered, so a model trained on a scene renders at the scene's poses whatever frame its PLY is in
+// (host/train/output_frame.h). --pose-frame original takes poses in original world coordinates (export
+// tum/colmap's default), --pose-frame model in the PLY's own coordinates (the only choice for a PLY from
+// elsewhere without --scene).
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -23,8 +23,8 @@
 #include "host/train/output_frame.h"
 #include "host/train/training_data.h"
 #include "io/gaussian_ply.h"
-#include "io/scene.h"
 #include "io/image.h"
+#include "io/scene.h"
 #include "kernels/splat/rasterizer.h"
 #include "kernels/splat/reference.h"
 #include "tools/commands.h"
@@ -33,28 +33,29 @@ namespace litgs::tools {
 namespace {
 
 struct RenderOptions {
-  std::string model;                 // 3DGS PLY
-  std::string camera_json;           // camera file (see camera_from_json), or the flags below
-  std::vector<double> pose;          // qw qx qy qz tx ty tz: world-to-camera, COLMAP's images.txt order
-  std::vector<double> intrinsics;    // fx fy cx cy in pixels
+  std::string model;               // 3DGS PLY
+  std::string camera_json;         // camera file (see camera_from_json), or the flags below
+  std::vector<double> pose;        // qw qx qy qz tx ty tz: world-to-camera, COLMAP's images.txt order
+  std::vector<double> intrinsics;  // fx fy cx cy in pixels
   uint32_t width = 0, height = 0;
-  int sh_degree = -1;                // -1: the model's degree
-  std::string out;                   // image PNG: 8-bit, or 16-bit with --bit-depth 16; values clamped to [0, 1]
+  int sh_degree = -1;  // -1: the model's degree
+  std::string out;     // image PNG: 8-bit, or 16-bit with --bit-depth 16; values clamped to [0, 1]
   int bit_depth = 8;
-  std::string depth_out;             // expected depth, 16-bit PNG in units of 1/depth_scale metres
-  double depth_scale = 1000.0;       // depth PNG value per metre (1000: millimetres, up to 65.535 m)
-  std::string alpha_out;             // accumulated alpha, 8-bit PNG
-  bool reference = false;            // render with the double-precision CPU reference instead of the device
-  std::string scene;                 // scene directory: its world_offset_m, and its cameras for --time
-  std::string time;                  // render the scene's view at this time (s), as training sees it
-  double downscale = 1.0;            // --time: the training resolution (train's --downscale)
-  std::string poses = "estimated";   // --time: estimated (poses.txt) | truth (gt/poses.txt)
-  std::string pose_frame = "auto";   // auto | scene | original | model (see the top of this file)
+  std::string depth_out;            // expected depth, 16-bit PNG in units of 1/depth_scale metres
+  double depth_scale = 1000.0;      // depth PNG value per metre (1000: millimetres, up to 65.535 m)
+  std::string alpha_out;            // accumulated alpha, 8-bit PNG
+  bool reference = false;           // render with the double-precision CPU reference instead of the device
+  std::string scene;                // scene directory: its world_offset_m, and its cameras for --time
+  std::string time;                 // render the scene's view at this time (s), as training sees it
+  double downscale = 1.0;           // --time: the training resolution (train's --downscale)
+  std::string poses = "estimated";  // --time: estimated (poses.txt) | truth (gt/poses.txt)
+  std::string pose_frame = "auto";  // auto | scene | original | model (see the top of this file)
 };
 
 glm::dmat3 rotation_from_quat(double w, double x, double y, double z) {
   const double n = std::sqrt(w * w + x * x + y * y + z * z);
-  if (!(n > 1e-12) || !std::isfinite(n)) throw std::invalid_argument("camera rotation quaternion is zero or not finite");
+  if (!(n > 1e-12) || !std::isfinite(n))
+    throw std::invalid_argument("camera rotation quaternion is zero or not finite");
   w /= n, x /= n, y /= n, z /= n;
   return glm::dmat3(1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y),  //
                     2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x),  //
@@ -78,7 +79,8 @@ kernels::SplatCamera camera_from_json(const std::string& path) {
     c.cy = j.at("cy").get<double>();
     const auto q = j.at("q_cam_world").get<std::vector<double>>();
     const auto t = j.at("t_cam_world").get<std::vector<double>>();
-    if (q.size() != 4 || t.size() != 3) throw std::invalid_argument("q_cam_world needs 4 values, t_cam_world 3");
+    if (q.size() != 4 || t.size() != 3)
+      throw std::invalid_argument("q_cam_world needs 4 values, t_cam_world 3");
     c.R_cam_world = rotation_from_quat(q[0], q[1], q[2], q[3]);
     c.t_cam_world = {t[0], t[1], t[2]};
     return c;
@@ -116,8 +118,8 @@ kernels::SplatCamera scene_camera(const RenderOptions& o, const io::Scene& scene
   if (!o.camera_json.empty() || !o.pose.empty())
     throw std::invalid_argument("give --time, or --camera, or --pose: not more than one");
   if (o.pose_frame != "auto" && o.pose_frame != "scene")
-    throw std::invalid_argument("--time renders the scene's camera, in the scene frame: --pose-frame " + o.pose_frame +
-                                " does not apply");
+    throw std::invalid_argument("--time renders the scene's camera, in the scene frame: --pose-frame " +
+                                o.pose_frame + " does not apply");
   if (o.poses != "estimated" && o.poses != "truth")
     throw std::invalid_argument("--poses must be estimated or truth, not '" + o.poses + "'");
   double t = 0;
@@ -135,9 +137,12 @@ kernels::SplatCamera scene_camera(const RenderOptions& o, const io::Scene& scene
 }
 
 void run_render(const RenderOptions& o) {
-  if (o.pose_frame != "auto" && o.pose_frame != "scene" && o.pose_frame != "original" && o.pose_frame != "model")
-    throw std::invalid_argument("--pose-frame must be auto, scene, original or model, not '" + o.pose_frame + "'");
-  if (!o.time.empty() && o.scene.empty()) throw std::invalid_argument("--time needs --scene (the scene's cameras)");
+  if (o.pose_frame != "auto" && o.pose_frame != "scene" && o.pose_frame != "original" &&
+      o.pose_frame != "model")
+    throw std::invalid_argument("--pose-frame must be auto, scene, original or model, not '" + o.pose_frame +
+                                "'");
+  if (!o.time.empty() && o.scene.empty())
+    throw std::invalid_argument("--time needs --scene (the scene's cameras)");
   std::optional<io::Scene> scene;
   if (!o.scene.empty()) {
     io::SceneReadOptions read;
@@ -152,7 +157,8 @@ void run_render(const RenderOptions& o) {
     camera = camera_from_json(o.camera_json);
   } else {
     if (o.pose.size() != 7 || o.intrinsics.size() != 4 || o.width == 0 || o.height == 0)
-      throw std::invalid_argument("give --camera FILE, or --pose (7 values) --intrinsics (4) --width --height");
+      throw std::invalid_argument(
+          "give --camera FILE, or --pose (7 values) --intrinsics (4) --width --height");
     camera.R_cam_world = rotation_from_quat(o.pose[0], o.pose[1], o.pose[2], o.pose[3]);
     camera.t_cam_world = {o.pose[4], o.pose[5], o.pose[6]};
     camera.fx = o.intrinsics[0];
@@ -172,17 +178,19 @@ void run_render(const RenderOptions& o) {
   std::optional<Eigen::Vector3d> scene_offset = model_frame.scene_world_offset_m;
   if (scene) {
     if (scene_offset && *scene_offset != scene->config.world_offset_m)
-      std::cerr << "render: note: the model was trained on a scene with world_offset_m " << vector_text(*scene_offset)
-                << "; poses are taken in " << o.scene << "'s frame (world_offset_m "
-                << vector_text(scene->config.world_offset_m) << ")\n";
+      std::cerr << "render: note: the model was trained on a scene with world_offset_m "
+                << vector_text(*scene_offset) << "; poses are taken in " << o.scene
+                << "'s frame (world_offset_m " << vector_text(scene->config.world_offset_m) << ")\n";
     scene_offset = scene->config.world_offset_m;
   }
   const std::string frame = o.pose_frame == "auto" ? (scene_offset ? "scene" : "model") : o.pose_frame;
   Eigen::Vector3d frame_offset = Eigen::Vector3d::Zero();  // pose-frame coordinates + this = original world
   if (frame == "scene") {
     if (!scene_offset)
-      throw std::invalid_argument(o.model + " does not state the scene it was trained on (no "
-                                  "litgs_scene_world_offset_m header line): give --scene DIR for --pose-frame scene");
+      throw std::invalid_argument(
+          o.model +
+          " does not state the scene it was trained on (no "
+          "litgs_scene_world_offset_m header line): give --scene DIR for --pose-frame scene");
     frame_offset = *scene_offset;
   } else if (frame == "model") {
     frame_offset = model_frame.world_offset_m;
@@ -215,15 +223,18 @@ void run_render(const RenderOptions& o) {
   io::write_image(o.out, to_image(image, camera.width, camera.height, model.channels, o.bit_depth, full));
   if (!o.depth_out.empty())
     io::write_image(o.depth_out, to_image(depth, camera.width, camera.height, 1, 16, o.depth_scale));
-  if (!o.alpha_out.empty()) io::write_image(o.alpha_out, to_image(alpha, camera.width, camera.height, 1, 8, 255.0));
-  const std::string frame_text = frame == "scene"      ? "scene frame (world_offset_m " + vector_text(frame_offset) + ")"
+  if (!o.alpha_out.empty())
+    io::write_image(o.alpha_out, to_image(alpha, camera.width, camera.height, 1, 8, 255.0));
+  const std::string frame_text = frame == "scene"
+                                     ? "scene frame (world_offset_m " + vector_text(frame_offset) + ")"
                                  : frame == "original" ? "original world frame"
                                                        : "model's frame";
   std::cout << "render: " << model.size() << " Gaussians, " << intersections << " tile intersections, "
-            << camera.width << "x" << camera.height << (o.reference ? " (CPU reference)" : "") << ", poses in the "
-            << frame_text << " -> " << o.out << "\n";
+            << camera.width << "x" << camera.height << (o.reference ? " (CPU reference)" : "")
+            << ", poses in the " << frame_text << " -> " << o.out << "\n";
   if (culled > 0)
-    std::cout << "render: warning: " << culled << " Gaussians culled for a non-finite parameter (not drawn)\n";
+    std::cout << "render: warning: " << culled
+              << " Gaussians culled for a non-finite parameter (not drawn)\n";
   if (walks_cut > 0)
     std::cout << "render: warning: " << walks_cut
               << " tile-list walks cut short by the driver's loop limit (the render is incomplete there)\n";
@@ -237,7 +248,9 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--model", o->model, "3DGS PLY model")->required()->check(CLI::ExistingFile);
   cmd->add_option("--camera", o->camera_json, "Camera JSON: width height fx fy cx cy q_cam_world t_cam_world")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--pose", o->pose, "qw qx qy qz tx ty tz, world-to-camera (COLMAP images.txt order), in --pose-frame's world")->expected(7);
+  cmd->add_option("--pose", o->pose,
+                  "qw qx qy qz tx ty tz, world-to-camera (COLMAP images.txt order), in --pose-frame's world")
+      ->expected(7);
   cmd->add_option("--intrinsics", o->intrinsics, "fx fy cx cy in pixels")->expected(4);
   cmd->add_option("--width", o->width, "Image width");
   cmd->add_option("--height", o->height, "Image height");
@@ -248,15 +261,20 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--depth-scale", o->depth_scale, "Depth PNG value per metre")->capture_default_str();
   cmd->add_option("--alpha", o->alpha_out, "Accumulated alpha as 8-bit PNG");
   cmd->add_flag("--reference", o->reference, "Use the double-precision CPU reference (slow)");
-  cmd->add_option("--scene", o->scene, "Scene directory: poses in its frame (poses.txt's), and its cameras for --time")
+  cmd->add_option("--scene", o->scene,
+                  "Scene directory: poses in its frame (poses.txt's), and its cameras for --time")
       ->check(CLI::ExistingDirectory);
-  cmd->add_option("--time", o->time, "Render the scene's view at this time (s) as training does (needs --scene)");
-  cmd->add_option("--downscale", o->downscale, "--time: divide image size and intrinsics by this (train's --downscale)")
+  cmd->add_option("--time", o->time,
+                  "Render the scene's view at this time (s) as training does (needs --scene)");
+  cmd->add_option("--downscale", o->downscale,
+                  "--time: divide image size and intrinsics by this (train's --downscale)")
       ->capture_default_str();
-  cmd->add_option("--poses", o->poses, "--time: estimated (poses.txt) or truth (gt/poses.txt)")->capture_default_str();
-  cmd->add_option("--pose-frame", o->pose_frame,
-                  "Frame of --pose/--camera: scene (poses.txt's; the default when the scene is known), original "
-                  "(original world), model (the PLY's coordinates; the default otherwise)")
+  cmd->add_option("--poses", o->poses, "--time: estimated (poses.txt) or truth (gt/poses.txt)")
+      ->capture_default_str();
+  cmd->add_option(
+         "--pose-frame", o->pose_frame,
+         "Frame of --pose/--camera: scene (poses.txt's; the default when the scene is known), original "
+         "(original world), model (the PLY's coordinates; the default otherwise)")
       ->capture_default_str();
   cmd->callback([o] { run_render(*o); });
 }

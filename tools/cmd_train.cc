@@ -1,7 +1,7 @@
 // `litgs-engine train SCENE --out DIR ...`: a Gaussian map of a scene directory, on the Vulkan device.
-#include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,20 +22,20 @@ namespace {
 
 struct TrainCliOptions {
   std::string scene, out;
-  std::string init = "auto";       // auto | random | a .ply/.pcd file (in the scene's original world frame)
-  uint32_t random_count = 20000;   // Gaussians of --init random
+  std::string init = "auto";      // auto | random | a .ply/.pcd file (in the scene's original world frame)
+  uint32_t random_count = 20000;  // Gaussians of --init random
   uint32_t max_init_points = 200000;  // LiDAR-map initialization keeps at most this many points
   // LiDAR-map initialization: a point on a LiDAR plane becomes a disc this thin relative to its radius
   // (host::surfel_covariances); 1: spheres, as 3DGS.
   double init_flatness = 0.1;
-  std::string intensity = "auto";  // auto | percentile | linear
+  std::string intensity = "auto";   // auto | percentile | linear
   std::string poses = "estimated";  // estimated (poses.txt) | truth (gt/poses.txt)
   host::TrainingDataOptions data;
   host::TrainOptions train;
 };
 
-// The counters of events that should not happen (host/train/run_record.h), only those that did: "" in a healthy
-// run.
+// The counters of events that should not happen (host/train/run_record.h), only those that did: "" in a
+// healthy run.
 std::string anomaly_text(const host::TrainingCounters& c) {
   std::string s;
   if (c.adam_nonfinite_total() > 0) {
@@ -43,7 +43,8 @@ std::string anomaly_text(const host::TrainingCounters& c) {
     bool first = true;
     for (uint32_t g = 0; g < kernels::kParamGroupCount; ++g)
       if (c.adam_nonfinite_skips[g] > 0) {
-        s += std::string(first ? "" : ", ") + kernels::kParamGroupNames[g] + " " + std::to_string(c.adam_nonfinite_skips[g]);
+        s += std::string(first ? "" : ", ") + kernels::kParamGroupNames[g] + " " +
+             std::to_string(c.adam_nonfinite_skips[g]);
         first = false;
       }
     s += ")";
@@ -102,8 +103,9 @@ void run_train(TrainCliOptions o) {
         const bool on_plane = pid >= 0 && pid < static_cast<double>(scene.gt->planes.size());
         gt_planes->points.push_back(m.positions[i].cast<float>());
         gt_planes->centres.push_back(m.positions[i].cast<float>());  // a true point lies on its plane
-        gt_planes->normals.push_back(on_plane ? Eigen::Vector3f(scene.gt->planes[static_cast<size_t>(pid)].n.cast<float>())
-                                              : Eigen::Vector3f(Eigen::Vector3f::Zero()));
+        gt_planes->normals.push_back(
+            on_plane ? Eigen::Vector3f(scene.gt->planes[static_cast<size_t>(pid)].n.cast<float>())
+                     : Eigen::Vector3f(Eigen::Vector3f::Zero()));
         gt_planes->planar.push_back(on_plane ? 1 : 0);
       }
       host::assign_surfel_radii(*gt_planes);
@@ -137,9 +139,8 @@ void run_train(TrainCliOptions o) {
       normals.push_back(planes->normals[i]);
       planar.push_back(planes->planar[i]);
     }
-    const auto covariances =
-        host::surfel_covariances(host::neighbour_scales(pts, init, data.scene_extent_m * 0.01), normals, planar,
-                                 o.init_flatness);
+    const auto covariances = host::surfel_covariances(
+        host::neighbour_scales(pts, init, data.scene_extent_m * 0.01), normals, planar, o.init_flatness);
     model = host::init_from_points(pts, data, init, covariances);
     init_what = std::to_string(pts.size()) + " LiDAR map points";
   } else {
@@ -152,17 +153,19 @@ void run_train(TrainCliOptions o) {
   const bool tty = ::isatty(STDOUT_FILENO);
   std::cout << "train: " << data.views.size() << " views (" << data.width << "x" << data.height << ", "
             << data.frozen_skipped << " frozen skipped), "
-            << (o.train.resume ? "resuming from " : "init " + std::to_string(model.size()) + " Gaussians from ")
-            << init_what
-            << ", lambda_geo " << o.train.lambda_geo << ", on " << context.info().name << "\n";
+            << (o.train.resume ? "resuming from "
+                               : "init " + std::to_string(model.size()) + " Gaussians from ")
+            << init_what << ", lambda_geo " << o.train.lambda_geo << ", on " << context.info().name << "\n";
   auto progress = [&](const host::TrainProgress& p) {
     const double eta = (p.total - p.iteration) / std::max(p.iterations_per_s, 1e-9);
     char terms[64] = "";
     if (std::isfinite(p.geometric_rms_m))
-      std::snprintf(terms, sizeof terms, " (pho %.4f, plane rms %.1f cm)", p.photometric_loss, 100 * p.geometric_rms_m);
+      std::snprintf(terms, sizeof terms, " (pho %.4f, plane rms %.1f cm)", p.photometric_loss,
+                    100 * p.geometric_rms_m);
     char line[320];
-    std::snprintf(line, sizeof line, "[%6u/%u] loss %.4f%s  psnr %s  gaussians %zu  %.2f it/s  eta %s", p.iteration,
-                  p.total, p.loss, terms, std::isfinite(p.psnr_db) ? std::to_string(p.psnr_db).substr(0, 5).c_str() : "-",
+    std::snprintf(line, sizeof line, "[%6u/%u] loss %.4f%s  psnr %s  gaussians %zu  %.2f it/s  eta %s",
+                  p.iteration, p.total, p.loss, terms,
+                  std::isfinite(p.psnr_db) ? std::to_string(p.psnr_db).substr(0, 5).c_str() : "-",
                   p.gaussians, p.iterations_per_s, format_eta(eta).c_str());
     std::cout << (tty ? "\r" : "") << line << anomaly_text(p.counters) << (tty ? "" : "\n") << std::flush;
   };
@@ -174,8 +177,10 @@ void run_train(TrainCliOptions o) {
   std::cout << "train: " << r.iterations << " iterations in " << r.wall_s << " s (" << r.ms_per_iteration
             << " ms/iteration), " << r.gaussians << " Gaussians; held-out PSNR " << r.final_eval.psnr_db
             << " dB, SSIM " << r.final_eval.ssim << "; wrote " << o.out << "/point_cloud.ply ("
-            << (o.train.recentred_output ? "recentred scene frame" : "original world frame") << ") and metrics.json\n";
-  if (r.counters.any_anomaly()) std::cout << "train: counters:" << anomaly_text(r.counters) << " (metrics.json)\n";
+            << (o.train.recentred_output ? "recentred scene frame" : "original world frame")
+            << ") and metrics.json\n";
+  if (r.counters.any_anomaly())
+    std::cout << "train: counters:" << anomaly_text(r.counters) << " (metrics.json)\n";
 }
 
 }  // namespace
@@ -183,17 +188,23 @@ void run_train(TrainCliOptions o) {
 void add_train_command(CLI::App& app) {
   auto o = std::make_shared<TrainCliOptions>();
   CLI::App* cmd = app.add_subcommand("train", "Train a Gaussian map of a scene directory on the device");
-  cmd->add_option("scene", o->scene, "Scene directory (docs/scene-format.md)")->required()->check(CLI::ExistingDirectory);
-  cmd->add_option("--out", o->out, "Output directory (point_cloud.ply, metrics.json, checkpoints/)")->required();
+  cmd->add_option("scene", o->scene, "Scene directory (docs/scene-format.md)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--out", o->out, "Output directory (point_cloud.ply, metrics.json, checkpoints/)")
+      ->required();
   cmd->add_option("--iterations", o->train.iterations, "Training iterations")->capture_default_str();
-  cmd->add_option("--downscale", o->data.downscale, "Divide image size and intrinsics by this")->capture_default_str();
-  cmd->add_option("--lambda-geo", o->train.lambda_geo, "Weight of the LiDAR point-to-plane loss")->capture_default_str();
+  cmd->add_option("--downscale", o->data.downscale, "Divide image size and intrinsics by this")
+      ->capture_default_str();
+  cmd->add_option("--lambda-geo", o->train.lambda_geo, "Weight of the LiDAR point-to-plane loss")
+      ->capture_default_str();
   cmd->add_option("--geo-robust-scale", o->train.geo_robust_scale_m,
                   "Cauchy scale of the point-to-plane residual, metres (0: squared residuals)")
       ->capture_default_str();
   cmd->add_flag("!--geo-no-opacity-gradient", o->train.geo_gradient_to_opacity,
                 "The LiDAR term moves Gaussians but leaves their opacity to the image");
-  cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")->capture_default_str();
+  cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")
+      ->capture_default_str();
   cmd->add_option("--init", o->init, "auto (LiDAR map, else random), random, or a .ply/.pcd point file")
       ->capture_default_str();
   cmd->add_option("--init-flatness", o->init_flatness,
@@ -201,38 +212,50 @@ void add_train_command(CLI::App& app) {
       ->check(CLI::Range(1e-3, 1.0))
       ->capture_default_str();
   cmd->add_option("--random-count", o->random_count, "Gaussians of --init random")->capture_default_str();
-  cmd->add_option("--eval-every", o->train.eval_every, "Evaluate held-out views every K iterations (0: at the end)");
+  cmd->add_option("--eval-every", o->train.eval_every,
+                  "Evaluate held-out views every K iterations (0: at the end)");
   cmd->add_option("--checkpoint-every", o->train.checkpoint_every, "Checkpoint every K iterations (0: none)");
-  cmd->add_flag("--resume", o->train.resume,
-                "Continue from the newest checkpoint in --out, with its options (only --iterations, --eval-every, "
-                "--checkpoint-every, --progress-every, --recentred-output may change)");
-  cmd->add_flag("--recentred-output", o->train.recentred_output,
-                "Write point_cloud.ply in the scene's recentred frame (poses.txt's) instead of the original world "
-                "frame (scene + world_offset_m)");
-  cmd->add_option("--max-gaussians", o->train.max_gaussians, "Cap of the model size (the MCMC budget)")->capture_default_str();
-  cmd->add_option("--strategy", o->train.strategy, "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")
+  cmd->add_flag(
+      "--resume", o->train.resume,
+      "Continue from the newest checkpoint in --out, with its options (only --iterations, --eval-every, "
+      "--checkpoint-every, --progress-every, --recentred-output may change)");
+  cmd->add_flag(
+      "--recentred-output", o->train.recentred_output,
+      "Write point_cloud.ply in the scene's recentred frame (poses.txt's) instead of the original world "
+      "frame (scene + world_offset_m)");
+  cmd->add_option("--max-gaussians", o->train.max_gaussians, "Cap of the model size (the MCMC budget)")
+      ->capture_default_str();
+  cmd->add_option("--strategy", o->train.strategy,
+                  "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")
       ->check(CLI::IsMember({"adc", "mcmc"}))
       ->capture_default_str();
-  cmd->add_option("--mcmc-growth", o->train.mcmc_growth, "MCMC: growth per refinement (fraction)")->capture_default_str();
+  cmd->add_option("--mcmc-growth", o->train.mcmc_growth, "MCMC: growth per refinement (fraction)")
+      ->capture_default_str();
   cmd->add_option("--mcmc-noise-lr", o->train.mcmc_noise_lr, "MCMC: position noise x means learning rate")
       ->capture_default_str();
   cmd->add_flag("--deterministic", o->train.deterministic, "Bit-identical gradients (slower)");
   cmd->add_option("--sh-degree", o->train.sh_degree, "Final SH degree")->capture_default_str();
   cmd->add_option("--seed", o->train.seed, "Seed of view order and densification")->capture_default_str();
-  cmd->add_option("--holdout-every", o->data.holdout_every, "Hold out every Nth frame (0: none)")->capture_default_str();
+  cmd->add_option("--holdout-every", o->data.holdout_every, "Hold out every Nth frame (0: none)")
+      ->capture_default_str();
   cmd->add_option("--intensity", o->intensity, "auto | percentile | linear")->capture_default_str();
   cmd->add_option("--plane-prune-k", o->train.plane_prune_k,
-                  "Prune Gaussians beyond median + k * 1.4826 * MAD of their LiDAR-plane distances (at least 10 cm; 0: off)")
+                  "Prune Gaussians beyond median + k * 1.4826 * MAD of their LiDAR-plane distances (at least "
+                  "10 cm; 0: off)")
       ->capture_default_str();
   cmd->add_option("--poses", o->poses, "estimated (poses.txt) or truth (gt/poses.txt of synthetic scenes)")
       ->capture_default_str();
-  cmd->add_option("--densify-from", o->train.densify_from, "First densification iteration")->capture_default_str();
-  cmd->add_option("--densify-until", o->train.densify_until, "Last densification iteration")->capture_default_str();
+  cmd->add_option("--densify-from", o->train.densify_from, "First densification iteration")
+      ->capture_default_str();
+  cmd->add_option("--densify-until", o->train.densify_until, "Last densification iteration")
+      ->capture_default_str();
   cmd->add_option("--densify-every", o->train.densify_every, "Densification cadence")->capture_default_str();
   cmd->add_option("--densify-grad-threshold", o->train.densify_grad_threshold,
-                  "Densify where the screen-space gradient of the total loss exceeds this (3DGS units; not scaled by 1 - lambda_geo)")
+                  "Densify where the screen-space gradient of the total loss exceeds this (3DGS units; not "
+                  "scaled by 1 - lambda_geo)")
       ->capture_default_str();
-  cmd->add_option("--opacity-reset-every", o->train.opacity_reset_every, "Opacity reset cadence")->capture_default_str();
+  cmd->add_option("--opacity-reset-every", o->train.opacity_reset_every, "Opacity reset cadence")
+      ->capture_default_str();
   cmd->add_option("--progress-every", o->train.progress_every, "Progress cadence")->capture_default_str();
   cmd->callback([o] { run_train(*o); });
 }

@@ -8,7 +8,7 @@ class App;
 namespace litgs::tools {
 
 void add_info_command(CLI::App& app);
-void add_bench_command(CLI::App& app);       // bench sort | render | loss
+void add_bench_command(CLI::App& app);  // bench sort | render | loss
 void add_bench_sort_command(CLI::App& bench);
 void add_bench_render_command(CLI::App& bench);
 void add_bench_loss_command(CLI::App& bench);

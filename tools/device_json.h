@@ -9,7 +9,8 @@ namespace litgs::tools {
 
 inline nlohmann::json device_json(const engine::DeviceInfo& d) {
   nlohmann::json heaps = nlohmann::json::array();
-  for (const auto& h : d.memory_heaps) heaps.push_back({{"size_bytes", h.size_bytes}, {"device_local", h.device_local}});
+  for (const auto& h : d.memory_heaps)
+    heaps.push_back({{"size_bytes", h.size_bytes}, {"device_local", h.device_local}});
   return {{"index", d.index},
           {"name", d.name},
           {"type", d.type},

@@ -2,10 +2,9 @@
 #pragma once
 
 #include <iomanip>
+#include <nlohmann/json.hpp>
 #include <ostream>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "engine/sequence.h"
 
@@ -18,8 +17,8 @@ inline void print_kernel_profile(std::ostream& out, const std::vector<engine::Ke
   const std::streamsize precision = out.precision();
   out << std::fixed << std::setprecision(2) << "  per kernel (last run, GPU timestamps):\n";
   for (const auto& k : profile)
-    out << "    " << std::left << std::setw(42) << k.name << std::right << std::setw(3) << k.dispatches << "x "
-        << std::setw(9) << k.ms << " ms\n";
+    out << "    " << std::left << std::setw(42) << k.name << std::right << std::setw(3) << k.dispatches
+        << "x " << std::setw(9) << k.ms << " ms\n";
   out.flags(flags);
   out.precision(precision);
 }
@@ -27,7 +26,8 @@ inline void print_kernel_profile(std::ostream& out, const std::vector<engine::Ke
 // The JSON "kernels" array: [{"name", "ms", "dispatches"}] in profile order.
 inline nlohmann::json kernel_profile_json(const std::vector<engine::KernelTime>& profile) {
   nlohmann::json kernels = nlohmann::json::array();
-  for (const auto& k : profile) kernels.push_back({{"name", k.name}, {"ms", k.ms}, {"dispatches", k.dispatches}});
+  for (const auto& k : profile)
+    kernels.push_back({{"name", k.name}, {"ms", k.ms}, {"dispatches", k.dispatches}});
   return kernels;
 }
 

@@ -1,6 +1,5 @@
 // litgs-engine: one binary, one subcommand per job.
 #include <CLI/CLI.hpp>
-
 #include <iostream>
 #include <string>
 

@@ -37,8 +37,8 @@ Eigen::Isometry3d lidar_mount(const Vector3d& t_imu_lidar, Rng& rng) {
 }
 
 // The radiances below are written relative to 3500 counts and shifted by this: the Workswell frames of
-// the Thermitage DUNR set (a facade; tests/data/thermitage-dunr holds 3 of them) sit around 4000 counts (1st..99th percentile ~3900..4200),
-// their sky near 3050.
+// the Thermitage DUNR set (a facade; tests/data/thermitage-dunr holds 3 of them) sit around 4000 counts
+// (1st..99th percentile ~3900..4200), their sky near 3050.
 constexpr double kSceneOffsetRaw = 550;
 
 ThermalTexture uniform(double base, double noise, double scale_m, uint64_t seed) {

@@ -18,10 +18,10 @@
 namespace litgs::host {
 
 struct Checkpoint {
-  uint32_t iteration = 0;             // iterations completed
-  std::vector<uint32_t> view_order;   // the current epoch's order of training views
-  uint32_t order_position = 0;        // next index into view_order
-  std::string rng_state;              // std::mt19937 state as text (operator<<)
+  uint32_t iteration = 0;            // iterations completed
+  std::vector<uint32_t> view_order;  // the current epoch's order of training views
+  uint32_t order_position = 0;       // next index into view_order
+  std::string rng_state;             // std::mt19937 state as text (operator<<)
   kernels::TrainingState state;
   RunRecord record;
   bool has_record = true;  // false: read from a format-1 file (no options, evaluations or counters stored)

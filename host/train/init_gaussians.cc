@@ -2,10 +2,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
-#include <nanoflann.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <nanoflann.hpp>
 #include <random>
 #include <stdexcept>
 
@@ -26,7 +25,8 @@ struct CloudAdaptor {
     return false;
   }
 };
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor>, CloudAdaptor, 3>;
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor>, CloudAdaptor, 3>;
 
 // Intensity of the nearest training view that sees p, or -1.
 double sample_views(const Eigen::Vector3d& p, const TrainingData& data) {
@@ -41,10 +41,14 @@ double sample_views(const Eigen::Vector3d& p, const TrainingData& data) {
     if (u < 0 || w < 0 || u > c.width - 1.0 || w > c.height - 1.0) continue;
     const int x0 = std::min(static_cast<int>(u), static_cast<int>(c.width) - 1);
     const int y0 = std::min(static_cast<int>(w), static_cast<int>(c.height) - 1);
-    const int x1 = std::min(x0 + 1, static_cast<int>(c.width) - 1), y1 = std::min(y0 + 1, static_cast<int>(c.height) - 1);
+    const int x1 = std::min(x0 + 1, static_cast<int>(c.width) - 1),
+              y1 = std::min(y0 + 1, static_cast<int>(c.height) - 1);
     const double fx = u - x0, fy = w - y0;
-    auto at = [&](int x, int y) { return static_cast<double>(v.image[static_cast<size_t>(y) * c.width + x]); };
-    value = (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+    auto at = [&](int x, int y) {
+      return static_cast<double>(v.image[static_cast<size_t>(y) * c.width + x]);
+    };
+    value =
+        (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
     best_depth = q.z;
   }
   return value;
@@ -70,15 +74,18 @@ GaussianShape shape_of(const Eigen::Matrix3d& cov, double min_scale_m, size_t in
 }
 
 // The six covariance fields of a cloud, if it has all of them (none: empty; some: an error).
-std::vector<Eigen::Matrix3d> read_covariances(const io::PointCloud& cloud, const std::filesystem::path& file) {
+std::vector<Eigen::Matrix3d> read_covariances(const io::PointCloud& cloud,
+                                              const std::filesystem::path& file) {
   static const char* names[6] = {"cov_xx", "cov_xy", "cov_xz", "cov_yy", "cov_yz", "cov_zz"};
   const io::ScalarField* f[6];
   int present = 0;
   for (int k = 0; k < 6; ++k) present += (f[k] = cloud.field(names[k])) != nullptr;
   if (present == 0) return {};
   if (present < 6)
-    throw std::invalid_argument(file.string() + ": a per-point covariance needs all six fields cov_xx cov_xy cov_xz "
-                                "cov_yy cov_yz cov_zz; the file has " + std::to_string(present));
+    throw std::invalid_argument(file.string() +
+                                ": a per-point covariance needs all six fields cov_xx cov_xy cov_xz "
+                                "cov_yy cov_yz cov_zz; the file has " +
+                                std::to_string(present));
   std::vector<Eigen::Matrix3d> out(cloud.size());
   for (size_t i = 0; i < cloud.size(); ++i) {
     const double xx = f[0]->values[i], xy = f[1]->values[i], xz = f[2]->values[i], yy = f[3]->values[i],
@@ -104,7 +111,8 @@ void InitOptions::check() const {
 
 InitPoints load_points(const std::filesystem::path& file, const Eigen::Vector3d& offset) {
   std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   io::PointCloud cloud;
   if (ext == ".ply")
     cloud = io::read_ply_points(file);
@@ -150,9 +158,10 @@ std::vector<Eigen::Matrix3d> surfel_covariances(const std::vector<double>& scale
                                                 const std::vector<uint8_t>& planar, double flatness) {
   if (normals.size() != scales.size() || planar.size() != scales.size())
     throw std::invalid_argument("surfel_covariances: " + std::to_string(scales.size()) + " scales, " +
-                                std::to_string(normals.size()) + " normals and " + std::to_string(planar.size()) +
-                                " planar flags (need one each per point)");
-  if (!(flatness > 0 && flatness <= 1)) throw std::invalid_argument("surfel_covariances: flatness must be in (0, 1]");
+                                std::to_string(normals.size()) + " normals and " +
+                                std::to_string(planar.size()) + " planar flags (need one each per point)");
+  if (!(flatness > 0 && flatness <= 1))
+    throw std::invalid_argument("surfel_covariances: flatness must be in (0, 1]");
   std::vector<Eigen::Matrix3d> out(scales.size());
   for (size_t i = 0; i < scales.size(); ++i) {
     const double s2 = scales[i] * scales[i];
@@ -165,12 +174,13 @@ std::vector<Eigen::Matrix3d> surfel_covariances(const std::vector<double>& scale
 }
 
 kernels::GaussianModel init_from_points(const std::vector<Eigen::Vector3d>& points, const TrainingData& data,
-                                        const InitOptions& o, const std::vector<Eigen::Matrix3d>& covariances) {
+                                        const InitOptions& o,
+                                        const std::vector<Eigen::Matrix3d>& covariances) {
   o.check();
   if (points.empty()) throw std::invalid_argument("init_from_points: no points");
   if (!covariances.empty() && covariances.size() != points.size())
-    throw std::invalid_argument("init_from_points: " + std::to_string(covariances.size()) + " covariances for " +
-                                std::to_string(points.size()) + " points");
+    throw std::invalid_argument("init_from_points: " + std::to_string(covariances.size()) +
+                                " covariances for " + std::to_string(points.size()) + " points");
   kernels::GaussianModel m;
   m.channels = 1;
   m.sh_degree = o.sh_degree;
@@ -202,7 +212,8 @@ kernels::GaussianModel init_from_points(const std::vector<Eigen::Vector3d>& poin
   return m;
 }
 
-kernels::GaussianModel init_random(const TrainingData& data, uint32_t count, uint32_t seed, const InitOptions& o) {
+kernels::GaussianModel init_random(const TrainingData& data, uint32_t count, uint32_t seed,
+                                   const InitOptions& o) {
   if (count == 0) throw std::invalid_argument("init_random: count must be positive");
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const auto& v : data.views) {

@@ -4,8 +4,8 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <optional>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "host/train/training_data.h"
@@ -54,6 +54,7 @@ std::vector<Eigen::Matrix3d> surfel_covariances(const std::vector<double>& scale
                                                 const std::vector<uint8_t>& planar, double flatness);
 
 // `count` points uniform in the cube of side 2 x scene extent around the mean camera centre, then as above.
-kernels::GaussianModel init_random(const TrainingData& data, uint32_t count, uint32_t seed, const InitOptions& options);
+kernels::GaussianModel init_random(const TrainingData& data, uint32_t count, uint32_t seed,
+                                   const InitOptions& options);
 
 }  // namespace litgs::host

@@ -2,10 +2,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <nanoflann.hpp>
-
 #include <cmath>
 #include <limits>
+#include <nanoflann.hpp>
 #include <stdexcept>
 
 namespace litgs::host {
@@ -88,7 +87,8 @@ void assign_surfel_radii(PlanarMap& map, uint32_t neighbours, double coverage) {
   std::vector<double> d2(neighbours + 1);
   const double per_neighbour = coverage / std::sqrt(static_cast<double>(neighbours));
   for (size_t i = 0; i < pts.size(); ++i) {
-    const size_t found = tree.knnSearch(pts[i].data(), neighbours + 1, idx.data(), d2.data());  // itself first
+    const size_t found =
+        tree.knnSearch(pts[i].data(), neighbours + 1, idx.data(), d2.data());  // itself first
     if (found == neighbours + 1) map.radii[i] = static_cast<float>(std::sqrt(d2[neighbours]) * per_neighbour);
   }
 }
@@ -185,7 +185,8 @@ struct FloatAdaptor {
     return false;
   }
 };
-using FloatTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, FloatAdaptor>, FloatAdaptor, 3>;
+using FloatTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, FloatAdaptor>, FloatAdaptor, 3>;
 
 }  // namespace
 
@@ -205,7 +206,8 @@ PlaneDistance::PlaneDistance(const PlanarMap& map, double max_radius_m) : index_
     index_->planar.push_back(map.planar[i]);
   }
   index_->max_d2 = static_cast<float>(max_radius_m * max_radius_m);
-  index_->tree = std::make_unique<FloatTree>(3, index_->adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  index_->tree =
+      std::make_unique<FloatTree>(3, index_->adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
   if (!index_->points.empty()) index_->tree->buildIndex();
 }
 

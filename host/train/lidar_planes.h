@@ -12,10 +12,10 @@
 namespace litgs::host {
 
 struct PlaneFitOptions {
-  uint32_t neighbours = 12;      // map points in each local plane fit
-  double max_flatness = 0.05;    // smallest / middle eigenvalue of the neighbourhood: above it, not planar
-  double max_radius_m = 1.0;     // neighbours farther than this make the fit invalid (sparse areas)
-  void check() const;            // throws std::invalid_argument naming the bad field
+  uint32_t neighbours = 12;    // map points in each local plane fit
+  double max_flatness = 0.05;  // smallest / middle eigenvalue of the neighbourhood: above it, not planar
+  double max_radius_m = 1.0;   // neighbours farther than this make the fit invalid (sparse areas)
+  void check() const;          // throws std::invalid_argument naming the bad field
 };
 
 // A LiDAR map with a local plane (a point on it and a unit normal) per point where its neighbourhood is
@@ -24,8 +24,9 @@ struct PlaneFitOptions {
 struct PlanarMap {
   std::vector<Eigen::Vector3f> points;   // world, metres (the scene's recentred frame)
   std::vector<Eigen::Vector3f> normals;  // unit, sign arbitrary (the loss squares the residual)
-  std::vector<Eigen::Vector3f> centres;  // the local plane's point (centroid of the fit); zero where not planar
-  std::vector<uint8_t> planar;           // 1 where the fit is valid
+  std::vector<Eigen::Vector3f>
+      centres;                  // the local plane's point (centroid of the fit); zero where not planar
+  std::vector<uint8_t> planar;  // 1 where the fit is valid
   // The surface each point stands for in a view: a disc of this radius (metres; on its plane where planar,
   // facing the camera elsewhere), so that a nearer surface hides the points behind it between its own
   // sparse points. Empty or 0: the point covers only the pixel it falls in.
@@ -49,11 +50,12 @@ struct ViewPlaneMaps {
 };
 
 // The nearest map surface per pixel by a z-buffer of the points' discs (pixel centres at +0.5, the
-// rasterizer's convention): a planar point's disc lies on its local plane and is depth-tested where the pixel's
-// ray meets that plane; a non-planar point's faces the camera at its depth (it only hides what lies behind).
-// Where the nearest disc is planar, the pixel carries its point moved onto the local plane, and the plane's
-// normal. Points project with their radius clamped to max_radius_px pixels.
-ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& camera, double max_radius_px = 16);
+// rasterizer's convention): a planar point's disc lies on its local plane and is depth-tested where the
+// pixel's ray meets that plane; a non-planar point's faces the camera at its depth (it only hides what lies
+// behind). Where the nearest disc is planar, the pixel carries its point moved onto the local plane, and the
+// plane's normal. Points project with their radius clamped to max_radius_px pixels.
+ViewPlaneMaps project_planes(const PlanarMap& map, const kernels::SplatCamera& camera,
+                             double max_radius_px = 16);
 
 }  // namespace litgs::host
 
@@ -61,8 +63,8 @@ namespace litgs::host {
 
 // Distances of points to the LiDAR planes, for the densifier's geometric outlier prune: for each query, the
 // nearest map point p (within max_radius_m) is its association; where p lies on a plane the distance is
-// |n . (x - c)| to p's local plane (centroid c, normal n), where p is not planar (foliage, edges, clutter) or there is no point in reach it is NaN (no
-// plane claims the query, so it is never pruned by distance).
+// |n . (x - c)| to p's local plane (centroid c, normal n), where p is not planar (foliage, edges, clutter) or
+// there is no point in reach it is NaN (no plane claims the query, so it is never pruned by distance).
 class PlaneDistance {
  public:
   explicit PlaneDistance(const PlanarMap& map, double max_radius_m = 0.5);

@@ -2,7 +2,8 @@
 // check that decides whether `train --resume` may continue a checkpoint with this run's options.
 //
 // May differ on resume (each difference is reported as a note):
-//   iterations        to extend (or shorten) the run; not below the checkpoint's iteration. From the resume on,
+//   iterations        to extend (or shorten) the run; not below the checkpoint's iteration. From the resume
+//   on,
 //                     the means' learning-rate decay and the refinement window (densify_until clipped to the
 //                     run) follow the new total, so an extended run is not the run that had started with it.
 //   eval_every, checkpoint_every, progress_every   reporting cadence only.
@@ -27,11 +28,12 @@ namespace litgs::host {
 // "0.000199999994947575".
 nlohmann::json run_options_json(const TrainOptions& options, const TrainingData& data);
 
-// Compares the options stored in `checkpoint` (written after `checkpoint_iteration` iterations) with this run's.
-// Returns one note per allowed difference (and per option the checkpoint did not record, assumed unchanged);
-// throws std::invalid_argument "CHECKPOINT: train --resume refused: ..." that names every other difference
-// with the checkpoint's and this run's value (and the CLI flag where there is one).
-std::vector<std::string> check_resume_options(const std::filesystem::path& checkpoint, uint32_t checkpoint_iteration,
-                                              const nlohmann::json& stored, const nlohmann::json& now);
+// Compares the options stored in `checkpoint` (written after `checkpoint_iteration` iterations) with this
+// run's. Returns one note per allowed difference (and per option the checkpoint did not record, assumed
+// unchanged); throws std::invalid_argument "CHECKPOINT: train --resume refused: ..." that names every other
+// difference with the checkpoint's and this run's value (and the CLI flag where there is one).
+std::vector<std::string> check_resume_options(const std::filesystem::path& checkpoint,
+                                              uint32_t checkpoint_iteration, const nlohmann::json& stored,
+                                              const nlohmann::json& now);
 
 }  // namespace litgs::host

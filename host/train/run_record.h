@@ -1,6 +1,6 @@
 // What a training run reports and carries across a resume besides the model: its evaluations, its counters of
-// silent events (non-finite skips and culls, walks a driver cut short, prunes), and where it was resumed. Header
-// only and free of Vulkan, so that the checkpoint reader (and its fuzz target) can parse it.
+// silent events (non-finite skips and culls, walks a driver cut short, prunes), and where it was resumed.
+// Header only and free of Vulkan, so that the checkpoint reader (and its fuzz target) can parse it.
 #pragma once
 
 #include <array>
@@ -91,12 +91,9 @@ inline nlohmann::json to_json(const TrainingCounters& c) {
   nlohmann::json adam = nlohmann::json::object();
   for (uint32_t g = 0; g < kernels::kParamGroupCount; ++g)
     adam[kernels::kParamGroupNames[g]] = c.adam_nonfinite_skips[g];
-  return {{"adam_nonfinite_skips", adam},
-          {"culled_nonfinite", c.culled_nonfinite},
-          {"walks_cut_short", c.walks_cut_short},
-          {"pruned_nonfinite", c.pruned_nonfinite},
-          {"pruned_plane", c.pruned_plane},
-          {"densify_capped", c.densify_capped}};
+  return {{"adam_nonfinite_skips", adam},         {"culled_nonfinite", c.culled_nonfinite},
+          {"walks_cut_short", c.walks_cut_short}, {"pruned_nonfinite", c.pruned_nonfinite},
+          {"pruned_plane", c.pruned_plane},       {"densify_capped", c.densify_capped}};
 }
 inline TrainingCounters counters_from_json(const nlohmann::json& j) {
   TrainingCounters c;

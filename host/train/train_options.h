@@ -12,17 +12,17 @@ namespace litgs::host {
 
 struct TrainOptions {
   uint32_t iterations = 7000;
-  double lambda_geo = 0.6;         // L = (1 - lambda_geo) L_pho + lambda_geo L_geo (0: photometric only)
-  double lambda_ssim = 0.2;        // L_pho = (1 - lambda_ssim) L1 + lambda_ssim (1 - SSIM)
+  double lambda_geo = 0.6;   // L = (1 - lambda_geo) L_pho + lambda_geo L_geo (0: photometric only)
+  double lambda_ssim = 0.2;  // L_pho = (1 - lambda_ssim) L1 + lambda_ssim (1 - SSIM)
   // Scale s of the Cauchy kernel on the point-to-plane residual (kernels/loss/geometric_loss.h), metres; 0:
   // the plain square. Residuals well below s are squared as the method states; the ~1% of LiDAR targets that
-  // are not the surface a pixel sees (up to ~1 m off on the synthetic facade, yet half the squared loss's pull
-  // on a true render: tests/train/test_plane_targets_synthetic.cc) pull with a bounded force.
+  // are not the surface a pixel sees (up to ~1 m off on the synthetic facade, yet half the squared loss's
+  // pull on a true render: tests/train/test_plane_targets_synthetic.cc) pull with a bounded force.
   double geo_robust_scale_m = 0.05;
   // false: the LiDAR term's gradient moves Gaussians but leaves their opacity to the image
   // (kernels::RasterizerOptions::depth_gradient_to_opacity).
   bool geo_gradient_to_opacity = true;
-  uint32_t sh_degree = 3;          // final SH degree; the active degree rises by one every sh_degree_every
+  uint32_t sh_degree = 3;  // final SH degree; the active degree rises by one every sh_degree_every
   uint32_t sh_degree_every = 1000;
   // Adaptive density control (3DGS defaults, in iterations).
   uint32_t densify_from = 500;
@@ -37,27 +37,28 @@ struct TrainOptions {
   // The geometric outlier prune: Gaussians farther from their LiDAR plane than median + k 1.4826 MAD of all
   // such distances (at least 10 cm) are pruned at each refinement; 0 turns it off.
   double plane_prune_k = 5.0;
-  uint32_t max_gaussians = 2000000;        // cap of the model size (the budget of the MCMC strategy)
+  uint32_t max_gaussians = 2000000;  // cap of the model size (the budget of the MCMC strategy)
   // Densification strategy: "adc" (3DGS adaptive density control: clone, split, prune, opacity resets) or
   // "mcmc" (3DGS-MCMC: a fixed budget, relocation of dead Gaussians, position noise, regularizers; the same
   // window and cadence).
   std::string strategy = "adc";
-  float mcmc_growth = 0.05f;    // MCMC: rows added per refinement, as a fraction of the model
-  float mcmc_noise_lr = 5e5f;   // MCMC: position noise, times the means' learning rate
-  float mcmc_opacity_reg = 0.01f;  // MCMC: L1 weights, relative to the photometric loss (photometric_weight())
+  float mcmc_growth = 0.05f;   // MCMC: rows added per refinement, as a fraction of the model
+  float mcmc_noise_lr = 5e5f;  // MCMC: position noise, times the means' learning rate
+  float mcmc_opacity_reg =
+      0.01f;  // MCMC: L1 weights, relative to the photometric loss (photometric_weight())
   float mcmc_scale_reg = 0.01f;
-  float lr_scale = 1.0f;                   // multiplies every learning rate (stability tests, tuning)
+  float lr_scale = 1.0f;  // multiplies every learning rate (stability tests, tuning)
   // Evaluation, checkpoints, reproducibility.
-  uint32_t eval_every = 0;         // 0: only at the end
-  uint32_t checkpoint_every = 0;   // 0: none
-  bool resume = false;             // continue from the newest checkpoint in the output directory
-  bool deterministic = false;      // bit-identical gradients (slower)
-  uint32_t seed = 0;               // view order and densification noise
-  uint32_t progress_every = 50;    // log cadence when stdout is not a terminal
+  uint32_t eval_every = 0;        // 0: only at the end
+  uint32_t checkpoint_every = 0;  // 0: none
+  bool resume = false;            // continue from the newest checkpoint in the output directory
+  bool deterministic = false;     // bit-identical gradients (slower)
+  uint32_t seed = 0;              // view order and densification noise
+  uint32_t progress_every = 50;   // log cadence when stdout is not a terminal
   // point_cloud.ply in the scene's recentred frame (scene = original - world_offset_m, docs/scene-format.md)
   // instead of the original world frame. Training and checkpoints always use the scene frame.
   bool recentred_output = false;
-  void check() const;              // throws std::invalid_argument naming the bad field
+  void check() const;  // throws std::invalid_argument naming the bad field
   // The SH degree rendered after `iterations_done` iterations (the ramp: one more every sh_degree_every).
   uint32_t active_sh_degree(uint32_t iterations_done) const {
     return std::min(sh_degree, iterations_done / sh_degree_every);

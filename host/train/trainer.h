@@ -10,8 +10,8 @@
 // - With `deterministic`, a run interrupted after a checkpoint and resumed with the same options writes the
 //   same bits (point_cloud.ply, and metrics.json but for timings) as the run that was never interrupted.
 // - With float atomics (the default) the gradient sums' order varies run to run, so a resumed run is another
-//   sample of the same training, not the same bits: held-out PSNR within 0.5 dB of an uninterrupted run on the
-//   test scene (tests/gpu/test_train_resume.cc), the spread of two uninterrupted runs.
+//   sample of the same training, not the same bits: held-out PSNR within 0.5 dB of an uninterrupted run on
+//   the test scene (tests/gpu/test_train_resume.cc), the spread of two uninterrupted runs.
 // - metrics.json of a resumed run carries the evaluations, counters and resumes of the checkpoint's run.
 #pragma once
 
@@ -39,9 +39,9 @@ struct TrainReport {
   uint64_t peak_device_bytes = 0;
   EvalResult final_eval;
   std::vector<EvalResult> evals;
-  size_t nonfinite_pruned = 0;  // = counters.pruned_nonfinite
-  size_t plane_pruned = 0;      // = counters.pruned_plane: pruned for their distance to the LiDAR plane
-  TrainingCounters counters;    // over the whole run, resumed runs included
+  size_t nonfinite_pruned = 0;        // = counters.pruned_nonfinite
+  size_t plane_pruned = 0;            // = counters.pruned_plane: pruned for their distance to the LiDAR plane
+  TrainingCounters counters;          // over the whole run, resumed runs included
   std::vector<ResumeRecord> resumes;  // every resume of the run, oldest first
   uint32_t start_iteration = 0;       // where this call started (the checkpoint's iteration, or 0)
   std::vector<std::pair<std::string, double>> kernel_ms_per_iteration;  // GPU timestamps, training steps only
@@ -49,20 +49,20 @@ struct TrainReport {
 
 struct TrainProgress {
   uint32_t iteration, total;
-  double loss;      // last read back (every few iterations): (1 - lambda_geo) L_pho + lambda_geo L_geo
+  double loss;  // last read back (every few iterations): (1 - lambda_geo) L_pho + lambda_geo L_geo
   double photometric_loss;  // its L_pho
   double geometric_rms_m;   // sqrt(L_geo): the RMS point-to-plane residual over valid pixels (NaN: no term)
-  double psnr_db;   // last evaluation (or NaN)
+  double psnr_db;           // last evaluation (or NaN)
   size_t gaussians;
   double iterations_per_s;
   TrainingCounters counters;  // so far, over the whole run
 };
 
-// Trains `initial` (unused when resuming) on `data` and writes `out_dir/point_cloud.ply` (in the original world
-// frame, or the scene's with options.recentred_output: host/train/output_frame.h) and `out_dir/metrics.json`
-// (atomically). `planes` (optional) drives the geometric loss; without it lambda_geo must be 0.
-// `gt_planes` (optional): the scene's true planes, sampled as points with their plane's normal; evaluation
-// then also reports the RMSE of the rendered depth's point-to-plane residual against them.
+// Trains `initial` (unused when resuming) on `data` and writes `out_dir/point_cloud.ply` (in the original
+// world frame, or the scene's with options.recentred_output: host/train/output_frame.h) and
+// `out_dir/metrics.json` (atomically). `planes` (optional) drives the geometric loss; without it lambda_geo
+// must be 0. `gt_planes` (optional): the scene's true planes, sampled as points with their plane's normal;
+// evaluation then also reports the RMSE of the rendered depth's point-to-plane residual against them.
 // `notice` receives the resume's notes and warnings, one line each (default: std::cerr).
 TrainReport train(engine::Context& context, const TrainingData& data, const kernels::GaussianModel& initial,
                   const PlanarMap* planes, const TrainOptions& options, const std::filesystem::path& out_dir,

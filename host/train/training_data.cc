@@ -10,11 +10,13 @@
 namespace litgs::host {
 namespace {
 
-// T_world_cam of every frame: the pose at the frame's time in `poses` (matched, else interpolated), moved from
-// the IMU to the camera if the scene's poses describe the IMU.
-Eigen::Isometry3d pose_at(const io::Scene& scene, const std::vector<io::TumPose>& poses, double t, double tolerance) {
+// T_world_cam of every frame: the pose at the frame's time in `poses` (matched, else interpolated), moved
+// from the IMU to the camera if the scene's poses describe the IMU.
+Eigen::Isometry3d pose_at(const io::Scene& scene, const std::vector<io::TumPose>& poses, double t,
+                          double tolerance) {
   if (poses.empty()) throw std::invalid_argument("poses.txt has no poses");
-  auto it = std::lower_bound(poses.begin(), poses.end(), t, [](const io::TumPose& p, double x) { return p.t_s < x; });
+  auto it = std::lower_bound(poses.begin(), poses.end(), t,
+                             [](const io::TumPose& p, double x) { return p.t_s < x; });
   auto rotation_of = [&](const io::TumPose& p) {
     if (!p.has_rotation)
       throw std::invalid_argument("poses.txt: the pose at t = " + std::to_string(p.t_s) +
@@ -30,7 +32,8 @@ Eigen::Isometry3d pose_at(const io::Scene& scene, const std::vector<io::TumPose>
     T.translation() = exact->p_world;
   } else {
     if (it == poses.begin() || it == poses.end())
-      throw std::invalid_argument("frame at t = " + std::to_string(t) + " s lies outside the trajectory of poses.txt");
+      throw std::invalid_argument("frame at t = " + std::to_string(t) +
+                                  " s lies outside the trajectory of poses.txt");
     const io::TumPose& a = *std::prev(it);
     const io::TumPose& b = *it;
     const double s = (t - a.t_s) / (b.t_s - a.t_s);
@@ -58,18 +61,21 @@ Eigen::Vector2d distort(const io::CameraIntrinsics& k, double x, double y) {
   const double r2 = x * x + y * y;
   const double radial = 1 + r2 * (coef(0) + r2 * (coef(1) + r2 * coef(4)));
   const double p1 = coef(2), p2 = coef(3);
-  return {x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x), y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y};
+  return {x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
+          y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y};
 }
 
 // Bilinear sample at OpenCV pixel coordinates (pixel centres at integers); -1 outside the image.
 double sample(const std::vector<float>& img, int w, int h, double u, double v) {
   if (u < -0.5 || v < -0.5 || u > w - 0.5 || v > h - 0.5) return -1.0;
   const double uc = std::clamp(u, 0.0, w - 1.0), vc = std::clamp(v, 0.0, h - 1.0);
-  const int x0 = std::min(static_cast<int>(uc), w - 2 < 0 ? 0 : w - 2), y0 = std::min(static_cast<int>(vc), h - 2 < 0 ? 0 : h - 2);
+  const int x0 = std::min(static_cast<int>(uc), w - 2 < 0 ? 0 : w - 2),
+            y0 = std::min(static_cast<int>(vc), h - 2 < 0 ? 0 : h - 2);
   const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
   const double fx = uc - x0, fy = vc - y0;
   auto at = [&](int x, int y) { return static_cast<double>(img[static_cast<size_t>(y) * w + x]); };
-  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) +
+         fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
 }
 
 // The training resolution and its pinhole intrinsics (pixel centres at +0.5, the rasterizer's convention).
@@ -112,14 +118,15 @@ kernels::SplatCamera make_camera(const Eigen::Isometry3d& T_world_cam, const Pin
 const std::vector<io::TumPose>& training_poses(const std::filesystem::path& dir, const io::Scene& scene,
                                                bool true_poses) {
   if (true_poses && (!scene.gt || scene.gt->poses.empty()))
-    throw std::invalid_argument(dir.string() + ": training on true poses needs gt/poses.txt, which the scene lacks");
+    throw std::invalid_argument(dir.string() +
+                                ": training on true poses needs gt/poses.txt, which the scene lacks");
   return true_poses ? scene.gt->poses : scene.poses;
 }
 
 }  // namespace
 
-kernels::SplatCamera training_camera(const std::filesystem::path& scene_dir, const io::Scene& scene, double t_s,
-                                     const TrainingDataOptions& o) {
+kernels::SplatCamera training_camera(const std::filesystem::path& scene_dir, const io::Scene& scene,
+                                     double t_s, const TrainingDataOptions& o) {
   o.check();
   const std::vector<io::TumPose>& poses = training_poses(scene_dir, scene, o.true_poses);
   return make_camera(pose_at(scene, poses, t_s, o.pose_match_tolerance_s),
@@ -128,10 +135,12 @@ kernels::SplatCamera training_camera(const std::filesystem::path& scene_dir, con
 
 void TrainingDataOptions::check() const {
   if (!(downscale >= 1.0) || !std::isfinite(downscale))
-    throw std::invalid_argument("TrainingDataOptions.downscale = " + std::to_string(downscale) + " must be >= 1");
+    throw std::invalid_argument("TrainingDataOptions.downscale = " + std::to_string(downscale) +
+                                " must be >= 1");
   if (!(low_percentile >= 0 && low_percentile < high_percentile && high_percentile <= 100))
     throw std::invalid_argument("TrainingDataOptions: percentiles must satisfy 0 <= low < high <= 100");
-  if (!(frozen_threshold >= 0)) throw std::invalid_argument("TrainingDataOptions.frozen_threshold must be >= 0");
+  if (!(frozen_threshold >= 0))
+    throw std::invalid_argument("TrainingDataOptions.frozen_threshold must be >= 0");
 }
 
 TrainingData load_training_data(const std::filesystem::path& dir, const TrainingDataOptions& o) {

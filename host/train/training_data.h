@@ -19,10 +19,10 @@ enum class IntensityMapping {
 };
 
 struct TrainingDataOptions {
-  double downscale = 1.0;              // images and intrinsics divided by this (>= 1)
-  uint32_t holdout_every = 8;          // frames i with i % holdout_every == 0 are held out (0: none)
+  double downscale = 1.0;      // images and intrinsics divided by this (>= 1)
+  uint32_t holdout_every = 8;  // frames i with i % holdout_every == 0 are held out (0: none)
   IntensityMapping mapping = IntensityMapping::kAuto;
-  double low_percentile = 0.5;         // of all frames' raw values together, not per frame
+  double low_percentile = 0.5;  // of all frames' raw values together, not per frame
   double high_percentile = 99.5;
   // Frames whose mean absolute difference to the previous kept frame is below this fraction of the
   // stretch range are frozen by the camera's non-uniformity correction and skipped.
@@ -37,19 +37,20 @@ struct TrainingDataOptions {
 };
 
 struct TrainingView {
-  std::string name;              // the frame's file name
+  std::string name;  // the frame's file name
   double t_s = 0;
-  kernels::SplatCamera camera;   // pinhole, undistorted, at the training resolution
-  std::vector<float> image;      // [H][W] target in [0, 1]
+  kernels::SplatCamera camera;  // pinhole, undistorted, at the training resolution
+  std::vector<float> image;     // [H][W] target in [0, 1]
   bool heldout = false;
 };
 
 struct TrainingData {
-  TrainingDataOptions options;  // what load_training_data was given (stored in checkpoints, compared on resume)
+  TrainingDataOptions
+      options;  // what load_training_data was given (stored in checkpoints, compared on resume)
   std::vector<TrainingView> views;
-  double stretch_low = 0, stretch_high = 1;  // raw values mapped to 0 and 1
+  double stretch_low = 0, stretch_high = 1;                  // raw values mapped to 0 and 1
   Eigen::Vector3d world_offset_m = Eigen::Vector3d::Zero();  // scene world = original world - offset
-  double scene_extent_m = 1;   // 1.1 x the largest camera-centre distance from their mean (3DGS)
+  double scene_extent_m = 1;  // 1.1 x the largest camera-centre distance from their mean (3DGS)
   size_t frozen_skipped = 0;
   uint32_t width = 0, height = 0;  // training resolution
 };
@@ -63,7 +64,7 @@ TrainingData load_training_data(const std::filesystem::path& scene_dir, const Tr
 // within pose_match_tolerance_s or interpolated and moved from the IMU to the camera where the poses are the
 // IMU's; the undistorted pinhole intrinsics at the training resolution (options.downscale). Throws
 // std::invalid_argument for a time outside the trajectory.
-kernels::SplatCamera training_camera(const std::filesystem::path& scene_dir, const io::Scene& scene, double t_s,
-                                     const TrainingDataOptions& options);
+kernels::SplatCamera training_camera(const std::filesystem::path& scene_dir, const io::Scene& scene,
+                                     double t_s, const TrainingDataOptions& options);
 
 }  // namespace litgs::host

@@ -108,7 +108,8 @@ void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy
   for (const auto& k : s.profile()) times[k.name] += k.ms;
   const std::vector<uint32_t> c = render_counters_.download();  // host-visible: written by this submit
   counters.culled_nonfinite += c[SPLAT_COUNTER_CULLED_NONFINITE];
-  const uint64_t walks_cut = uint64_t{c[SPLAT_COUNTER_FORWARD_WALKS_CUT]} + c[SPLAT_COUNTER_BACKWARD_WALKS_CUT];
+  const uint64_t walks_cut =
+      uint64_t{c[SPLAT_COUNTER_FORWARD_WALKS_CUT]} + c[SPLAT_COUNTER_BACKWARD_WALKS_CUT];
   counters.walks_cut_short += walks_cut - walks_cut_seen_;
   walks_cut_seen_ = walks_cut;
 }

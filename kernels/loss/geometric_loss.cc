@@ -13,7 +13,8 @@ namespace litgs::kernels {
 using engine::Access;
 
 GeometricLoss::GeometricLoss(engine::Context& context) : context_(&context), sum_(context) {
-  kernel_ = loss_detail::make_kernel(context, "loss/geometric", GEOMETRIC_BINDING_COUNT, sizeof(GeometricParams));
+  kernel_ =
+      loss_detail::make_kernel(context, "loss/geometric", GEOMETRIC_BINDING_COUNT, sizeof(GeometricParams));
 }
 
 GeometricLoss::~GeometricLoss() = default;
@@ -71,7 +72,8 @@ void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& dep
   p.cy = cy;
   p.inv_valid = valid_count > 0 ? static_cast<float>(1.0 / valid_count) : 0.0f;
   p.weight = weight;
-  p.inv_scale2 = robust_scale_m > 0 ? static_cast<float>(1.0 / (double{robust_scale_m} * robust_scale_m)) : 0.0f;
+  p.inv_scale2 =
+      robust_scale_m > 0 ? static_cast<float>(1.0 / (double{robust_scale_m} * robust_scale_m)) : 0.0f;
   sequence.dispatch(*kernel_, groups,
                     {{GEOMETRIC_BINDING_DEPTH, &depth, Access::kRead},
                      {GEOMETRIC_BINDING_POINTS, &points, Access::kRead},

@@ -50,8 +50,8 @@ class GeometricLoss {
   // Intrinsics in pixels; pixel (u, v) has its centre at (u + 0.5, v + 0.5). Scratch as PhotometricLoss.
   void record(engine::Sequence& sequence, const engine::Buffer& depth, const engine::Buffer& points,
               const engine::Buffer& normals, uint32_t width, uint32_t height, float fx, float fy, float cx,
-              float cy, uint32_t valid_count, float weight, float robust_scale_m, const engine::Buffer& grad_depth,
-              const engine::Buffer& loss_out, uint32_t loss_slot);
+              float cy, uint32_t valid_count, float weight, float robust_scale_m,
+              const engine::Buffer& grad_depth, const engine::Buffer& loss_out, uint32_t loss_slot);
 
   // N_valid of a point map [H][W][4]: pixels whose valid flag (element 3) is above 0.5.
   static uint32_t count_valid(std::span<const float> points);

@@ -118,8 +118,8 @@ PhotometricLossResult photometric_loss_reference(std::span<const double> image,
 
 GeometricLossResult geometric_loss_reference(std::span<const double> depth, std::span<const float> points,
                                              std::span<const float> normals, uint32_t width, uint32_t height,
-                                             double fx, double fy, double cx, double cy,
-                                             uint32_t valid_count, double robust_scale_m) {
+                                             double fx, double fy, double cx, double cy, uint32_t valid_count,
+                                             double robust_scale_m) {
   static const char* who = "geometric_loss_reference";
   const size_t n = size_t{width} * height;
   check_size(who, "depth", depth.size(), n);

@@ -35,8 +35,8 @@ struct GeometricLossResult {
 // the Cauchy kernel's s (0: squares), as geometric_loss.h.
 GeometricLossResult geometric_loss_reference(std::span<const double> depth, std::span<const float> points,
                                              std::span<const float> normals, uint32_t width, uint32_t height,
-                                             double fx, double fy, double cx, double cy,
-                                             uint32_t valid_count, double robust_scale_m = 0.0);
+                                             double fx, double fy, double cx, double cy, uint32_t valid_count,
+                                             double robust_scale_m = 0.0);
 
 // Mean SSIM over all pixels and channels (3DGS's ssim(), as the photometric loss), in double.
 double ssim_reference(std::span<const float> image, std::span<const float> target, uint32_t channels,

@@ -11,8 +11,8 @@
 #include "engine/context.h"
 #include "engine/kernel.h"
 #include "engine/sequence.h"
-#include "kernels/subgroup_kernel.h"
 #include "kernels/loss/loss_shared.h"
+#include "kernels/subgroup_kernel.h"
 
 namespace litgs::kernels::loss_detail {
 

@@ -25,10 +25,14 @@ PhotometricLoss::PhotometricLoss(engine::Context& context, uint32_t channels, Ph
   if (channels < 1 || channels > SPLAT_MAX_CHANNELS)
     throw std::invalid_argument("PhotometricLoss: channels = " + std::to_string(channels) + ", must be 1.." +
                                 std::to_string(SPLAT_MAX_CHANNELS));
-  moments_ = loss_detail::make_kernel(context, "loss/ssim_moments_h", SSIM_MOMENTS_BINDING_COUNT, sizeof(PhotometricParams));
-  pixel_ = loss_detail::make_kernel(context, "loss/ssim_pixel", SSIM_PIXEL_BINDING_COUNT, sizeof(PhotometricParams));
-  partials_h_ = loss_detail::make_kernel(context, "loss/ssim_partials_h", SSIM_PARTIALS_BINDING_COUNT, sizeof(PhotometricParams));
-  backward_ = loss_detail::make_kernel(context, "loss/ssim_backward", SSIM_BACKWARD_BINDING_COUNT, sizeof(PhotometricParams));
+  moments_ = loss_detail::make_kernel(context, "loss/ssim_moments_h", SSIM_MOMENTS_BINDING_COUNT,
+                                      sizeof(PhotometricParams));
+  pixel_ = loss_detail::make_kernel(context, "loss/ssim_pixel", SSIM_PIXEL_BINDING_COUNT,
+                                    sizeof(PhotometricParams));
+  partials_h_ = loss_detail::make_kernel(context, "loss/ssim_partials_h", SSIM_PARTIALS_BINDING_COUNT,
+                                         sizeof(PhotometricParams));
+  backward_ = loss_detail::make_kernel(context, "loss/ssim_backward", SSIM_BACKWARD_BINDING_COUNT,
+                                       sizeof(PhotometricParams));
 }
 
 PhotometricLoss::~PhotometricLoss() = default;

@@ -23,7 +23,9 @@ void require(bool ok, const char* field, double value, const char* rule) {
                                 rule);
 }
 
-float logit(double p) { return static_cast<float>(std::log(p / (1.0 - p))); }
+float logit(double p) {
+  return static_cast<float>(std::log(p / (1.0 - p)));
+}
 
 }  // namespace
 
@@ -33,7 +35,8 @@ void McmcOptions::check() const {
   require(growth >= 0 && std::isfinite(growth), "growth", growth, "must be finite and >= 0");
   require(min_opacity > 0 && min_opacity < 1, "min_opacity", min_opacity, "must be in (0, 1)");
   require(noise_lr >= 0 && std::isfinite(noise_lr), "noise_lr", noise_lr, "must be finite and >= 0");
-  require(opacity_reg >= 0 && std::isfinite(opacity_reg), "opacity_reg", opacity_reg, "must be finite and >= 0");
+  require(opacity_reg >= 0 && std::isfinite(opacity_reg), "opacity_reg", opacity_reg,
+          "must be finite and >= 0");
   require(scale_reg >= 0 && std::isfinite(scale_reg), "scale_reg", scale_reg, "must be finite and >= 0");
   require(!std::isnan(max_plane_distance_m) && max_plane_distance_m >= 0, "max_plane_distance_m",
           max_plane_distance_m, "must be >= 0 (infinity: off)");
@@ -50,7 +53,8 @@ McmcStrategy::McmcStrategy(engine::Context& context) : context_(&context), scan_
   weights_ = make_kernel(context, "mcmc/mcmc_weights", WEIGHTS_BINDING_COUNT, sizeof(McmcParams));
   list_dead_ = make_kernel(context, "mcmc/mcmc_list_dead", LIST_BINDING_COUNT, sizeof(McmcParams));
   sample_ = make_kernel(context, "mcmc/mcmc_sample", SAMPLE_BINDING_COUNT, sizeof(McmcParams));
-  update_sources_ = make_kernel(context, "mcmc/mcmc_update_sources", UPDATE_BINDING_COUNT, sizeof(McmcParams));
+  update_sources_ =
+      make_kernel(context, "mcmc/mcmc_update_sources", UPDATE_BINDING_COUNT, sizeof(McmcParams));
   copy_rows_ = make_kernel(context, "mcmc/mcmc_copy_rows", COPY_BINDING_COUNT, sizeof(CopyRowsParams));
   noise_ = make_kernel(context, "mcmc/mcmc_noise", NOISE_BINDING_COUNT, sizeof(McmcParams));
   regularize_ = make_kernel(context, "mcmc/mcmc_regularize", REG_BINDING_COUNT, sizeof(McmcParams));
@@ -60,8 +64,8 @@ McmcStrategy::McmcStrategy(engine::Context& context) : context_(&context), scan_
 
 McmcStrategy::~McmcStrategy() = default;
 
-McmcReport McmcStrategy::relocate_and_grow(TrainableGaussians& model, const McmcOptions& options, uint32_t step,
-                                           const engine::Buffer* plane_distance) {
+McmcReport McmcStrategy::relocate_and_grow(TrainableGaussians& model, const McmcOptions& options,
+                                           uint32_t step, const engine::Buffer* plane_distance) {
   options.check();
   engine::Context& ctx = *context_;
   const uint32_t n = static_cast<uint32_t>(model.size());
@@ -98,7 +102,8 @@ McmcReport McmcStrategy::relocate_and_grow(TrainableGaussians& model, const Mcmc
                 {WEIGHTS_BINDING_MEANS, &g.means.buffer(), Access::kRead},
                 {WEIGHTS_BINDING_QUATS, &g.quats.buffer(), Access::kRead},
                 {WEIGHTS_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kRead},
-                {WEIGHTS_BINDING_PLANE_DISTANCE, plane_distance ? plane_distance : &no_plane_->buffer(), Access::kRead},
+                {WEIGHTS_BINDING_PLANE_DISTANCE, plane_distance ? plane_distance : &no_plane_->buffer(),
+                 Access::kRead},
                 {WEIGHTS_BINDING_WEIGHT, &weight_->buffer(), Access::kWrite},
                 {WEIGHTS_BINDING_DEAD, &dead_->buffer(), Access::kWrite},
                 {WEIGHTS_BINDING_REPORT, &report_->buffer(), Access::kReadWrite}},
@@ -125,7 +130,8 @@ McmcReport McmcStrategy::relocate_and_grow(TrainableGaussians& model, const Mcmc
                            report.to_string() + ")");
   if (total_weight == 0) return report;  // nothing alive to draw from: leave the model as it is
 
-  const uint64_t wanted = static_cast<uint64_t>(std::floor(static_cast<double>(n) * (1.0 + double{options.growth})));
+  const uint64_t wanted =
+      static_cast<uint64_t>(std::floor(static_cast<double>(n) * (1.0 + double{options.growth})));
   const uint32_t target_rows = static_cast<uint32_t>(std::min<uint64_t>(options.max_gaussians, wanted));
   const uint32_t added = target_rows > n ? target_rows - n : 0u;
   const uint32_t targets = dead + added;
@@ -173,7 +179,8 @@ McmcReport McmcStrategy::relocate_and_grow(TrainableGaussians& model, const Mcmc
       copy_rows(*a.buffer, a.stride, COPY_MODE_SOURCE_TO_TARGET);
     } else {
       copy_rows(*a.buffer, a.stride, COPY_MODE_ZERO_TARGET);
-      if (a.kind == TrainableGaussians::RowArray::kMoment) copy_rows(*a.buffer, a.stride, COPY_MODE_ZERO_SOURCE);
+      if (a.kind == TrainableGaussians::RowArray::kMoment)
+        copy_rows(*a.buffer, a.stride, COPY_MODE_ZERO_SOURCE);
     }
   }
   s.submit_and_wait();
@@ -193,7 +200,8 @@ McmcStrategy::Draws McmcStrategy::last_draws() const {
 }
 
 void McmcStrategy::record_regularization(engine::Sequence& sequence, const TrainableGaussians& model,
-                                         const Rasterizer::DeviceGrads& grads, const McmcOptions& options) const {
+                                         const Rasterizer::DeviceGrads& grads,
+                                         const McmcOptions& options) const {
   const uint32_t n = static_cast<uint32_t>(model.size());
   if (n == 0 || (options.opacity_reg == 0 && options.scale_reg == 0)) return;
   if (!grads.opacity_logits || !grads.log_scales)

@@ -80,11 +80,12 @@ class McmcStrategy {
  private:
   engine::Context* context_;
   ExclusiveScan scan_;
-  std::unique_ptr<engine::Kernel> weights_, list_dead_, sample_, update_sources_, copy_rows_, noise_, regularize_;
+  std::unique_ptr<engine::Kernel> weights_, list_dead_, sample_, update_sources_, copy_rows_, noise_,
+      regularize_;
   // Scratch, grown geometrically: [N] weight, cdf, dead, dead rank, copies; [targets] dead index, source,
   // target; the report.
-  std::unique_ptr<engine::DeviceArray<uint32_t>> weight_, cdf_, dead_, dead_rank_, copies_, dead_index_, source_,
-      target_, report_;
+  std::unique_ptr<engine::DeviceArray<uint32_t>> weight_, cdf_, dead_, dead_rank_, copies_, dead_index_,
+      source_, target_, report_;
   std::unique_ptr<engine::DeviceArray<float>> no_plane_;
   uint32_t last_targets_ = 0;
 };

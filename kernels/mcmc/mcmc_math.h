@@ -36,8 +36,8 @@ MM_FN real relocated_opacity(real o, uint n) {
 
 // 3DGS-MCMC's normalizer sum_{i=1..n} sum_{k=0..i-1} C(i-1,k) (-1)^k x^(k+1) / sqrt(k+1). That alternating
 // sum cancels (at n = 51 its terms grow to ~1e5 for a result of about 2: float keeps four digits), so it is
-// evaluated in its equivalent positive form (1/sqrt(k+1) = pi^-1/2 int t^-1/2 e^-(k+1)t dt, then the binomial and
-// geometric sums close, and t = s^2):
+// evaluated in its equivalent positive form (1/sqrt(k+1) = pi^-1/2 int t^-1/2 e^-(k+1)t dt, then the binomial
+// and geometric sums close, and t = s^2):
 //     (2 / sqrt(pi)) int_0^inf [1 - (1 - x e^(-s^2))^n] ds,
 // whose integrand is smooth, in [0, 1] and even in s: the trapezoid rule with step h is spectrally accurate
 // (n = 1 gives x exactly). `steps` points past s = 0 cover [0, steps h]; beyond s = 6 the integrand is below
@@ -52,8 +52,8 @@ MM_FN real stacked_opacity_integral(real x, uint n, real h, uint steps) {
 }
 
 // The change of every log-scale of a Gaussian of opacity o relocated into n copies of opacity o_new:
-// log(o / stacked_opacity_integral(o_new, n)), so that the copies' summed opacity profile keeps the original's
-// peak (3DGS-MCMC eq. 9).
+// log(o / stacked_opacity_integral(o_new, n)), so that the copies' summed opacity profile keeps the
+// original's peak (3DGS-MCMC eq. 9).
 MM_FN real relocation_log_scale_delta(real o, real o_new, uint n) {
   return log(o / stacked_opacity_integral(o_new, n, real(0.1), 60u));
 }

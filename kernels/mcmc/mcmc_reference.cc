@@ -10,7 +10,9 @@ namespace litgs::kernels {
 
 namespace {
 
-double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
+double sigmoid(double x) {
+  return 1.0 / (1.0 + std::exp(-x));
+}
 
 bool finite_row(const GaussianModel& m, size_t i) {
   for (int k = 0; k < 3; ++k)
@@ -27,7 +29,8 @@ double mcmc_normalizer_alternating(double x, uint32_t n) {
   for (uint32_t i = 1; i <= n; ++i) {
     long double binom = 1;  // C(i-1, k)
     for (uint32_t k = 0; k < i; ++k) {
-      const long double term = binom * std::pow(static_cast<long double>(x), k + 1) / std::sqrt((long double)(k + 1));
+      const long double term =
+          binom * std::pow(static_cast<long double>(x), k + 1) / std::sqrt((long double)(k + 1));
       sum += (k % 2 == 0) ? term : -term;
       binom = binom * (i - 1 - k) / (k + 1);
     }
@@ -77,7 +80,8 @@ TrainingState mcmc_relocate_reference(const TrainingState& in, const std::vector
     const double delta = std::log(o / mcmc_normalizer_reference(o_new, n));
     const double clamped = std::clamp(o_new, double{options.min_opacity}, 1.0 - 1.0 / 8388608.0);
     m.opacity_logits[i] = static_cast<float>(std::log(clamped / (1.0 - clamped)));
-    for (int k = 0; k < 3; ++k) m.log_scales[3 * i + k] = static_cast<float>(in.model.log_scales[3 * i + k] + delta);
+    for (int k = 0; k < 3; ++k)
+      m.log_scales[3 * i + k] = static_cast<float>(in.model.log_scales[3 * i + k] + delta);
   }
   const size_t sv = m.sh.size() / std::max<size_t>(m.size(), 1);
   for (size_t t = 0; t < source.size(); ++t) {
@@ -95,18 +99,20 @@ TrainingState mcmc_relocate_reference(const TrainingState& in, const std::vector
     const size_t width = out.exp_avg[g].size() / std::max<size_t>(m.size(), 1);
     for (size_t t = 0; t < source.size(); ++t)
       for (size_t row : {size_t{source[t]}, size_t{target[t]}})
-        for (size_t k = 0; k < width; ++k) out.exp_avg[g][row * width + k] = out.exp_avg_sq[g][row * width + k] = 0;
+        for (size_t k = 0; k < width; ++k)
+          out.exp_avg[g][row * width + k] = out.exp_avg_sq[g][row * width + k] = 0;
   }
   return out;
 }
 
-std::vector<double> mcmc_noise_reference(const GaussianModel& model, const McmcOptions& options, float means_lr,
-                                         uint32_t step) {
+std::vector<double> mcmc_noise_reference(const GaussianModel& model, const McmcOptions& options,
+                                         float means_lr, uint32_t step) {
   std::vector<double> means(model.means.begin(), model.means.end());
   const double scale = double{means_lr} * options.noise_lr;
   for (size_t i = 0; i < model.size(); ++i) {
     const glm::dvec3 ls(model.log_scales[3 * i], model.log_scales[3 * i + 1], model.log_scales[3 * i + 2]);
-    const glm::dvec4 q(model.quats[4 * i], model.quats[4 * i + 1], model.quats[4 * i + 2], model.quats[4 * i + 3]);
+    const glm::dvec4 q(model.quats[4 * i], model.quats[4 * i + 1], model.quats[4 * i + 2],
+                       model.quats[4 * i + 3]);
     const glm::dvec3 offset = splat_math::covariance_world(ls, q) *
                               mcmc_math::noise_normals(options.seed, step, static_cast<uint32_t>(i)) *
                               (mcmc_math::noise_gate(model.opacity_logits[i]) * scale);
@@ -125,7 +131,8 @@ void mcmc_regularization_reference(const GaussianModel& model, const McmcOptions
     const double o = sigmoid(model.opacity_logits[i]);
     grad_opacity[i] = options.opacity_reg / n * o * (1.0 - o);
     for (int k = 0; k < 3; ++k)
-      grad_log_scales[3 * i + k] = options.scale_reg / (3.0 * n) * std::exp(std::min<double>(model.log_scales[3 * i + k], 20.0));
+      grad_log_scales[3 * i + k] =
+          options.scale_reg / (3.0 * n) * std::exp(std::min<double>(model.log_scales[3 * i + k], 20.0));
   }
 }
 

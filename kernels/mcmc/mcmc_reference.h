@@ -30,8 +30,8 @@ uint32_t mcmc_draw_reference(const std::vector<uint32_t>& cdf, uint32_t total, u
 TrainingState mcmc_relocate_reference(const TrainingState& in, const std::vector<uint32_t>& source,
                                       const std::vector<uint32_t>& target, const McmcOptions& options);
 // Means after one noise step.
-std::vector<double> mcmc_noise_reference(const GaussianModel& model, const McmcOptions& options, float means_lr,
-                                         uint32_t step);
+std::vector<double> mcmc_noise_reference(const GaussianModel& model, const McmcOptions& options,
+                                         float means_lr, uint32_t step);
 // The regularizers' gradients w.r.t. the opacity logits ([N]) and log-scales ([N][3]).
 void mcmc_regularization_reference(const GaussianModel& model, const McmcOptions& options,
                                    std::vector<double>& grad_opacity, std::vector<double>& grad_log_scales);

@@ -51,7 +51,7 @@ using uint = uint32_t;
 #define SAMPLE_BINDING_COUNT 5
 
 // ---- mcmc_update_sources.comp (push constants: McmcParams) ----
-#define UPDATE_BINDING_COPIES 0         // [N]
+#define UPDATE_BINDING_COPIES 0          // [N]
 #define UPDATE_BINDING_OPACITY_LOGITS 1  // [N] updated in place
 #define UPDATE_BINDING_LOG_SCALES 2      // [N][3] updated in place
 #define UPDATE_BINDING_COUNT 3
@@ -73,9 +73,9 @@ using uint = uint32_t;
 #define NOISE_BINDING_COUNT 4
 
 // ---- mcmc_regularize.comp (push constants: McmcParams) ----
-#define REG_BINDING_OPACITY_LOGITS 0  // [N]
-#define REG_BINDING_LOG_SCALES 1      // [N][3]
-#define REG_BINDING_GRAD_OPACITY 2    // [N] += opacity_reg / N * o (1 - o)
+#define REG_BINDING_OPACITY_LOGITS 0   // [N]
+#define REG_BINDING_LOG_SCALES 1       // [N][3]
+#define REG_BINDING_GRAD_OPACITY 2     // [N] += opacity_reg / N * o (1 - o)
 #define REG_BINDING_GRAD_LOG_SCALES 3  // [N][3] += scale_reg / (3N) * exp(log_scale)
 #define REG_BINDING_COUNT 4
 
@@ -88,17 +88,17 @@ using uint = uint32_t;
 #define MCMC_REPORT_DEAD_PLANE 2
 #define MCMC_REPORT_LAST_DEAD_RANK 3  // copied: dead_rank[N-1]; + dead[N-1] = dead rows
 #define MCMC_REPORT_LAST_DEAD 4
-#define MCMC_REPORT_LAST_CDF 5        // copied: cdf[N-1]; + weight[N-1] = total weight
+#define MCMC_REPORT_LAST_CDF 5  // copied: cdf[N-1]; + weight[N-1] = total weight
 #define MCMC_REPORT_LAST_WEIGHT 6
 #define MCMC_REPORT_SLOTS 8
 
 struct McmcParams {
-  uint count;                // N (rows in use)
-  uint dead;                 // sample: dead rows (targets t < dead overwrite dead_index[t])
-  uint targets;              // sample: dead + added rows
-  uint total_weight;         // sample: the sum of the weights (> 0)
-  uint flags;                // MCMC_FLAG_*
-  uint seed;                 // sampling and noise: hash(seed, step, index)
+  uint count;         // N (rows in use)
+  uint dead;          // sample: dead rows (targets t < dead overwrite dead_index[t])
+  uint targets;       // sample: dead + added rows
+  uint total_weight;  // sample: the sum of the weights (> 0)
+  uint flags;         // MCMC_FLAG_*
+  uint seed;          // sampling and noise: hash(seed, step, index)
   uint step;
   float min_opacity_logit;   // dead below this
   float max_plane_distance;  // dead beyond this (metres; NaN never)

@@ -76,11 +76,15 @@ TrainableGaussians::TrainableGaussians(engine::Context& context, const TrainingS
   adam_options_.check();
   state.check();
   stats_ = make_kernel(context, "densify/densify_stats", STATS_BINDING_COUNT, sizeof(SplatView));
-  candidates_ = make_kernel(context, "densify/densify_candidates", DECIDE_BINDING_COUNT, sizeof(DensifyParams));
+  candidates_ =
+      make_kernel(context, "densify/densify_candidates", DECIDE_BINDING_COUNT, sizeof(DensifyParams));
   decide_ = make_kernel(context, "densify/densify_decide", DECIDE_BINDING_COUNT, sizeof(DensifyParams));
-  scatter_rows_ = make_kernel(context, "densify/densify_scatter_rows", SCATTER_BINDING_COUNT, sizeof(ScatterParams));
-  scatter_geometry_ = make_kernel(context, "densify/densify_scatter_geometry", GEOMETRY_BINDING_COUNT, sizeof(ScatterParams));
-  reset_opacity_ = make_kernel(context, "densify/densify_reset_opacity", RESET_BINDING_COUNT, sizeof(ResetOpacityParams));
+  scatter_rows_ =
+      make_kernel(context, "densify/densify_scatter_rows", SCATTER_BINDING_COUNT, sizeof(ScatterParams));
+  scatter_geometry_ =
+      make_kernel(context, "densify/densify_scatter_geometry", GEOMETRY_BINDING_COUNT, sizeof(ScatterParams));
+  reset_opacity_ =
+      make_kernel(context, "densify/densify_reset_opacity", RESET_BINDING_COUNT, sizeof(ResetOpacityParams));
   adam_counters_ =
       std::make_unique<DeviceArray<uint32_t>>(context, "optim: adam counters", ADAM_COUNTER_SLOTS);
   adam_counters_->upload(std::vector<uint32_t>(ADAM_COUNTER_SLOTS, 0u));
@@ -374,7 +378,8 @@ void TrainableGaussians::grow_rows(size_t rows, size_t capacity_cap) {
     std::swap(current_, spare_);
     const std::vector<RowArray> to = row_arrays();
     engine::Sequence copy(*context_);
-    for (size_t a = 0; a < from.size(); ++a) copy.copy(*from[a].buffer, *to[a].buffer, uint64_t{n} * from[a].stride * 4);
+    for (size_t a = 0; a < from.size(); ++a)
+      copy.copy(*from[a].buffer, *to[a].buffer, uint64_t{n} * from[a].stride * 4);
     copy.submit_and_wait();
   }
   engine::Sequence zero(*context_);

@@ -16,10 +16,12 @@ using engine::Access;
 void ScanOptions::check(uint32_t subgroup_size) const {
   if (block_size != 0 && (block_size % subgroup_size != 0))
     throw std::invalid_argument("ScanOptions.block_size = " + std::to_string(block_size) +
-                                " must be 0 or a multiple of the subgroup size " + std::to_string(subgroup_size));
+                                " must be 0 or a multiple of the subgroup size " +
+                                std::to_string(subgroup_size));
   if (block_size / subgroup_size > MAX_BATCHES_PER_WORKGROUP)
     throw std::invalid_argument("ScanOptions.block_size = " + std::to_string(block_size) + " exceeds " +
-                                std::to_string(MAX_BATCHES_PER_WORKGROUP) + " subgroup-wide batches per workgroup");
+                                std::to_string(MAX_BATCHES_PER_WORKGROUP) +
+                                " subgroup-wide batches per workgroup");
 }
 
 ExclusiveScan::ExclusiveScan(engine::Context& context, ScanOptions options)
@@ -28,7 +30,8 @@ ExclusiveScan::ExclusiveScan(engine::Context& context, ScanOptions options)
   options.check(width);
   block_size_ = options.block_size != 0 ? options.block_size : width * 256;
   reduce_ = make_subgroup_kernel(context, "scan/scan_reduce", SCAN_REDUCE_BINDING_COUNT, sizeof(ScanParams));
-  downsweep_ = make_subgroup_kernel(context, "scan/scan_downsweep", SCAN_DOWNSWEEP_BINDING_COUNT, sizeof(ScanParams));
+  downsweep_ =
+      make_subgroup_kernel(context, "scan/scan_downsweep", SCAN_DOWNSWEEP_BINDING_COUNT, sizeof(ScanParams));
 }
 
 ExclusiveScan::~ExclusiveScan() = default;

@@ -39,8 +39,9 @@ class ExclusiveScan {
   std::unique_ptr<engine::Kernel> reduce_;
   std::unique_ptr<engine::Kernel> downsweep_;
   std::vector<std::unique_ptr<engine::DeviceArray<uint32_t>>> block_sums_;  // [levels], stable addresses
-  std::vector<std::unique_ptr<engine::DeviceArray<uint32_t>>> retired_;     // outgrown, kept for recorded sequences
-  engine::DeviceArray<uint32_t> unused_offsets_;          // bound where a kernel ignores its offsets
+  std::vector<std::unique_ptr<engine::DeviceArray<uint32_t>>>
+      retired_;                                   // outgrown, kept for recorded sequences
+  engine::DeviceArray<uint32_t> unused_offsets_;  // bound where a kernel ignores its offsets
 };
 
 }  // namespace litgs::kernels

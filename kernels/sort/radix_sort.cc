@@ -26,8 +26,10 @@ RadixSort::RadixSort(engine::Context& context, RadixSortOptions options)
     : context_(&context), options_(options), width_(subgroup_width(context)), scan_(context) {
   options_.check();
   if (options_.max_blocks == 0) options_.max_blocks = context.info().type == "cpu" ? 64 : 2048;
-  histogram_ = make_subgroup_kernel(context, "sort/radix_histogram", RADIX_HISTOGRAM_BINDING_COUNT, sizeof(RadixPassParams));
-  scatter_ = make_subgroup_kernel(context, "sort/radix_scatter", RADIX_SCATTER_BINDING_COUNT, sizeof(RadixPassParams));
+  histogram_ = make_subgroup_kernel(context, "sort/radix_histogram", RADIX_HISTOGRAM_BINDING_COUNT,
+                                    sizeof(RadixPassParams));
+  scatter_ = make_subgroup_kernel(context, "sort/radix_scatter", RADIX_SCATTER_BINDING_COUNT,
+                                  sizeof(RadixPassParams));
 }
 
 RadixSort::~RadixSort() = default;
@@ -48,7 +50,8 @@ void RadixSort::reserve(uint32_t count, uint32_t blocks) {
   // Outgrown scratch is retired, not freed, while a recorded sequence may use it: kept alive.
   grow(*context_, keys_tmp_, count, "radix sort: keys scratch", &retired_);
   grow(*context_, values_tmp_, count, "radix sort: values scratch", &retired_);
-  grow(*context_, counts_, static_cast<size_t>(RADIX_BUCKETS) * blocks, "radix sort: digit counts", &retired_);
+  grow(*context_, counts_, static_cast<size_t>(RADIX_BUCKETS) * blocks, "radix sort: digit counts",
+       &retired_);
 }
 
 void RadixSort::record(engine::Sequence& sequence, const engine::DeviceArray<uint32_t>& keys,

@@ -51,9 +51,9 @@ class RadixSort {
   std::unique_ptr<engine::Kernel> histogram_;
   std::unique_ptr<engine::Kernel> scatter_;
   ExclusiveScan scan_;
-  std::unique_ptr<engine::DeviceArray<uint32_t>> keys_tmp_;    // [capacity]
-  std::unique_ptr<engine::DeviceArray<uint32_t>> values_tmp_;  // [capacity]
-  std::unique_ptr<engine::DeviceArray<uint32_t>> counts_;      // [RADIX_BUCKETS][block_count]
+  std::unique_ptr<engine::DeviceArray<uint32_t>> keys_tmp_;              // [capacity]
+  std::unique_ptr<engine::DeviceArray<uint32_t>> values_tmp_;            // [capacity]
+  std::unique_ptr<engine::DeviceArray<uint32_t>> counts_;                // [RADIX_BUCKETS][block_count]
   std::vector<std::unique_ptr<engine::DeviceArray<uint32_t>>> retired_;  // outgrown scratch
 };
 

@@ -23,19 +23,25 @@ namespace {
 // the loop structure of the kernels (rasterize_forward.comp, rasterize_backward.glsl): the chunk loop, the
 // colour load, the four ballot words and their entries, and per entry the butterfly sum (log2 S steps), the
 // atomic adds (compare-and-swap loops) or the deterministic mode's sum over the workgroup's subgroups.
-uint32_t log2_ceil(uint32_t v) { return static_cast<uint32_t>(std::bit_width(std::max(v, 1u) - 1)); }
+uint32_t log2_ceil(uint32_t v) {
+  return static_cast<uint32_t>(std::bit_width(std::max(v, 1u) - 1));
+}
 
-uint32_t forward_loops_per_chunk(uint32_t S, uint32_t C) { return 1 + (C + 1) + 5 + (S + 4); }
+uint32_t forward_loops_per_chunk(uint32_t S, uint32_t C) {
+  return 1 + (C + 1) + 5 + (S + 4);
+}
 
 uint32_t backward_loops_per_chunk(uint32_t S, uint32_t C, bool deterministic) {
   const uint32_t walk = 1 + (C + 1) + 5 + (S + 4) + S * (log2_ceil(S) + 1);
   if (!deterministic) return walk + 3 + 4 + 5 + (C + 1) + 2 * (SPLAT_GRAD2D_FIXED + C);
   const uint32_t subgroups = (SPLAT_TILE_SIZE * SPLAT_TILE_SIZE + S - 1) / S;
-  const uint32_t sums_per_invocation = (3 * S + SPLAT_TILE_SIZE * SPLAT_TILE_SIZE - 1) / (SPLAT_TILE_SIZE * SPLAT_TILE_SIZE);
+  const uint32_t sums_per_invocation =
+      (3 * S + SPLAT_TILE_SIZE * SPLAT_TILE_SIZE - 1) / (SPLAT_TILE_SIZE * SPLAT_TILE_SIZE);
   return walk + (sums_per_invocation + 1) * ((subgroups + 1) + 5);
 }
 
-// Entries per pass: whole chunks within RASTERIZE_PASS_LOOP_BUDGET, for every subgroup size the device may use.
+// Entries per pass: whole chunks within RASTERIZE_PASS_LOOP_BUDGET, for every subgroup size the device may
+// use.
 template <class LoopsPerChunk>
 uint32_t entries_within_budget(const engine::DeviceInfo& info, LoopsPerChunk loops_per_chunk) {
   uint32_t entries = 0xFFFFFFFFu;
@@ -69,7 +75,9 @@ SplatView make_view(const SplatCamera& c, uint32_t count, uint32_t sh_coeffs) {
 // The pass's push constants: entries [p E, (p + 1) E) of every tile's list.
 RasterizeParams pass_params(const SplatView& view, uint32_t pass, uint32_t entries_per_pass) {
   const uint64_t begin = uint64_t{pass} * entries_per_pass;
-  return {view, {static_cast<uint32_t>(begin), static_cast<uint32_t>(std::min<uint64_t>(begin + entries_per_pass, 0xFFFFFFFFu))}};
+  return {view,
+          {static_cast<uint32_t>(begin),
+           static_cast<uint32_t>(std::min<uint64_t>(begin + entries_per_pass, 0xFFFFFFFFu))}};
 }
 
 }  // namespace
@@ -89,10 +97,10 @@ struct Rasterizer::Buffers {
   // Per pixel and per tile.
   std::unique_ptr<DeviceArray<float>> image, depth, alpha, grad_image, grad_depth, grad_alpha;
   std::unique_ptr<DeviceArray<uint32_t>> last, ranges;
-  std::unique_ptr<DeviceArray<uint32_t>> corners;       // [(tiles_y + 1) * (tiles_x + 1)] list lengths
-  std::unique_ptr<DeviceArray<float>> backward_state;   // [2 + C][H][W] between backward passes (else [1])
-  std::unique_ptr<DeviceArray<uint32_t>> counters;      // [SPLAT_COUNTER_COUNT]
-  std::unique_ptr<DeviceArray<uint32_t>> readback;      // [SPLAT_COUNTER_COUNT] host-visible copy
+  std::unique_ptr<DeviceArray<uint32_t>> corners;      // [(tiles_y + 1) * (tiles_x + 1)] list lengths
+  std::unique_ptr<DeviceArray<float>> backward_state;  // [2 + C][H][W] between backward passes (else [1])
+  std::unique_ptr<DeviceArray<uint32_t>> counters;     // [SPLAT_COUNTER_COUNT]
+  std::unique_ptr<DeviceArray<uint32_t>> readback;     // [SPLAT_COUNTER_COUNT] host-visible copy
 };
 
 DeviceGaussians::DeviceGaussians(engine::Context& context, const GaussianModel& model)
@@ -147,7 +155,11 @@ GaussianModel DeviceGaussians::download() const {
 }
 
 Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOptions options)
-    : context_(&context), channels_(channels), options_(options), sort_(context), scan_(context),
+    : context_(&context),
+      channels_(channels),
+      options_(options),
+      sort_(context),
+      scan_(context),
       buffers_(std::make_unique<Buffers>()) {
   if (channels < 1 || channels > SPLAT_MAX_CHANNELS)
     throw std::invalid_argument("Rasterizer: channels = " + std::to_string(channels) + ", must be 1.." +
@@ -159,19 +171,22 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   ranges_ = make("splat/tile_ranges", RANGES_BINDING_COUNT, sizeof(SplatView));
   forward_ = make("splat/rasterize_forward", FWD_BINDING_COUNT, sizeof(RasterizeParams));
   const char* backward = options_.deterministic ? "splat/rasterize_backward_deterministic"
-                         : uses_float_atomics()  ? "splat/rasterize_backward_float_atomics"
-                                                 : "splat/rasterize_backward_cas_atomics";
-  backward_ = make(backward, BWD_BINDING_COUNT, sizeof(RasterizeParams), {{2, options_.depth_gradient_to_opacity ? 1u : 0u}});
+                         : uses_float_atomics() ? "splat/rasterize_backward_float_atomics"
+                                                : "splat/rasterize_backward_cas_atomics";
+  backward_ = make(backward, BWD_BINDING_COUNT, sizeof(RasterizeParams),
+                   {{2, options_.depth_gradient_to_opacity ? 1u : 0u}});
   reduce_ = make("splat/reduce_isect_grads", REDUCE_BINDING_COUNT, sizeof(SplatView));
   project_backward_ = make("splat/project_backward", PBWD_BINDING_COUNT, sizeof(SplatView));
-  buffers_->counters = std::make_unique<DeviceArray<uint32_t>>(context, "splat: counters", SPLAT_COUNTER_COUNT);
+  buffers_->counters =
+      std::make_unique<DeviceArray<uint32_t>>(context, "splat: counters", SPLAT_COUNTER_COUNT);
   buffers_->counters->upload(std::vector<uint32_t>(SPLAT_COUNTER_COUNT, 0u));
-  buffers_->readback = std::make_unique<DeviceArray<uint32_t>>(context, "splat: readback", SPLAT_COUNTER_COUNT,
-                                                                engine::MemoryKind::kHostVisible);
+  buffers_->readback = std::make_unique<DeviceArray<uint32_t>>(
+      context, "splat: readback", SPLAT_COUNTER_COUNT, engine::MemoryKind::kHostVisible);
   const engine::DeviceInfo& info = context.info();
-  forward_entries_per_pass_ = options_.entries_per_pass
-                                  ? options_.entries_per_pass
-                                  : entries_within_budget(info, [&](uint32_t S) { return forward_loops_per_chunk(S, channels); });
+  forward_entries_per_pass_ =
+      options_.entries_per_pass
+          ? options_.entries_per_pass
+          : entries_within_budget(info, [&](uint32_t S) { return forward_loops_per_chunk(S, channels); });
   backward_entries_per_pass_ =
       options_.entries_per_pass ? options_.entries_per_pass : entries_within_budget(info, [&](uint32_t S) {
         return backward_loops_per_chunk(S, channels, options_.deterministic);
@@ -179,7 +194,8 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
 }
 
 uint32_t Rasterizer::passes_for(uint32_t entries_per_pass) const {
-  return static_cast<uint32_t>(std::max<uint64_t>(1, (uint64_t{longest_tile_list_} + entries_per_pass - 1) / entries_per_pass));
+  return static_cast<uint32_t>(
+      std::max<uint64_t>(1, (uint64_t{longest_tile_list_} + entries_per_pass - 1) / entries_per_pass));
 }
 
 RasterizerCounters Rasterizer::read_counters() const {
@@ -199,7 +215,8 @@ bool Rasterizer::uses_float_atomics() const {
   return !options_.deterministic && !options_.force_cas_atomics && context_->info().float_atomic_add;
 }
 
-std::unique_ptr<engine::Kernel> Rasterizer::make(const char* name, uint32_t bindings, uint32_t push_constant_bytes,
+std::unique_ptr<engine::Kernel> Rasterizer::make(const char* name, uint32_t bindings,
+                                                 uint32_t push_constant_bytes,
                                                  std::vector<engine::SpecConstant> extra_constants) {
   engine::KernelDesc desc;
   desc.name = name;
@@ -302,9 +319,10 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   const std::vector<uint32_t> c = b.readback->download();
   const uint64_t m = (uint64_t{c[SPLAT_COUNTER_ISECT_HI]} << 32) | c[SPLAT_COUNTER_ISECT_LO];
   if (m > 0xFFFFFFFFull)
-    throw std::length_error("Rasterizer::forward: " + std::to_string(m) + " tile intersections (" + std::to_string(n) +
-                            " Gaussians on " + std::to_string(tiles) +
-                            " tiles) exceed the 2^32 an intersection id can index; render fewer or smaller Gaussians");
+    throw std::length_error(
+        "Rasterizer::forward: " + std::to_string(m) + " tile intersections (" + std::to_string(n) +
+        " Gaussians on " + std::to_string(tiles) +
+        " tiles) exceed the 2^32 an intersection id can index; render fewer or smaller Gaussians");
   intersections_ = m;
   longest_tile_list_ = c[SPLAT_COUNTER_MAX_LIST];
   forward_walks_cut_before_ = c[SPLAT_COUNTER_FORWARD_WALKS_CUT];
@@ -403,7 +421,8 @@ void Rasterizer::backward(const RenderGradInput& grad) {
 Rasterizer::DeviceOutputs Rasterizer::device_outputs() const {
   if (!last_gaussians_) throw std::logic_error("Rasterizer::device_outputs before forward");
   const Buffers& b = *buffers_;
-  return {&b.image->buffer(), &b.depth->buffer(), &b.alpha->buffer(), &b.rects->buffer(), &b.counters->buffer()};
+  return {&b.image->buffer(), &b.depth->buffer(), &b.alpha->buffer(), &b.rects->buffer(),
+          &b.counters->buffer()};
 }
 
 Rasterizer::DeviceUpstream Rasterizer::upstream_buffers() {
@@ -484,12 +503,13 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
               {PBWD_BINDING_GRAD_SH, &b.g_sh->buffer(), Access::kWrite},
               {PBWD_BINDING_GRAD_MEANS2D, &b.g_means2d->buffer(), Access::kWrite}},
              view);
-  return {&b.g_means->buffer(), &b.g_log_scales->buffer(), &b.g_quats->buffer(), &b.g_logits->buffer(),
-          &b.g_sh->buffer(), &b.g_means2d->buffer()};
+  return {&b.g_means->buffer(),  &b.g_log_scales->buffer(), &b.g_quats->buffer(),
+          &b.g_logits->buffer(), &b.g_sh->buffer(),         &b.g_means2d->buffer()};
 }
 
 GaussianGrads<float> Rasterizer::download_grads() const {
-  if (!last_gaussians_ || !buffers_->g_means) throw std::logic_error("Rasterizer::download_grads before backward");
+  if (!last_gaussians_ || !buffers_->g_means)
+    throw std::logic_error("Rasterizer::download_grads before backward");
   const Buffers& b = *buffers_;
   const size_t n = last_gaussians_->size();
   const size_t K = (last_gaussians_->sh_degree + 1) * (last_gaussians_->sh_degree + 1);

@@ -36,12 +36,12 @@ struct RasterizerOptions {
 
 // Counters of a rasterizer's renders (Rasterizer::read_counters).
 struct RasterizerCounters {
-  uint32_t culled_nonfinite = 0;     // Gaussians culled for a non-finite parameter, last forward
-  uint32_t longest_tile_list = 0;    // entries in the longest tile list, last forward
-  uint32_t forward_passes = 0;       // rasterize passes of the last forward
-  uint32_t backward_passes = 0;      // ... and of the last backward
-  uint64_t walks_cut_short = 0;      // subgroup walks that a driver's loop limit ended early, all renders so
-                                     // far (forward + backward); 0 unless a pass size is wrong for the device
+  uint32_t culled_nonfinite = 0;   // Gaussians culled for a non-finite parameter, last forward
+  uint32_t longest_tile_list = 0;  // entries in the longest tile list, last forward
+  uint32_t forward_passes = 0;     // rasterize passes of the last forward
+  uint32_t backward_passes = 0;    // ... and of the last backward
+  uint64_t walks_cut_short = 0;    // subgroup walks that a driver's loop limit ended early, all renders so
+                                   // far (forward + backward); 0 unless a pass size is wrong for the device
 };
 
 // A Gaussian model on the device, one buffer per attribute (structure of arrays, each binding bounded).
@@ -87,10 +87,10 @@ class Rasterizer {
   // gradient buffers to fill, and the parameter gradients the backward writes. Sizes: outputs and upstream
   // gradients hold at least C*H*W (image) or H*W values; parameter gradients at least N rows.
   struct DeviceOutputs {
-    const engine::Buffer* image;   // [C][H][W]
-    const engine::Buffer* depth;   // [H][W]
-    const engine::Buffer* alpha;   // [H][W]
-    const engine::Buffer* rects;   // [N][4] uint tile rectangles; empty (x1 <= x0) when culled
+    const engine::Buffer* image;  // [C][H][W]
+    const engine::Buffer* depth;  // [H][W]
+    const engine::Buffer* alpha;  // [H][W]
+    const engine::Buffer* rects;  // [N][4] uint tile rectangles; empty (x1 <= x0) when culled
     // [SPLAT_COUNTER_COUNT] uint (splat_shared.h, SPLAT_COUNTER_*): the last forward's culls, and the running
     // totals of walks cut short, for a copy inside a training step's submit.
     const engine::Buffer* counters;

@@ -28,7 +28,9 @@ sm::ViewGeometry view_geometry(const SplatCamera& c) {
   return v;
 }
 
-glm::dvec3 vec3_at(const std::vector<float>& v, size_t i) { return {v[3 * i], v[3 * i + 1], v[3 * i + 2]}; }
+glm::dvec3 vec3_at(const std::vector<float>& v, size_t i) {
+  return {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+}
 glm::dvec4 vec4_at(const std::vector<float>& v, size_t i) {
   return {v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]};
 }
@@ -36,15 +38,17 @@ glm::dvec4 vec4_at(const std::vector<float>& v, size_t i) {
 // Everything the per-pixel pass needs, computed once per render.
 struct Prepared {
   std::vector<sm::Projected> proj;
-  std::vector<std::array<uint32_t, 4>> rect;   // tiles x0 y0 x1 y1, half-open
-  std::vector<std::vector<double>> color;      // [N][C]
+  std::vector<std::array<uint32_t, 4>> rect;      // tiles x0 y0 x1 y1, half-open
+  std::vector<std::vector<double>> color;         // [N][C]
   std::vector<std::vector<uint32_t>> tile_lists;  // per tile: Gaussians in depth order
   uint32_t tiles_x = 0, tiles_y = 0;
   uint32_t culled_nonfinite = 0;
   uint64_t intersections = 0;
 };
 
-glm::dvec3 camera_centre(const SplatCamera& c) { return -glm::transpose(c.R_cam_world) * c.t_cam_world; }
+glm::dvec3 camera_centre(const SplatCamera& c) {
+  return -glm::transpose(c.R_cam_world) * c.t_cam_world;
+}
 
 Prepared prepare(const GaussianModel& m, const SplatCamera& cam) {
   m.check();
@@ -63,8 +67,8 @@ Prepared prepare(const GaussianModel& m, const SplatCamera& cam) {
   const glm::dvec3 centre = camera_centre(cam);
   std::vector<uint32_t> visible;
   for (size_t i = 0; i < n; ++i) {
-    const sm::Projected pr =
-        sm::project_gaussian(v, vec3_at(m.means, i), vec3_at(m.log_scales, i), vec4_at(m.quats, i), m.opacity_logits[i]);
+    const sm::Projected pr = sm::project_gaussian(v, vec3_at(m.means, i), vec3_at(m.log_scales, i),
+                                                  vec4_at(m.quats, i), m.opacity_logits[i]);
     p.proj[i] = pr;
     bool sh_finite = true;
     for (uint32_t k = 0; k < K * C; ++k) sh_finite = sh_finite && std::isfinite(m.sh[i * K * C + k]);
@@ -180,7 +184,8 @@ GaussianGrads<double> reference_backward(const GaussianModel& m, const SplatCame
   const uint32_t W = cam.width, H = cam.height, C = m.channels, K = m.sh_coeffs();
   const size_t n = m.size(), npix = static_cast<size_t>(W) * H;
   if (grad_out.image.size() != C * npix)
-    throw std::invalid_argument("reference_backward: grad image has " + std::to_string(grad_out.image.size()) +
+    throw std::invalid_argument("reference_backward: grad image has " +
+                                std::to_string(grad_out.image.size()) +
                                 " values, expected C*H*W = " + std::to_string(C * npix));
   auto at = [](const std::vector<float>& v, size_t i) { return v.empty() ? 0.0 : static_cast<double>(v[i]); };
 
@@ -254,8 +259,8 @@ GaussianGrads<double> reference_backward(const GaussianModel& m, const SplatCame
   for (size_t i = 0; i < n; ++i) {
     if (p.rect[i][0] >= p.rect[i][2]) continue;  // culled: no gradient
     const glm::dvec3 mean = vec3_at(m.means, i);
-    const sm::ParamGrad pg = sm::project_gaussian_backward(v, mean, vec3_at(m.log_scales, i), vec4_at(m.quats, i),
-                                                           m.opacity_logits[i], g2[i]);
+    const sm::ParamGrad pg = sm::project_gaussian_backward(v, mean, vec3_at(m.log_scales, i),
+                                                           vec4_at(m.quats, i), m.opacity_logits[i], g2[i]);
     // SH: color = sum_k basis_k coeff_k + 0.5, clamped at 0.
     const glm::dvec3 ray = mean - centre;
     const glm::dvec3 dir = glm::normalize(ray);

@@ -11,6 +11,7 @@ RenderImages<double> reference_forward(const GaussianModel& model, const SplatCa
 // Gradients of sum(grad_out . outputs) w.r.t. the model's parameters. depth_gradient_to_opacity = false:
 // the depth and alpha gradients skip the opacity (RasterizerOptions::depth_gradient_to_opacity).
 GaussianGrads<double> reference_backward(const GaussianModel& model, const SplatCamera& camera,
-                                         const RenderGradInput& grad_out, bool depth_gradient_to_opacity = true);
+                                         const RenderGradInput& grad_out,
+                                         bool depth_gradient_to_opacity = true);
 
 }  // namespace litgs::kernels

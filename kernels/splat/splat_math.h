@@ -27,10 +27,12 @@ using mat2x3 = glm::dmat2x3;
 using uint = uint32_t;
 #define SM_INOUT(T) T&
 #define SM_OUT(T) T&
-#define SM_OUT_ARRAY(T, name, n) T (&name)[n]
-#define SM_IN_ARRAY(T, name, n) const T (&name)[n]
+#define SM_OUT_ARRAY(T, name, n) T(&name)[n]
+#define SM_IN_ARRAY(T, name, n) const T(&name)[n]
 #define SM_FN inline
-inline bool is_finite_real(real x) { return std::isfinite(x); }
+inline bool is_finite_real(real x) {
+  return std::isfinite(x);
+}
 #else
 #define real float
 #define SM_INOUT(T) inout T
@@ -39,19 +41,26 @@ inline bool is_finite_real(real x) { return std::isfinite(x); }
 #define SM_IN_ARRAY(T, name, n) T name[n]
 #define SM_FN
 // Bitwise: fast-math may fold x == x, never an exponent test.
-bool is_finite_real(float x) { return (floatBitsToUint(x) & 0x7f800000u) != 0x7f800000u; }
+bool is_finite_real(float x) {
+  return (floatBitsToUint(x) & 0x7f800000u) != 0x7f800000u;
+}
 #endif
 
-SM_FN bool is_finite3(vec3 v) { return is_finite_real(v.x) && is_finite_real(v.y) && is_finite_real(v.z); }
-SM_FN bool is_finite4(vec4 v) { return is_finite3(vec3(v.x, v.y, v.z)) && is_finite_real(v.w); }
+SM_FN bool is_finite3(vec3 v) {
+  return is_finite_real(v.x) && is_finite_real(v.y) && is_finite_real(v.z);
+}
+SM_FN bool is_finite4(vec4 v) {
+  return is_finite3(vec3(v.x, v.y, v.z)) && is_finite_real(v.w);
+}
 
 // ---- Rotation ----
 
 SM_FN mat3 rotation_from_unit_quat(vec4 q) {
   const real w = q.x, x = q.y, y = q.z, z = q.w;
-  return mat3(real(1.0) - real(2.0) * (y * y + z * z), real(2.0) * (x * y + w * z), real(2.0) * (x * z - w * y),
-              real(2.0) * (x * y - w * z), real(1.0) - real(2.0) * (x * x + z * z), real(2.0) * (y * z + w * x),
-              real(2.0) * (x * z + w * y), real(2.0) * (y * z - w * x), real(1.0) - real(2.0) * (x * x + y * y));
+  return mat3(
+      real(1.0) - real(2.0) * (y * y + z * z), real(2.0) * (x * y + w * z), real(2.0) * (x * z - w * y),
+      real(2.0) * (x * y - w * z), real(1.0) - real(2.0) * (x * x + z * z), real(2.0) * (y * z + w * x),
+      real(2.0) * (x * z + w * y), real(2.0) * (y * z - w * x), real(1.0) - real(2.0) * (x * x + y * y));
 }
 
 // Unit quaternion, or (0, 0, 0, 0) below the norm floor, which rotation_from_unit_quat maps to identity.
@@ -128,25 +137,28 @@ SM_FN vec3 sh_basis_dir_grad(uint degree, vec3 d, SM_IN_ARRAY(real, g, SPLAT_MAX
   if (degree < 3u) return r;
   r += real(-0.5900435899266435) * vec3(real(6.0) * x * y, real(3.0) * xx - real(3.0) * yy, real(0.0)) * g[9];
   r += real(2.890611442640554) * vec3(y * z, x * z, x * y) * g[10];
-  r += real(-0.4570457994644658) * vec3(-real(2.0) * x * y, real(4.0) * zz - xx - real(3.0) * yy, real(8.0) * y * z) * g[11];
+  r += real(-0.4570457994644658) *
+       vec3(-real(2.0) * x * y, real(4.0) * zz - xx - real(3.0) * yy, real(8.0) * y * z) * g[11];
   r += real(0.3731763325901154) *
        vec3(-real(6.0) * x * z, -real(6.0) * y * z, real(6.0) * zz - real(3.0) * xx - real(3.0) * yy) * g[12];
-  r += real(-0.4570457994644658) * vec3(real(4.0) * zz - real(3.0) * xx - yy, -real(2.0) * x * y, real(8.0) * x * z) * g[13];
+  r += real(-0.4570457994644658) *
+       vec3(real(4.0) * zz - real(3.0) * xx - yy, -real(2.0) * x * y, real(8.0) * x * z) * g[13];
   r += real(1.445305721320277) * vec3(real(2.0) * x * z, -real(2.0) * y * z, xx - yy) * g[14];
-  r += real(-0.5900435899266435) * vec3(real(3.0) * xx - real(3.0) * yy, -real(6.0) * x * y, real(0.0)) * g[15];
+  r += real(-0.5900435899266435) * vec3(real(3.0) * xx - real(3.0) * yy, -real(6.0) * x * y, real(0.0)) *
+       g[15];
   return r;
 }
 
 // ---- Projection ----
 
 struct Projected {
-  vec2 mean2d;    // pixels
-  vec3 conic;     // inverse 2D covariance (a, b, c)
-  real depth;     // camera z
-  real opacity;   // sigmoid(logit)
-  vec2 extent;    // half-extent in pixels along x and y where alpha falls to SPLAT_ALPHA_MIN
-  bool finite;    // all parameters finite
-  bool visible;   // in front of the near plane, non-degenerate, opaque enough and on the image
+  vec2 mean2d;   // pixels
+  vec3 conic;    // inverse 2D covariance (a, b, c)
+  real depth;    // camera z
+  real opacity;  // sigmoid(logit)
+  vec2 extent;   // half-extent in pixels along x and y where alpha falls to SPLAT_ALPHA_MIN
+  bool finite;   // all parameters finite
+  bool visible;  // in front of the near plane, non-degenerate, opaque enough and on the image
 };
 
 struct ViewGeometry {
@@ -178,7 +190,8 @@ SM_FN mat3 covariance_world(vec3 log_scale, vec4 quat_raw) {
   return M * transpose(M);
 }
 
-SM_FN Projected project_gaussian(ViewGeometry v, vec3 mean, vec3 log_scale, vec4 quat_raw, real opacity_logit) {
+SM_FN Projected project_gaussian(ViewGeometry v, vec3 mean, vec3 log_scale, vec4 quat_raw,
+                                 real opacity_logit) {
   Projected o;
   o.mean2d = vec2(real(0.0));
   o.conic = vec3(real(0.0));
@@ -186,7 +199,8 @@ SM_FN Projected project_gaussian(ViewGeometry v, vec3 mean, vec3 log_scale, vec4
   o.opacity = real(0.0);
   o.extent = vec2(real(0.0));
   o.visible = false;
-  o.finite = is_finite3(mean) && is_finite3(log_scale) && is_finite4(quat_raw) && is_finite_real(opacity_logit);
+  o.finite =
+      is_finite3(mean) && is_finite3(log_scale) && is_finite4(quat_raw) && is_finite_real(opacity_logit);
   if (!o.finite) return o;
   const vec3 p = v.R * mean + v.t;
   o.depth = p.z;

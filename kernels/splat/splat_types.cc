@@ -25,8 +25,8 @@ void GaussianModel::check() const {
   auto expect = [&](const std::vector<float>& v, size_t per, const char* name) {
     if (v.size() != n * per)
       throw std::invalid_argument(std::string("GaussianModel.") + name + " has " + std::to_string(v.size()) +
-                                  " values, expected " + std::to_string(n * per) + " for " + std::to_string(n) +
-                                  " Gaussians");
+                                  " values, expected " + std::to_string(n * per) + " for " +
+                                  std::to_string(n) + " Gaussians");
   };
   expect(means, 3, "means");
   expect(log_scales, 3, "log_scales");
@@ -36,7 +36,8 @@ void GaussianModel::check() const {
 
 void SplatCamera::check() const {
   auto bad = [](const char* field, double v) {
-    throw std::invalid_argument(std::string("SplatCamera.") + field + " = " + std::to_string(v) + " is invalid");
+    throw std::invalid_argument(std::string("SplatCamera.") + field + " = " + std::to_string(v) +
+                                " is invalid");
   };
   if (!(fx > 0) || !std::isfinite(fx)) bad("fx", fx);
   if (!(fy > 0) || !std::isfinite(fy)) bad("fy", fy);

@@ -3,17 +3,16 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace litgs::kernels {
 
 // A Gaussian model on the host. Raw parameters, as the standard 3DGS PLY stores them.
 struct GaussianModel {
-  uint32_t channels = 1;   // C: 1 for thermal, 3 for RGB
-  uint32_t sh_degree = 3;  // the model's degree; K = (sh_degree + 1)^2 coefficients per channel
+  uint32_t channels = 1;              // C: 1 for thermal, 3 for RGB
+  uint32_t sh_degree = 3;             // the model's degree; K = (sh_degree + 1)^2 coefficients per channel
   std::vector<float> means;           // [N][3] world, metres
   std::vector<float> log_scales;      // [N][3]
   std::vector<float> quats;           // [N][4] w x y z, unnormalized
@@ -33,8 +32,8 @@ struct SplatCamera {
   glm::dvec3 t_cam_world{0.0};
   double fx = 0, fy = 0, cx = 0, cy = 0;  // pixel (i, j) has its centre at (i + 0.5, j + 0.5)
   uint32_t width = 0, height = 0;
-  double near_m = 0.01;     // Gaussians nearer than this are culled
-  uint32_t sh_degree = 3;   // active SH degree, at most the model's
+  double near_m = 0.01;    // Gaussians nearer than this are culled
+  uint32_t sh_degree = 3;  // active SH degree, at most the model's
   // Throws std::invalid_argument naming the bad field.
   void check() const;
 };

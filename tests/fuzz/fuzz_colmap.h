@@ -40,12 +40,19 @@ int fuzz_colmap(const uint8_t* data, size_t size, bool binary, Read read) {
     io::write_colmap_model(dir, small_colmap_model(), binary);
     std::array<std::string, 3> g;
     for (int i = 0; i < 3; ++i)
-      g[i] = io::read_file_bytes(dir / (std::string(i == 0 ? "cameras" : i == 1 ? "images" : "points3D") + ext));
+      g[i] = io::read_file_bytes(dir / (std::string(i == 0   ? "cameras"
+                                                    : i == 1 ? "images"
+                                                             : "points3D") +
+                                        ext));
     return g;
   }();
   const int which = data[0] % 4;
   const auto file = [&](int i) {
-    return std::string(binary ? "colmap-bin/" : "colmap-txt/") + (i == 0 ? "cameras" : i == 1 ? "images" : "points3D") + ext;
+    return std::string(binary ? "colmap-bin/" : "colmap-txt/") +
+           (i == 0   ? "cameras"
+            : i == 1 ? "images"
+                     : "points3D") +
+           ext;
   };
   if (which == 3)
     std::filesystem::remove(temp_dir() / file(2));

@@ -2,5 +2,6 @@
 #include "tests/fuzz/fuzz_colmap.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  return litgs::fuzz::fuzz_colmap(data, size, false, [](const auto& dir) { litgs::io::read_colmap_text(dir); });
+  return litgs::fuzz::fuzz_colmap(data, size, false,
+                                  [](const auto& dir) { litgs::io::read_colmap_text(dir); });
 }

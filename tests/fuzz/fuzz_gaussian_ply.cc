@@ -1,6 +1,6 @@
 // libFuzzer target: io::read_gaussian_ply (3DGS PLY models).
-#include "tests/fuzz/fuzz_util.h"
 #include "io/gaussian_ply.h"
+#include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const auto path = litgs::fuzz::write_temp("model.ply", data, size);

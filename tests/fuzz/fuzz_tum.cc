@@ -1,6 +1,6 @@
 // libFuzzer target: io::read_tum (TUM trajectories).
-#include "tests/fuzz/fuzz_util.h"
 #include "io/tum.h"
+#include "tests/fuzz/fuzz_util.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const auto path = litgs::fuzz::write_temp("poses.txt", data, size);

@@ -29,7 +29,8 @@ inline kernels::RenderGradInput random_grad(uint32_t channels, uint32_t w, uint3
 
 // Gradient arrays agree when their relative L2 error is small and almost every entry is close; the few
 // exceptions are Gaussians whose float and double walks cross a threshold (alpha 1/255, T 1e-4) apart.
-inline void expect_close(const std::vector<float>& got, const std::vector<double>& want, const std::string& name) {
+inline void expect_close(const std::vector<float>& got, const std::vector<double>& want,
+                         const std::string& name) {
   ASSERT_EQ(got.size(), want.size()) << name;
   double err2 = 0, ref2 = 0, scale = 0;
   for (double w : want) scale = std::max(scale, std::abs(w));
@@ -46,7 +47,8 @@ inline void expect_close(const std::vector<float>& got, const std::vector<double
   EXPECT_GE(static_cast<double>(close), 0.99 * static_cast<double>(got.size())) << name << ": entries close";
 }
 
-inline void expect_grads_match(const kernels::GaussianGrads<float>& got, const kernels::GaussianGrads<double>& want) {
+inline void expect_grads_match(const kernels::GaussianGrads<float>& got,
+                               const kernels::GaussianGrads<double>& want) {
   expect_close(got.means, want.means, "means");
   expect_close(got.log_scales, want.log_scales, "log_scales");
   expect_close(got.quats, want.quats, "quats");

@@ -34,7 +34,8 @@ inline kernels::GaussianModel random_scene(size_t n, uint32_t channels, uint32_t
   return m;
 }
 
-inline kernels::SplatCamera camera_looking_down_z(uint32_t width, uint32_t height, double fov_half_tan = 0.5) {
+inline kernels::SplatCamera camera_looking_down_z(uint32_t width, uint32_t height,
+                                                  double fov_half_tan = 0.5) {
   kernels::SplatCamera c;
   c.width = width;
   c.height = height;

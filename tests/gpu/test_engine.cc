@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "engine/buffer.h"
-#include "engine/vk_check.h"
 #include "engine/sequence.h"
+#include "engine/vk_check.h"
 #include "gpu_test.h"
 #include "kernels/scan/scan_shared.h"
 #include "kernels/spirv_registry.h"
@@ -79,34 +79,40 @@ TEST_F(EngineTest, UnknownShaderIsNamed) {
 }
 
 TEST_F(EngineTest, DispatchChecksBindingsAndPushConstants) {
-  auto kernel = kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
+  auto kernel =
+      kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
   engine::DeviceArray<uint32_t> a(context(), "a", 16);
   engine::Sequence seq(context());
   kernels::ScanParams params{16, 16, 0, 0};
   // Missing binding 1.
-  EXPECT_THROW(seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}}, params), std::invalid_argument);
+  EXPECT_THROW(seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}}, params),
+               std::invalid_argument);
   // Repeated binding 0.
-  EXPECT_THROW(seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {0, &a.buffer(), Access::kRead}},
-                            params),
+  EXPECT_THROW(seq.dispatch(*kernel, {1},
+                            {{0, &a.buffer(), Access::kReadWrite}, {0, &a.buffer(), Access::kRead}}, params),
                std::invalid_argument);
   // Wrong push-constant size.
   const uint32_t wrong = 0;
-  EXPECT_THROW(seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {1, &a.buffer(), Access::kRead}},
-                            wrong),
+  EXPECT_THROW(seq.dispatch(*kernel, {1},
+                            {{0, &a.buffer(), Access::kReadWrite}, {1, &a.buffer(), Access::kRead}}, wrong),
                std::invalid_argument);
 }
 
 TEST_F(EngineTest, BarriersOnlyWhereHazardsAre) {
-  auto kernel = kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
-  engine::DeviceArray<uint32_t> a(context(), "a", 64), b(context(), "b", 64), offsets(context(), "offsets", 1);
+  auto kernel =
+      kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
+  engine::DeviceArray<uint32_t> a(context(), "a", 64), b(context(), "b", 64),
+      offsets(context(), "offsets", 1);
   std::vector<uint32_t> ones(64, 1u);
   a.upload(ones);
   b.upload(ones);
   engine::Sequence seq(context());
   kernels::ScanParams params{64, 64, 0, 0};
   // Independent buffers: no barrier between the two scans.
-  seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {1, &offsets.buffer(), Access::kRead}}, params);
-  seq.dispatch(*kernel, {1}, {{0, &b.buffer(), Access::kReadWrite}, {1, &offsets.buffer(), Access::kRead}}, params);
+  seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {1, &offsets.buffer(), Access::kRead}},
+               params);
+  seq.dispatch(*kernel, {1}, {{0, &b.buffer(), Access::kReadWrite}, {1, &offsets.buffer(), Access::kRead}},
+               params);
   EXPECT_EQ(seq.barrier_count(), 0u);
   // Copy a into b after both were written: one barrier.
   seq.copy(a.buffer(), b.buffer(), 64 * sizeof(uint32_t));
@@ -125,7 +131,8 @@ TEST_F(EngineTest, BarriersOnlyWhereHazardsAre) {
 }
 
 TEST_F(EngineTest, SequenceReplays) {
-  auto kernel = kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
+  auto kernel =
+      kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
   engine::DeviceArray<uint32_t> a(context(), "a", 8), offsets(context(), "offsets", 1);
   engine::Sequence seq(context());
   seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {1, &offsets.buffer(), Access::kRead}},

@@ -9,8 +9,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -292,7 +292,8 @@ struct GeoOut {
 
 class GeometricLossTest : public testing::GpuTest {
  protected:
-  GeoOut run(GeometricLoss& loss, const GeoScene& s, float weight, uint32_t valid_count, float robust_scale = 0.0f) {
+  GeoOut run(GeometricLoss& loss, const GeoScene& s, float weight, uint32_t valid_count,
+             float robust_scale = 0.0f) {
     const size_t n = size_t{s.w} * s.h;
     DeviceArray<float> depth(context(), "test: depth", n), points(context(), "test: points", 4 * n),
         normals(context(), "test: normals", 4 * n), grad(context(), "test: grad depth", n),
@@ -330,7 +331,8 @@ class GeometricLossTest : public testing::GpuTest {
     // The float residual carries ~1e-6 m of rounding at these 3-7 m depths; the Cauchy gradient peaks at
     // |r| = s, so relative to its peak the rounding weighs 1e-6 m / s.
     const double tolerance = robust_scale > 0 ? std::max(1e-5, 2e-6 / robust_scale) : 1e-5;
-    EXPECT_LE(err, tolerance * scale) << where << ": max |grad error| " << err << " against max |grad| " << scale;
+    EXPECT_LE(err, tolerance * scale)
+        << where << ": max |grad error| " << err << " against max |grad| " << scale;
     for (size_t i = 0; i < s.depth.size(); ++i)
       if (s.depth[i] == 0.0f || s.points[4 * i + 3] == 0.0f) {
         ASSERT_EQ(d.grad[i], 0.0f) << where << " pixel " << i;

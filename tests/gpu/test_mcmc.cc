@@ -30,7 +30,9 @@ uint32_t bits(float x) {
   return b;
 }
 
-float logit(double o) { return static_cast<float>(std::log(o / (1.0 - o))); }
+float logit(double o) {
+  return static_cast<float>(std::log(o / (1.0 - o)));
+}
 
 // Random Gaussians, about 15% transparent, three non-finite rows, random moments and statistics.
 TrainingState random_state(size_t n, uint32_t seed) {
@@ -119,7 +121,8 @@ TEST_F(McmcTest, RelocationAndGrowthMatchTheReferenceGivenTheDraws) {
         ASSERT_NEAR(a[j], b[j], 2e-5 * std::max(1.0f, std::abs(b[j]))) << kParamGroupNames[g] << " " << j;
       else
         ASSERT_EQ(bits(a[j]), bits(b[j])) << kParamGroupNames[g] << " " << j;
-      ASSERT_EQ(bits(got.exp_avg[g][j]), bits(want.exp_avg[g][j])) << "exp_avg " << kParamGroupNames[g] << " " << j;
+      ASSERT_EQ(bits(got.exp_avg[g][j]), bits(want.exp_avg[g][j]))
+          << "exp_avg " << kParamGroupNames[g] << " " << j;
       ASSERT_EQ(bits(got.exp_avg_sq[g][j]), bits(want.exp_avg_sq[g][j])) << "exp_avg_sq " << j;
     }
   }
@@ -211,7 +214,8 @@ TEST_F(McmcTest, GrowthStopsAtTheBudgetAndBuffersGrowOnlyAsNeeded) {
   // The first rows were sources at some point: their parameters moved only by relocation (means are copies).
   for (size_t i = 0; i < got.size(); ++i) {
     bool matches_an_original = false;
-    for (size_t j = 0; j < m.size(); ++j) matches_an_original |= bits(got.means[3 * i]) == bits(m.means[3 * j]);
+    for (size_t j = 0; j < m.size(); ++j)
+      matches_an_original |= bits(got.means[3 * i]) == bits(m.means[3 * j]);
     ASSERT_TRUE(matches_an_original) << "row " << i << " is not a copy of an original Gaussian";
   }
 }
@@ -234,7 +238,8 @@ TEST_F(McmcTest, NoiseMatchesTheReference) {
   for (size_t j = 0; j < want.size(); ++j) {
     const double offset = want[j] - m.means[j];
     // float: a few ulps of the mean itself, plus the offset's own float error (Sigma z cancels partly)
-    ASSERT_NEAR(got.means[j], want[j], 1e-6 * std::max(1.0, std::abs(want[j])) + 1e-4 * std::abs(offset)) << j;
+    ASSERT_NEAR(got.means[j], want[j], 1e-6 * std::max(1.0, std::abs(want[j])) + 1e-4 * std::abs(offset))
+        << j;
     moved += std::abs(offset) > 1e-6;
   }
   EXPECT_GT(moved, want.size() / 4);  // the noise does act

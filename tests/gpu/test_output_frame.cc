@@ -281,7 +281,8 @@ TEST_F(OutputFrameTest, RecentredOutputIsTheTrainersModelAndRendersIdentically) 
 }
 
 // render says when Gaussians were culled for non-finite parameters (nothing else would tell), and is silent
-// when none were. (Walks cut short are reported the same way; tests/gpu/test_rasterizer_long_lists.cc makes lavapipe cut one.)
+// when none were. (Walks cut short are reported the same way; tests/gpu/test_rasterizer_long_lists.cc makes
+// lavapipe cut one.)
 TEST(RenderCounters, CulledGaussiansAreReported) {
   const fs::path dir = fs::temp_directory_path() / ("litgs-render-counters-" + std::to_string(::getpid()));
   fs::create_directories(dir);

@@ -27,7 +27,8 @@ Pairs reference_sort(const std::vector<uint32_t>& keys, uint32_t bits) {
   const uint32_t mask = bits >= 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
   std::vector<uint32_t> order(keys.size());
   std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return (keys[a] & mask) < (keys[b] & mask); });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t a, uint32_t b) { return (keys[a] & mask) < (keys[b] & mask); });
   Pairs out;
   for (uint32_t i : order) {
     out.keys.push_back(keys[i]);
@@ -38,11 +39,13 @@ Pairs reference_sort(const std::vector<uint32_t>& keys, uint32_t bits) {
 
 class RadixSortTest : public testing::GpuTest {
  protected:
-  Pairs device_sort(const std::vector<uint32_t>& keys, uint32_t bits, kernels::RadixSortOptions options = {}) {
+  Pairs device_sort(const std::vector<uint32_t>& keys, uint32_t bits,
+                    kernels::RadixSortOptions options = {}) {
     kernels::RadixSort sort(context(), options);
     std::vector<uint32_t> values(keys.size());
     std::iota(values.begin(), values.end(), 0u);
-    engine::DeviceArray<uint32_t> d_keys(context(), "keys", keys.size()), d_values(context(), "values", keys.size());
+    engine::DeviceArray<uint32_t> d_keys(context(), "keys", keys.size()),
+        d_values(context(), "values", keys.size());
     d_keys.upload(keys);
     d_values.upload(values);
     engine::Sequence seq(context());
@@ -77,11 +80,13 @@ std::vector<uint32_t> random_keys(size_t n, uint32_t seed, uint32_t mask = 0xFFF
 const std::vector<size_t> kSizes = {0, 1, 7, 255, 256, 257, 65537, 1000003};
 
 TEST_F(RadixSortTest, RandomKeys) {
-  for (size_t n : kSizes) expect_sorted_like_std(random_keys(n, static_cast<uint32_t>(n) + 1), 32, "random n=" + std::to_string(n));
+  for (size_t n : kSizes)
+    expect_sorted_like_std(random_keys(n, static_cast<uint32_t>(n) + 1), 32, "random n=" + std::to_string(n));
 }
 
 TEST_F(RadixSortTest, AllKeysEqual) {
-  for (size_t n : kSizes) expect_sorted_like_std(std::vector<uint32_t>(n, 42u), 32, "equal n=" + std::to_string(n));
+  for (size_t n : kSizes)
+    expect_sorted_like_std(std::vector<uint32_t>(n, 42u), 32, "equal n=" + std::to_string(n));
 }
 
 TEST_F(RadixSortTest, AlreadySorted) {
@@ -102,7 +107,8 @@ TEST_F(RadixSortTest, ReverseSorted) {
 
 TEST_F(RadixSortTest, FewLowBitsUsedManyDuplicates) {
   // Keys in 0..15: long runs of equal keys, stability matters everywhere.
-  for (size_t n : kSizes) expect_sorted_like_std(random_keys(n, 7, 0xFu), 32, "4-bit keys n=" + std::to_string(n));
+  for (size_t n : kSizes)
+    expect_sorted_like_std(random_keys(n, 7, 0xFu), 32, "4-bit keys n=" + std::to_string(n));
 }
 
 TEST_F(RadixSortTest, MaxKeys) {

@@ -26,8 +26,10 @@ using testing::random_grad;
 
 class RasterizerBackward : public testing::GpuTest {
  protected:
-  kernels::GaussianGrads<float> device_grads(const kernels::GaussianModel& model, const kernels::SplatCamera& camera,
-                                             const kernels::RenderGradInput& grad, RasterizerOptions options) {
+  kernels::GaussianGrads<float> device_grads(const kernels::GaussianModel& model,
+                                             const kernels::SplatCamera& camera,
+                                             const kernels::RenderGradInput& grad,
+                                             RasterizerOptions options) {
     DeviceGaussians g(context(), model);
     Rasterizer r(context(), model.channels, options);
     r.forward(g, camera);
@@ -42,7 +44,8 @@ TEST_F(RasterizerBackward, AtomicModeMatchesReference) {
     const auto camera = testing::camera_looking_down_z(50, 38);
     const auto grad = random_grad(channels, camera.width, camera.height, 5);
     SCOPED_TRACE("channels " + std::to_string(channels));
-    expect_grads_match(device_grads(model, camera, grad, {}), kernels::reference_backward(model, camera, grad));
+    expect_grads_match(device_grads(model, camera, grad, {}),
+                       kernels::reference_backward(model, camera, grad));
   }
 }
 
@@ -65,7 +68,8 @@ TEST_F(RasterizerBackward, DepthGradientWithoutOpacityMatchesReference) {
   for (size_t i = 0; i < want.means.size(); ++i) moved += std::abs(want.means[i] - image_want.means[i]);
   EXPECT_GT(moved, 0.0) << "the depth gradient still moves the means";
   double differs = 0;
-  for (size_t i = 0; i < want.opacity_logits.size(); ++i) differs += std::abs(want.opacity_logits[i] - exact.opacity_logits[i]);
+  for (size_t i = 0; i < want.opacity_logits.size(); ++i)
+    differs += std::abs(want.opacity_logits[i] - exact.opacity_logits[i]);
   EXPECT_GT(differs, 0.0) << "the exact gradient's opacity part depends on depth and alpha";
   for (const bool deterministic : {false, true}) {
     RasterizerOptions options;
@@ -82,7 +86,8 @@ TEST_F(RasterizerBackward, CasFallbackMatchesReference) {
   const auto grad = random_grad(1, camera.width, camera.height, 6);
   RasterizerOptions options;
   options.force_cas_atomics = true;
-  expect_grads_match(device_grads(model, camera, grad, options), kernels::reference_backward(model, camera, grad));
+  expect_grads_match(device_grads(model, camera, grad, options),
+                     kernels::reference_backward(model, camera, grad));
 }
 
 TEST_F(RasterizerBackward, DeterministicModeMatchesReferenceAndIsBitIdentical) {

@@ -18,7 +18,9 @@ namespace litgs {
 namespace {
 
 // Throws (the test fails, naming the path) when the archive is missing: never a silent skip.
-std::string garden_path() { return testing::test_data("gsplat-garden/test_garden.npz").string(); }
+std::string garden_path() {
+  return testing::test_data("gsplat-garden/test_garden.npz").string();
+}
 
 struct Garden {
   kernels::GaussianModel model;
@@ -129,8 +131,12 @@ class RasterizerGarden : public testing::GpuTest {
   }
 };
 
-TEST_F(RasterizerGarden, RgbDegree0MatchesReference) { check_parity(3, 0); }
-TEST_F(RasterizerGarden, ThermalDegree3MatchesReference) { check_parity(1, 3); }
+TEST_F(RasterizerGarden, RgbDegree0MatchesReference) {
+  check_parity(3, 0);
+}
+TEST_F(RasterizerGarden, ThermalDegree3MatchesReference) {
+  check_parity(1, 3);
+}
 
 }  // namespace
 }  // namespace litgs

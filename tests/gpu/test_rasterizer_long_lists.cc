@@ -58,7 +58,8 @@ GaussianModel faint_points_on_one_tile(size_t n, uint32_t seed) {
     m.means[3 * i + 2] = static_cast<float>(z);
     // Millimetre-sized and anisotropic, randomly turned: every parameter has a gradient (an isotropic
     // Gaussian's rotation gradient is exactly zero, and its float value pure rounding).
-    for (int a = 0; a < 3; ++a) m.log_scales[3 * i + a] = static_cast<float>(std::log(1e-3 * (0.5 + 2.5 * unit(rng))));
+    for (int a = 0; a < 3; ++a)
+      m.log_scales[3 * i + a] = static_cast<float>(std::log(1e-3 * (0.5 + 2.5 * unit(rng))));
     for (int a = 0; a < 4; ++a) m.quats[4 * i + a] = static_cast<float>(unit(rng) - 0.5);
     m.opacity_logits[i] = logit;
     m.sh[i] = static_cast<float>(unit(rng) - 0.5);  // colour 0.5 + 0.28 * sh in 0.36..0.64
@@ -152,15 +153,20 @@ class RasterizerLongLists : public testing::GpuTest {
       EXPECT_EQ(c.walks_cut_short, 0u) << "a pass exceeded the driver's loop limit";
       EXPECT_GT(c.forward_passes, 1u) << "the list should need several forward passes";
       EXPECT_GT(c.backward_passes, 1u) << "the list should need several backward passes";
-      std::printf("  %s: %zu entries, %u forward passes of %u, %u backward passes of %u\n", name, n, c.forward_passes,
-                  r.forward_entries_per_pass(), c.backward_passes, r.backward_entries_per_pass());
+      std::printf("  %s: %zu entries, %u forward passes of %u, %u backward passes of %u\n", name, n,
+                  c.forward_passes, r.forward_entries_per_pass(), c.backward_passes,
+                  r.backward_entries_per_pass());
     }
   }
 };
 
-TEST_F(RasterizerLongLists, OneTileCoveredBy100kGaussians) { check_one_tile(100'000); }
+TEST_F(RasterizerLongLists, OneTileCoveredBy100kGaussians) {
+  check_one_tile(100'000);
+}
 
-TEST_F(RasterizerLongLists, OneTileCoveredBy1MGaussians) { check_one_tile(1'000'000); }
+TEST_F(RasterizerLongLists, OneTileCoveredBy1MGaussians) {
+  check_one_tile(1'000'000);
+}
 
 // The loop-cost bound's worst case (every entry relevant to a subgroup) stays within the driver's limit.
 TEST_F(RasterizerLongLists, EveryEntryRelevantToASubgroupStaysWithinTheLoopLimit) {
@@ -253,7 +259,8 @@ TEST_F(RasterizerLongLists, MoreThan2To32IntersectionsIsAClearError) {
     r.forward(g, cam);
     FAIL() << "a render of " << expected_total << " intersections must not proceed";
   } catch (const std::length_error& e) {
-    EXPECT_NE(std::string(e.what()).find(expected_total + " tile intersections"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(expected_total + " tile intersections"), std::string::npos)
+        << e.what();
   }
 }
 

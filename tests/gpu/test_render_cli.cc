@@ -1,12 +1,12 @@
 // `litgs-engine render` end to end: a 3DGS PLY in, PNGs out, device and CPU reference agreeing; bad input
 // gets a clear message and a non-zero exit.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "io/gaussian_ply.h"
 #include "io/image.h"
@@ -38,7 +38,8 @@ class RenderCli : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("litgs-render-cli-" + std::to_string(::getpid()));
     fs::create_directories(dir_);
     io::write_gaussian_ply(dir_ / "model.ply", testing::random_scene(300, 1, 3, 5));
-    std::ofstream(dir_ / "camera.json") << R"({"width": 48, "height": 40, "fx": 48, "fy": 48, "cx": 24, "cy": 20,
+    std::ofstream(dir_ / "camera.json")
+        << R"({"width": 48, "height": 40, "fx": 48, "fy": 48, "cx": 24, "cy": 20,
       "q_cam_world": [1, 0, 0, 0], "t_cam_world": [0, 0, 0]})";
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -47,13 +48,13 @@ class RenderCli : public ::testing::Test {
 };
 
 TEST_F(RenderCli, DeviceAndReferenceAgree) {
-  const CommandResult device = run("render --model " + path("model.ply") + " --camera " + path("camera.json") + " --out " +
-                         path("device.png") + " --depth " + path("depth.png") + " --alpha " + path("alpha.png") +
-                         " --bit-depth 16");
+  const CommandResult device = run("render --model " + path("model.ply") + " --camera " +
+                                   path("camera.json") + " --out " + path("device.png") + " --depth " +
+                                   path("depth.png") + " --alpha " + path("alpha.png") + " --bit-depth 16");
   ASSERT_EQ(device.status, 0) << device.output;
-  const CommandResult reference = run("render --reference --model " + path("model.ply") + " --pose 1 0 0 0 0 0 0" +
-                            " --intrinsics 48 48 24 20 --width 48 --height 40 --out " + path("reference.png") +
-                            " --bit-depth 16");
+  const CommandResult reference = run(
+      "render --reference --model " + path("model.ply") + " --pose 1 0 0 0 0 0 0" +
+      " --intrinsics 48 48 24 20 --width 48 --height 40 --out " + path("reference.png") + " --bit-depth 16");
   ASSERT_EQ(reference.status, 0) << reference.output;
   EXPECT_EQ(device.output.find("validation"), std::string::npos) << device.output;
   const io::Image a = io::read_image(path("device.png")), b = io::read_image(path("reference.png"));
@@ -79,9 +80,10 @@ TEST_F(RenderCli, MissingCameraIsAClearError) {
 }
 
 TEST_F(RenderCli, CorruptModelIsAClearError) {
-  std::ofstream(path("bad.ply")) << "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n";
-  const CommandResult r = run("render --model " + path("bad.ply") + " --camera " + path("camera.json") + " --out " +
-                    path("x.png"));
+  std::ofstream(path("bad.ply"))
+      << "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n";
+  const CommandResult r = run("render --model " + path("bad.ply") + " --camera " + path("camera.json") +
+                              " --out " + path("x.png"));
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("bad.ply"), std::string::npos) << r.output;
 }

@@ -48,8 +48,8 @@ std::vector<uint32_t> random_values(size_t n, uint32_t max_value, uint32_t seed)
 TEST_F(ScanTest, Sizes) {
   const uint32_t s = kernels::subgroup_width(context());
   const uint32_t block = kernels::ExclusiveScan(context()).block_size();
-  for (size_t n : {size_t{0}, size_t{1}, size_t{s - 1}, size_t{s}, size_t{s + 1}, size_t{block - 1}, size_t{block},
-                   size_t{block + 1}, size_t{65537}, size_t{1000003}}) {
+  for (size_t n : {size_t{0}, size_t{1}, size_t{s - 1}, size_t{s}, size_t{s + 1}, size_t{block - 1},
+                   size_t{block}, size_t{block + 1}, size_t{65537}, size_t{1000003}}) {
     const auto input = random_values(n, 1000, static_cast<uint32_t>(n));
     EXPECT_EQ(device_scan(input), cpu_exclusive_scan(input)) << "n = " << n;
   }

@@ -14,7 +14,9 @@
 namespace litgs::testing {
 
 // The real-data folder (tests/data); a test that needs it fails (never skips) when it is missing.
-inline std::filesystem::path data_dir() { return test_data_dir(); }
+inline std::filesystem::path data_dir() {
+  return test_data_dir();
+}
 
 // A fresh directory under the system temp folder, removed after the test.
 class TempDirTest : public ::testing::Test {

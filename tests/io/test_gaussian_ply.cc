@@ -94,8 +94,8 @@ TEST_F(GaussianPlyTest, TruncatedFileIsAnError) {
 
 TEST_F(GaussianPlyTest, BadRestCountIsAnError) {
   std::string header = "ply\nformat ascii 1.0\nelement vertex 1\n";
-  for (const char* p : {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "f_rest_0", "f_rest_1", "opacity", "scale_0",
-                        "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
+  for (const char* p : {"x", "y", "z", "f_dc_0", "f_dc_1", "f_dc_2", "f_rest_0", "f_rest_1", "opacity",
+                        "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"})
     header += std::string("property float ") + p + "\n";
   const auto path = write_text("rest.ply", header + "end_header\n0 0 0 0 0 0 0 0 0 0 0 0 1 0 0 0\n");
   EXPECT_THROW(read_gaussian_ply(path), IoError);

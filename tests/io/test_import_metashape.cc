@@ -101,7 +101,6 @@ std::map<std::pair<int, int>, double> xml_reprojection_errors(const std::filesys
   return errors;
 }
 
-
 // The 8-bit frames (tests/data has all 45 of them; of the 16-bit TIFFs only 3, too few for an import).
 TEST_F(ImportMetashapeTest, ImportsDunrAndReadsItBack) {
   const auto data = testing::data_dir() / "thermitage-dunr";

@@ -158,8 +158,8 @@ GeoScene random_geo_scene(uint32_t seed) {
 void expect_geometric_gradient_matches_fd(double robust_scale) {
   SCOPED_TRACE("robust scale " + std::to_string(robust_scale));
   GeoScene s = random_geo_scene(3);
-  const auto r = geometric_loss_reference(s.depth, s.points, s.normals, s.w, s.h, s.fx, s.fy, s.cx, s.cy, s.valid,
-                                          robust_scale);
+  const auto r = geometric_loss_reference(s.depth, s.points, s.normals, s.w, s.h, s.fx, s.fy, s.cx, s.cy,
+                                          s.valid, robust_scale);
   const double step = 1e-6;
   double worst = 0.0, scale = 0.0;
   uint32_t counted = 0;

@@ -16,7 +16,8 @@ TEST(McmcMath, QuadratureMatchesThePapersAlternatingSumForSmallN) {
   for (uint32_t n = 1; n <= 8; ++n)
     for (double x : {0.005, 0.05, 0.3, 0.7, 0.95, 0.999}) {
       const double alt = mcmc_normalizer_alternating(x, n);
-      EXPECT_NEAR(mcmc_normalizer_reference(x, n), alt, 1e-10 * std::max(1.0, alt)) << "n " << n << " x " << x;
+      EXPECT_NEAR(mcmc_normalizer_reference(x, n), alt, 1e-10 * std::max(1.0, alt))
+          << "n " << n << " x " << x;
       // The kernels' coarser grid (step 0.1 to s = 6), still in double.
       EXPECT_NEAR(mcmc_math::stacked_opacity_integral(x, n, 0.1, 60u), alt, 1e-9 * std::max(1.0, alt))
           << "n " << n << " x " << x;
@@ -65,7 +66,8 @@ TEST(McmcMathHardCase, FiftyOneCopiesOfANearlyOpaqueGaussian) {
   for (uint32_t i = 1; i <= 51; ++i) {
     float binom = 1;
     for (uint32_t k = 0; k < i; ++k) {
-      const float term = binom * std::pow(static_cast<float>(x51), static_cast<float>(k + 1)) / std::sqrt(static_cast<float>(k + 1));
+      const float term = binom * std::pow(static_cast<float>(x51), static_cast<float>(k + 1)) /
+                         std::sqrt(static_cast<float>(k + 1));
       alt_f += (k % 2 == 0) ? term : -term;
       binom = binom * static_cast<float>(i - 1 - k) / static_cast<float>(k + 1);
     }

@@ -128,8 +128,8 @@ TEST_P(SplatReferenceFd, EveryParameterKind) {
 }
 
 INSTANTIATE_TEST_SUITE_P(ChannelsAndDegrees, SplatReferenceFd,
-                         ::testing::Values(std::make_pair(1u, 3u), std::make_pair(3u, 1u), std::make_pair(1u, 0u),
-                                           std::make_pair(2u, 2u)));
+                         ::testing::Values(std::make_pair(1u, 3u), std::make_pair(3u, 1u),
+                                           std::make_pair(1u, 0u), std::make_pair(2u, 2u)));
 
 TEST(SplatReference, MeanGradientWithIdentityPoseMatchesFd) {
   // The camera at the origin without rotation (the other FD tests use a rotated, offset camera); the

@@ -13,8 +13,8 @@ struct NpyArray {
   std::vector<size_t> shape;   // () for a scalar
   std::vector<uint8_t> bytes;  // raw little-endian data
   size_t element_count() const;
-  std::vector<float> as_float() const;    // from <f4, <f8, |u1 or <i8
-  int64_t as_scalar_int() const;          // a () or (1,) integer array
+  std::vector<float> as_float() const;  // from <f4, <f8, |u1 or <i8
+  int64_t as_scalar_int() const;        // a () or (1,) integer array
 };
 
 // Throws std::runtime_error naming the file and array when missing, truncated or of an unsupported kind.

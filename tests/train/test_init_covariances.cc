@@ -80,12 +80,15 @@ TEST(InitCovariances, CountMismatchIsAnError) {
 
 class CovariancePly : public ::testing::Test {
  protected:
-  void SetUp() override { path_ = fs::temp_directory_path() / ("litgs-init-cov-" + std::to_string(::getpid()) + ".ply"); }
+  void SetUp() override {
+    path_ = fs::temp_directory_path() / ("litgs-init-cov-" + std::to_string(::getpid()) + ".ply");
+  }
   void TearDown() override { fs::remove(path_); }
   void write(const std::string& properties, const std::vector<std::string>& rows) {
     std::ofstream f(path_);
     f << "ply\nformat ascii 1.0\nelement vertex " << rows.size() << "\nproperty float x\nproperty float y\n"
-      << "property float z\n" << properties << "end_header\n";
+      << "property float z\n"
+      << properties << "end_header\n";
     for (const auto& r : rows) f << r << "\n";
   }
   fs::path path_;

@@ -26,16 +26,17 @@ namespace fs = std::filesystem;
 // What the targets of one view ask of a render whose depth is the true one: per target, the residual r
 // against the true surface along the plane normal. A perfect render should feel no pull.
 struct TargetQuality {
-  size_t seen = 0;        // pixels that see a true plane
-  size_t valid = 0;       // pixels with a target
-  size_t off = 0;         // whose target misses the visible surface by more than 5 cm along the ray
-  size_t behind = 0;      // whose target lies more than 30 cm behind the visible surface (shows through)
-  double on_sq = 0;       // sum of r^2 over the others
-  double pull_sq = 0, pull_sq_off = 0;            // sum |d rho / dr| at the truth, squared loss: all, off
-  double pull_cauchy = 0, pull_cauchy_off = 0;    // the same with the Cauchy kernel (scale 5 cm)
+  size_t seen = 0;    // pixels that see a true plane
+  size_t valid = 0;   // pixels with a target
+  size_t off = 0;     // whose target misses the visible surface by more than 5 cm along the ray
+  size_t behind = 0;  // whose target lies more than 30 cm behind the visible surface (shows through)
+  double on_sq = 0;   // sum of r^2 over the others
+  double pull_sq = 0, pull_sq_off = 0;          // sum |d rho / dr| at the truth, squared loss: all, off
+  double pull_cauchy = 0, pull_cauchy_off = 0;  // the same with the Cauchy kernel (scale 5 cm)
   void add(const TargetQuality& o) {
     seen += o.seen, valid += o.valid, off += o.off, behind += o.behind, on_sq += o.on_sq;
-    pull_sq += o.pull_sq, pull_sq_off += o.pull_sq_off, pull_cauchy += o.pull_cauchy, pull_cauchy_off += o.pull_cauchy_off;
+    pull_sq += o.pull_sq, pull_sq_off += o.pull_sq_off, pull_cauchy += o.pull_cauchy,
+        pull_cauchy_off += o.pull_cauchy_off;
   }
 };
 
@@ -114,13 +115,14 @@ class FacadeTargets : public ::testing::Test {
 };
 
 void print(const char* what, const TargetQuality& q) {
-  std::printf("[ stats    ] %s: %zu targets (%.1f%% of the pixels that see a plane), %.2f%% off the visible surface "
-              "by > 5 cm (%zu behind it by > 30 cm), the rest %.1f mm RMS along the normal; share of the pull on a "
-              "true render from the off ones: squared %.3f, Cauchy %.3f\n",
-              what, q.valid, 100.0 * static_cast<double>(q.valid) / static_cast<double>(q.seen),
-              100.0 * static_cast<double>(q.off) / static_cast<double>(q.valid), q.behind,
-              1000 * std::sqrt(q.on_sq / static_cast<double>(q.valid - q.off)), q.pull_sq_off / q.pull_sq,
-              q.pull_cauchy_off / q.pull_cauchy);
+  std::printf(
+      "[ stats    ] %s: %zu targets (%.1f%% of the pixels that see a plane), %.2f%% off the visible surface "
+      "by > 5 cm (%zu behind it by > 30 cm), the rest %.1f mm RMS along the normal; share of the pull on a "
+      "true render from the off ones: squared %.3f, Cauchy %.3f\n",
+      what, q.valid, 100.0 * static_cast<double>(q.valid) / static_cast<double>(q.seen),
+      100.0 * static_cast<double>(q.off) / static_cast<double>(q.valid), q.behind,
+      1000 * std::sqrt(q.on_sq / static_cast<double>(q.valid - q.off)), q.pull_sq_off / q.pull_sq,
+      q.pull_cauchy_off / q.pull_cauchy);
 }
 
 TEST_F(FacadeTargets, DiscsCoverTheSurfacesAndHideWhatLiesBehind) {

@@ -20,7 +20,9 @@ namespace {
 
 namespace fs = std::filesystem;
 // Throws (the suite fails, naming the path) when the data is missing.
-fs::path dunr() { return testing::test_data("thermitage-dunr"); }
+fs::path dunr() {
+  return testing::test_data("thermitage-dunr");
+}
 
 class DunrScene : public ::testing::Test {
  protected:
