@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "engine/sequence.h"
+#include "kernels/device_growth.h"
 
 namespace litgs::host {
 
@@ -33,9 +34,7 @@ void Refinement::after_step(kernels::TrainableGaussians& model, kernels::McmcStr
       // Only the means come back to the host, and the distance buffer is reused while it is large enough.
       const engine::DeviceArray<float>& means = model.gaussians().means;
       const std::vector<float> d = plane_index_->distances(means.download(0, 3 * model.size()));
-      if (!plane_distances_ || plane_distances_->size() < d.size())
-        plane_distances_ = std::make_unique<engine::DeviceArray<float>>(
-            *context_, "train: plane distances", std::max<size_t>(d.size() + d.size() / 2, 1));
+      kernels::grow(*context_, plane_distances_, d.size(), "train: plane distances");
       plane_distances_->upload(d);
       plane_distance = &plane_distances_->buffer();
       step_options.max_plane_distance_m = PlaneDistance::robust_bound(d, o.plane_prune_k);

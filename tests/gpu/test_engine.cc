@@ -79,8 +79,8 @@ TEST_F(EngineTest, UnknownShaderIsNamed) {
 }
 
 TEST_F(EngineTest, DispatchChecksBindingsAndPushConstants) {
-  auto kernel =
-      kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
+  auto kernel = kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", SCAN_DOWNSWEEP_BINDING_COUNT,
+                                              sizeof(kernels::ScanParams));
   engine::DeviceArray<uint32_t> a(context(), "a", 16);
   engine::Sequence seq(context());
   kernels::ScanParams params{16, 16, 0, 0};
@@ -99,8 +99,8 @@ TEST_F(EngineTest, DispatchChecksBindingsAndPushConstants) {
 }
 
 TEST_F(EngineTest, BarriersOnlyWhereHazardsAre) {
-  auto kernel =
-      kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
+  auto kernel = kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", SCAN_DOWNSWEEP_BINDING_COUNT,
+                                              sizeof(kernels::ScanParams));
   engine::DeviceArray<uint32_t> a(context(), "a", 64), b(context(), "b", 64),
       offsets(context(), "offsets", 1);
   std::vector<uint32_t> ones(64, 1u);
@@ -131,8 +131,8 @@ TEST_F(EngineTest, BarriersOnlyWhereHazardsAre) {
 }
 
 TEST_F(EngineTest, SequenceReplays) {
-  auto kernel =
-      kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", 2, sizeof(kernels::ScanParams));
+  auto kernel = kernels::make_subgroup_kernel(context(), "scan/scan_downsweep", SCAN_DOWNSWEEP_BINDING_COUNT,
+                                              sizeof(kernels::ScanParams));
   engine::DeviceArray<uint32_t> a(context(), "a", 8), offsets(context(), "offsets", 1);
   engine::Sequence seq(context());
   seq.dispatch(*kernel, {1}, {{0, &a.buffer(), Access::kReadWrite}, {1, &offsets.buffer(), Access::kRead}},
