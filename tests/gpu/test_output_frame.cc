@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "engine_cli.h"
 #include "gpu_test.h"
 #include "host/synth/synth.h"
 #include "host/train/checkpoint.h"
@@ -31,6 +32,7 @@
 #include "io/scene.h"
 #include "io/scene_yaml.h"
 #include "kernels/optim/trainable_gaussians.h"
+#include "small_training_scene.h"
 #include "splat_scenes.h"
 
 namespace litgs {
@@ -38,20 +40,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-  int status;
-  std::string output;
-};
-
-CommandResult run_engine(const std::string& args) {
-  const std::string cmd = std::string(LITGS_ENGINE_BINARY) + " " + args + " 2>&1";
-  CommandResult r{0, ""};
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[512];
-  while (fgets(buf, sizeof buf, pipe)) r.output += buf;
-  r.status = pclose(pipe);
-  return r;
-}
+using testing::CommandResult;
+using testing::run_engine;
 
 // A render as render --bit-depth 16 writes it: [0, 1] clamped, times 65535, rounded.
 std::vector<int> quantized(const std::vector<float>& image) {
@@ -79,43 +69,16 @@ Difference difference(const std::vector<int>& a, const io::Image& b) {
   return d;
 }
 
-class OutputFrameTest : public testing::GpuTest {
+class OutputFrameTest : public testing::SmallTrainingSceneTest {
  protected:
   static void SetUpTestSuite() {
-    testing::GpuTest::SetUpTestSuite();
-    root_ = fs::temp_directory_path() / ("litgs-output-frame-" + std::to_string(::getpid()));
-    fs::remove_all(root_);
-    host::synth::SynthOptions s;
-    s.frames = 12;
-    s.width = 64;
-    s.height = 48;
-    s.out = root_ / "scene";
-    host::synth::generate_synthetic_scene(s);
-    // The synthetic scene as if it had been recentred from a survey frame far from the origin (like DUNR's,
-    // near 1000 m): only the stated offset changes, every stored position stays as it is.
-    io::SceneConfig config = io::read_scene_yaml(root_ / "scene" / "scene.yaml");
-    config.world_offset_m = kOffset;
-    io::write_scene_yaml(root_ / "scene" / "scene.yaml", config);
-
-    host::TrainingDataOptions d;
-    d.holdout_every = 4;
-    data_ = new host::TrainingData(host::load_training_data(root_ / "scene", d));
-    const io::Scene scene = io::read_scene(root_ / "scene");
-    std::vector<Eigen::Vector3d> pts = scene.map->positions;
-    planes_ = new host::PlanarMap(host::fit_planes(pts, host::PlaneFitOptions{}));
-    std::mt19937 rng(1);
-    std::shuffle(pts.begin(), pts.end(), rng);
-    pts.resize(3000);
-    host::InitOptions init;
-    init.sh_degree = 1;
-    initial_ = new kernels::GaussianModel(host::init_from_points(pts, *data_, init));
-  }
-  static void TearDownTestSuite() {
-    delete data_;
-    delete planes_;
-    delete initial_;
-    fs::remove_all(root_);
-    testing::GpuTest::TearDownTestSuite();
+    set_up_scene("litgs-output-frame", [](const fs::path& dir) {
+      // The synthetic scene as if it had been recentred from a survey frame far from the origin (like DUNR's,
+      // near 1000 m): only the stated offset changes, every stored position stays as it is.
+      io::SceneConfig config = io::read_scene_yaml(dir / "scene.yaml");
+      config.world_offset_m = kOffset;
+      io::write_scene_yaml(dir / "scene.yaml", config);
+    });
   }
 
   // 30 iterations (SH degree 1 active from 20, so the evaluation and the PLY use the same degree), refinement
@@ -178,10 +141,6 @@ class OutputFrameTest : public testing::GpuTest {
   }
 
   static inline const Eigen::Vector3d kOffset{1000.25, -2000.5, 30.125};
-  static inline fs::path root_;
-  static inline host::TrainingData* data_ = nullptr;
-  static inline host::PlanarMap* planes_ = nullptr;
-  static inline kernels::GaussianModel* initial_ = nullptr;
 };
 
 TEST_F(OutputFrameTest, PlyInTheOriginalFrameRendersAtPosesTxtTimesLikeTheEvaluation) {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <string>
 
+#include "engine_cli.h"
 #include "io/gaussian_ply.h"
 #include "io/image.h"
 #include "splat_scenes.h"
@@ -17,20 +18,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CommandResult {
-  int status;
-  std::string output;
-};
-
-CommandResult run(const std::string& args) {
-  const std::string cmd = std::string(LITGS_ENGINE_BINARY) + " " + args + " 2>&1";
-  CommandResult r{0, ""};
-  FILE* pipe = popen(cmd.c_str(), "r");
-  char buf[512];
-  while (fgets(buf, sizeof buf, pipe)) r.output += buf;
-  r.status = pclose(pipe);
-  return r;
-}
+using testing::CommandResult;
+using testing::run_engine;
 
 class RenderCli : public ::testing::Test {
  protected:
@@ -48,11 +37,12 @@ class RenderCli : public ::testing::Test {
 };
 
 TEST_F(RenderCli, DeviceAndReferenceAgree) {
-  const CommandResult device = run("render --model " + path("model.ply") + " --camera " +
-                                   path("camera.json") + " --out " + path("device.png") + " --depth " +
-                                   path("depth.png") + " --alpha " + path("alpha.png") + " --bit-depth 16");
+  const CommandResult device =
+      run_engine("render --model " + path("model.ply") + " --camera " + path("camera.json") + " --out " +
+                 path("device.png") + " --depth " + path("depth.png") + " --alpha " + path("alpha.png") +
+                 " --bit-depth 16");
   ASSERT_EQ(device.status, 0) << device.output;
-  const CommandResult reference = run(
+  const CommandResult reference = run_engine(
       "render --reference --model " + path("model.ply") + " --pose 1 0 0 0 0 0 0" +
       " --intrinsics 48 48 24 20 --width 48 --height 40 --out " + path("reference.png") + " --bit-depth 16");
   ASSERT_EQ(reference.status, 0) << reference.output;
@@ -73,7 +63,7 @@ TEST_F(RenderCli, DeviceAndReferenceAgree) {
 }
 
 TEST_F(RenderCli, MissingCameraIsAClearError) {
-  const CommandResult r = run("render --model " + path("model.ply") + " --out " + path("x.png"));
+  const CommandResult r = run_engine("render --model " + path("model.ply") + " --out " + path("x.png"));
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("--camera"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(path("x.png")));
@@ -82,8 +72,8 @@ TEST_F(RenderCli, MissingCameraIsAClearError) {
 TEST_F(RenderCli, CorruptModelIsAClearError) {
   std::ofstream(path("bad.ply"))
       << "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n";
-  const CommandResult r = run("render --model " + path("bad.ply") + " --camera " + path("camera.json") +
-                              " --out " + path("x.png"));
+  const CommandResult r = run_engine("render --model " + path("bad.ply") + " --camera " +
+                                     path("camera.json") + " --out " + path("x.png"));
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("bad.ply"), std::string::npos) << r.output;
 }

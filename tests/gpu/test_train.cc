@@ -24,6 +24,7 @@
 #include "host/train/training_data.h"
 #include "io/gaussian_ply.h"
 #include "io/scene.h"
+#include "small_training_scene.h"
 
 namespace litgs {
 namespace {
@@ -34,38 +35,9 @@ bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
 }
 
-class TrainTest : public testing::GpuTest {
+class TrainTest : public testing::SmallTrainingSceneTest {
  protected:
-  static void SetUpTestSuite() {
-    testing::GpuTest::SetUpTestSuite();
-    root_ = fs::temp_directory_path() / ("litgs-train-test-" + std::to_string(::getpid()));
-    fs::remove_all(root_);
-    host::synth::SynthOptions s;
-    s.frames = 12;
-    s.width = 64;
-    s.height = 48;
-    s.out = root_ / "scene";
-    host::synth::generate_synthetic_scene(s);
-    host::TrainingDataOptions d;
-    d.holdout_every = 4;
-    data_ = new host::TrainingData(host::load_training_data(root_ / "scene", d));
-    const io::Scene scene = io::read_scene(root_ / "scene");
-    std::vector<Eigen::Vector3d> pts = scene.map->positions;
-    planes_ = new host::PlanarMap(host::fit_planes(pts, host::PlaneFitOptions{}));
-    std::mt19937 rng(1);
-    std::shuffle(pts.begin(), pts.end(), rng);
-    pts.resize(3000);
-    host::InitOptions init;
-    init.sh_degree = 1;
-    initial_ = new kernels::GaussianModel(host::init_from_points(pts, *data_, init));
-  }
-  static void TearDownTestSuite() {
-    delete data_;
-    delete planes_;
-    delete initial_;
-    fs::remove_all(root_);
-    testing::GpuTest::TearDownTestSuite();
-  }
+  static void SetUpTestSuite() { set_up_scene("litgs-train-test"); }
 
   static host::TrainOptions small_run(uint32_t iterations) {
     host::TrainOptions o;
@@ -168,11 +140,6 @@ class TrainTest : public testing::GpuTest {
           &kernels::GaussianModel::opacity_logits, &kernels::GaussianModel::sh})
       EXPECT_TRUE(same_bits(resumed.*member, straight.*member));
   }
-
-  static inline fs::path root_;
-  static inline host::TrainingData* data_ = nullptr;
-  static inline host::PlanarMap* planes_ = nullptr;
-  static inline kernels::GaussianModel* initial_ = nullptr;
 };
 
 TEST_F(TrainTest, TruePosesPlaceTheCamerasAtTheGroundTruth) {

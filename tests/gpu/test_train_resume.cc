@@ -24,6 +24,7 @@
 #include "host/train/training_data.h"
 #include "io/gaussian_ply.h"
 #include "io/scene.h"
+#include "small_training_scene.h"
 
 namespace litgs {
 namespace host {
@@ -48,38 +49,9 @@ nlohmann::json read_json(const fs::path& path) {
   return nlohmann::json::parse(in);
 }
 
-class TrainResumeTest : public testing::GpuTest {
+class TrainResumeTest : public testing::SmallTrainingSceneTest {
  protected:
-  static void SetUpTestSuite() {
-    testing::GpuTest::SetUpTestSuite();
-    root_ = fs::temp_directory_path() / ("litgs-train-resume-" + std::to_string(::getpid()));
-    fs::remove_all(root_);
-    host::synth::SynthOptions s;
-    s.frames = 12;
-    s.width = 64;
-    s.height = 48;
-    s.out = root_ / "scene";
-    host::synth::generate_synthetic_scene(s);
-    host::TrainingDataOptions d;
-    d.holdout_every = 4;
-    data_ = new host::TrainingData(host::load_training_data(root_ / "scene", d));
-    const io::Scene scene = io::read_scene(root_ / "scene");
-    std::vector<Eigen::Vector3d> pts = scene.map->positions;
-    planes_ = new host::PlanarMap(host::fit_planes(pts, host::PlaneFitOptions{}));
-    std::mt19937 rng(1);
-    std::shuffle(pts.begin(), pts.end(), rng);
-    pts.resize(3000);
-    host::InitOptions init;
-    init.sh_degree = 1;
-    initial_ = new kernels::GaussianModel(host::init_from_points(pts, *data_, init));
-  }
-  static void TearDownTestSuite() {
-    delete data_;
-    delete planes_;
-    delete initial_;
-    fs::remove_all(root_);
-    testing::GpuTest::TearDownTestSuite();
-  }
+  static void SetUpTestSuite() { set_up_scene("litgs-train-resume"); }
 
   // 40 iterations, a checkpoint and an evaluation every 10, refinement at 20 and 30.
   static host::TrainOptions options() {
@@ -124,11 +96,6 @@ class TrainResumeTest : public testing::GpuTest {
   }
 
   static fs::path out(const std::string& name) { return root_ / name; }
-
-  static inline fs::path root_;
-  static inline host::TrainingData* data_ = nullptr;
-  static inline host::PlanarMap* planes_ = nullptr;
-  static inline kernels::GaussianModel* initial_ = nullptr;
 };
 
 // Everything in metrics.json but the timings must match between an uninterrupted run and a resumed one.
