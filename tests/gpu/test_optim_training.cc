@@ -16,21 +16,20 @@
 namespace litgs::kernels {
 namespace {
 
-class TrainingSmokeTest : public testing::GpuTest {};
-
-TEST_F(TrainingSmokeTest, FiftyAdamStepsReduceAnImageLoss) {
-  const uint32_t W = 64, H = 48;
-  SplatCamera camera = testing::camera_looking_down_z(W, H);
-  camera.sh_degree = 1;
-  const GaussianModel target_model = testing::random_scene(150, 1, 1, 31);
-  Rasterizer raster(context(), 1);
-  std::vector<float> target;
-  {
-    DeviceGaussians target_gaussians(context(), target_model);
-    raster.forward(target_gaussians, camera);
-    target = raster.download_images().image;
+class TrainingSmokeTest : public testing::GpuTest {
+ protected:
+  // The image the model renders from the camera: the target the smoke tests fit.
+  std::vector<float> render(const GaussianModel& model, const SplatCamera& camera) {
+    Rasterizer raster(context(), model.channels);
+    DeviceGaussians gaussians(context(), model);
+    raster.forward(gaussians, camera);
+    return raster.download_images().image;
   }
-  GaussianModel start = target_model;
+};
+
+// The target model with its means, colours and opacities disturbed (seeded): where training starts.
+GaussianModel disturbed(const GaussianModel& target) {
+  GaussianModel start = target;
   std::mt19937 rng(5);
   std::normal_distribution<float> normal(0.0f, 1.0f);
   for (auto& x : start.means) x += 0.05f * normal(rng);
@@ -38,6 +37,17 @@ TEST_F(TrainingSmokeTest, FiftyAdamStepsReduceAnImageLoss) {
     start.sh[i * start.sh_coeffs()] += 0.3f * normal(rng);
     start.opacity_logits[i] += 0.5f * normal(rng);
   }
+  return start;
+}
+
+TEST_F(TrainingSmokeTest, FiftyAdamStepsReduceAnImageLoss) {
+  const uint32_t W = 64, H = 48;
+  SplatCamera camera = testing::camera_looking_down_z(W, H);
+  camera.sh_degree = 1;
+  const GaussianModel target_model = testing::random_scene(150, 1, 1, 31);
+  Rasterizer raster(context(), 1);
+  const std::vector<float> target = render(target_model, camera);
+  const GaussianModel start = disturbed(target_model);
   TrainableGaussians model(context(), start);
   const AdamOptions& adam = model.adam_options();
   const float extent = 5.0f;
@@ -149,21 +159,8 @@ TEST_F(TrainingSmokeTest, NonFiniteRowsAreCountedSkippedAndPrunedWhileTheRestTra
   SplatCamera camera = testing::camera_looking_down_z(W, H);
   camera.sh_degree = 1;
   const GaussianModel target_model = testing::random_scene(150, 1, 1, 31);
-  std::vector<float> target;
-  {
-    Rasterizer raster(context(), 1);
-    DeviceGaussians target_gaussians(context(), target_model);
-    raster.forward(target_gaussians, camera);
-    target = raster.download_images().image;
-  }
-  GaussianModel clean = target_model;
-  std::mt19937 rng(5);
-  std::normal_distribution<float> normal(0.0f, 1.0f);
-  for (auto& x : clean.means) x += 0.05f * normal(rng);
-  for (size_t i = 0; i < clean.size(); ++i) {
-    clean.sh[i * clean.sh_coeffs()] += 0.3f * normal(rng);
-    clean.opacity_logits[i] += 0.5f * normal(rng);
-  }
+  const std::vector<float> target = render(target_model, camera);
+  const GaussianModel clean = disturbed(target_model);
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   GaussianModel bad = clean;
   const size_t n = clean.size(), k = clean.sh_coeffs();
