@@ -20,6 +20,7 @@
 #include <stdexcept>
 
 #include "engine/context.h"
+#include "host/train/level_plan.h"
 #include "host/train/output_frame.h"
 #include "host/train/training_data.h"
 #include "io/gaussian_ply.h"
@@ -50,7 +51,37 @@ struct RenderOptions {
   double downscale = 1.0;           // --time: the training resolution (train's --downscale)
   std::string poses = "estimated";  // --time: estimated (poses.txt) | truth (gt/poses.txt)
   std::string pose_frame = "auto";  // auto | scene | original | model (see the top of this file)
+  std::string levels;               // train's levels.json: the level of --time, and the stretch for --counts
+  bool counts = false;              // 16-bit raw counts (the inverse of the stretch) instead of [0, 1] scaled
 };
+
+// Before anything is rendered: --levels and --counts need their companions.
+void check_level_options(const RenderOptions& o) {
+  if (o.counts && o.levels.empty())
+    throw std::invalid_argument("--counts needs --levels (train's levels.json holds the stretch window)");
+  if (o.counts && o.bit_depth != 16)
+    throw std::invalid_argument("--counts writes 16-bit raw counts: give --bit-depth 16");
+  if (!o.levels.empty() && o.time.empty())
+    throw std::invalid_argument("--levels applies the level of a scene time: give --scene and --time");
+}
+
+// The level of --time from train's levels.json applied to the render (x' = g v x + o), and with --counts the
+// values turned back into the raw frames' counts: low + x' (high - low). Returns the scale to_image takes.
+double level_and_counts(const RenderOptions& o, const kernels::SplatCamera& camera,
+                        std::vector<float>& image) {
+  if (o.levels.empty()) return o.bit_depth == 16 ? 65535.0 : 255.0;
+  const host::LevelTable table = host::read_level_table(o.levels);
+  const kernels::LevelGeometry g{camera.width, camera.height, 1, static_cast<float>(camera.cx),
+                                 static_cast<float>(camera.cy)};
+  if (image.size() != size_t{camera.width} * camera.height)
+    throw std::invalid_argument("--levels: the level model is for one-channel (thermal) models");
+  image = host::apply_level(image, g, table.at_time(std::stod(o.time)), table.vignetting());
+  if (!o.counts) return o.bit_depth == 16 ? 65535.0 : 255.0;
+  // to_image scales [0, 1]: shift to counts first, then scale by 1.
+  for (float& v : image)
+    v = static_cast<float>(table.stretch_low + v * (table.stretch_high - table.stretch_low));
+  return 1.0;
+}
 
 glm::dmat3 rotation_from_quat(double w, double x, double y, double z) {
   const double n = std::sqrt(w * w + x * x + y * y + z * z);
@@ -143,6 +174,7 @@ void run_render(const RenderOptions& o) {
                                 "'");
   if (!o.time.empty() && o.scene.empty())
     throw std::invalid_argument("--time needs --scene (the scene's cameras)");
+  check_level_options(o);
   std::optional<io::Scene> scene;
   if (!o.scene.empty()) {
     io::SceneReadOptions read;
@@ -219,7 +251,7 @@ void run_render(const RenderOptions& o) {
     culled = r.culled_nonfinite;
     walks_cut = r.walks_cut_short;
   }
-  const double full = o.bit_depth == 16 ? 65535.0 : 255.0;
+  const double full = level_and_counts(o, camera, image);
   io::write_image(o.out, to_image(image, camera.width, camera.height, model.channels, o.bit_depth, full));
   if (!o.depth_out.empty())
     io::write_image(o.depth_out, to_image(depth, camera.width, camera.height, 1, 16, o.depth_scale));
@@ -276,6 +308,11 @@ void add_render_command(CLI::App& app) {
          "Frame of --pose/--camera: scene (poses.txt's; the default when the scene is known), original "
          "(original world), model (the PLY's coordinates; the default otherwise)")
       ->capture_default_str();
+  cmd->add_option("--levels", o->levels,
+                  "train's levels.json: apply the level of --time (interpolated between training frames)")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--counts", o->counts,
+                "With --levels and --bit-depth 16: write raw counts (the inverse of training's stretch)");
   cmd->callback([o] { run_render(*o); });
 }
 

@@ -1,5 +1,5 @@
-// `litgs-engine synth --preset NAME --out DIR [--seed S] [--frames N] [--width W --height H] [--force]`:
-// a synthetic scene directory with exact ground truth (docs/scene-format.md). CPU only.
+// `litgs-engine synth --preset NAME --out DIR [--seed S] [--frames N] [--width W --height H] [--force]
+// [--drift]`: a synthetic scene directory with exact ground truth (docs/scene-format.md). CPU only.
 #include <CLI/CLI.hpp>
 #include <iomanip>
 #include <iostream>
@@ -26,6 +26,9 @@ void add_synth_command(CLI::App& app) {
   CLI::Option* w = synth->add_option("--width", *width, "Image width in pixels (default 320)");
   CLI::Option* h = synth->add_option("--height", *height, "Image height in pixels (default 256)");
   synth->add_flag("--force", o->force, "Replace the scene files in a non-empty --out");
+  synth->add_flag("--drift", o->drift,
+                  "A known sensor level drift (slow gain and offset warm-up, an offset jump at the first NUC "
+                  "freeze) in the raw frames; the truth in gt/levels.txt");
   synth->add_option("--threads", o->threads, "Worker threads (0: all cores, at most 8)")
       ->capture_default_str();
   synth->callback([o, frames, width, height, f, w, h] {

@@ -176,9 +176,13 @@ void run_train(TrainCliOptions o) {
   if (tty) std::cout << "\n";
   std::cout << "train: " << r.iterations << " iterations in " << r.wall_s << " s (" << r.ms_per_iteration
             << " ms/iteration), " << r.gaussians << " Gaussians; held-out PSNR " << r.final_eval.psnr_db
-            << " dB, SSIM " << r.final_eval.ssim << "; wrote " << o.out << "/point_cloud.ply ("
+            << " dB, SSIM " << r.final_eval.ssim << ", MAE " << r.final_eval.mae_counts << " counts";
+  if (r.final_eval.leveled)
+    std::cout << " (at interpolated levels; at identity " << r.final_eval.psnr_identity_db << " dB, "
+              << r.final_eval.mae_counts_identity << " counts)";
+  std::cout << "; wrote " << o.out << "/point_cloud.ply ("
             << (o.train.recentred_output ? "recentred scene frame" : "original world frame")
-            << ") and metrics.json\n";
+            << "), levels.json and metrics.json\n";
   if (r.counters.any_anomaly())
     std::cout << "train: counters:" << anomaly_text(r.counters) << " (metrics.json)\n";
 }
@@ -257,6 +261,24 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--opacity-reset-every", o->train.opacity_reset_every, "Opacity reset cadence")
       ->capture_default_str();
   cmd->add_option("--progress-every", o->train.progress_every, "Progress cadence")->capture_default_str();
+  cmd->add_option("--level-model", o->train.level_model,
+                  "Radiometric level per frame, learnt with the map: none, affine (gain and offset per "
+                  "frame) or affine-vignetting (and a vignetting shared by all frames)")
+      ->check(CLI::IsMember({"none", "affine", "affine-vignetting"}))
+      ->capture_default_str();
+  cmd->add_option("--level-lr-gain", o->train.level_lr_log_gain, "Level model: Adam rate of the log-gains")
+      ->capture_default_str();
+  cmd->add_option("--level-lr-offset", o->train.level_lr_offset, "Level model: Adam rate of the offsets")
+      ->capture_default_str();
+  cmd->add_option("--level-lr-vignetting", o->train.level_lr_vignetting,
+                  "Level model: Adam rate of the vignetting")
+      ->capture_default_str();
+  cmd->add_option("--level-lambda-identity", o->train.level_lambda_identity,
+                  "Level model: weight of the pull toward identity")
+      ->capture_default_str();
+  cmd->add_option("--level-lambda-smooth", o->train.level_lambda_smooth,
+                  "Level model: weight of the pull toward the neighbouring frames' level")
+      ->capture_default_str();
   cmd->callback([o] { run_train(*o); });
 }
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "host/synth/level_drift.h"
 #include "host/synth/presets.h"
 #include "io/atomic_file.h"
 #include "io/scene.h"
@@ -179,7 +180,8 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   c.has_lidar_map = true;
   std::ostringstream source;
   source << "synthetic: litgs-engine synth --preset " << p.name << " --seed " << options.seed << " --frames "
-         << n << " --width " << K.width << " --height " << K.height << " (" << p.description << ")";
+         << n << " --width " << K.width << " --height " << K.height << (options.drift ? " --drift" : "")
+         << " (" << p.description << ")";
   c.source = source.str();
 
   // Ground truth that the io reader does not know: written first, scene.yaml still comes last.
@@ -206,8 +208,26 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
     while (f > 0 && frozen.count(f)) --f;
     return f;
   };
+  // The level drift (SynthOptions::drift): a frozen frame repeats its source frame's bytes, drift included.
+  std::vector<LevelDrift> drift;
+  if (options.drift) {
+    std::vector<double> times;
+    for (const auto& f : scene.frames) times.push_back(f.t_s);
+    size_t first_after_freeze = times.size();
+    if (!frozen.empty()) {
+      int f = *frozen.begin();
+      while (frozen.count(f)) ++f;
+      first_after_freeze = static_cast<size_t>(f);
+    }
+    drift = level_drift(times, first_after_freeze);
+    for (const int f : frozen) drift[static_cast<size_t>(f)] = drift[static_cast<size_t>(source_of(f))];
+    write_level_drift(out / "gt/levels.txt", times, drift);
+  }
   auto render = [&](int f) {
-    return render_thermal(p.world, p.camera, T_world_cam[f], options.seed, static_cast<uint64_t>(f), threads);
+    io::Image raw =
+        render_thermal(p.world, p.camera, T_world_cam[f], options.seed, static_cast<uint64_t>(f), threads);
+    if (!drift.empty()) apply_level_drift(raw, drift[static_cast<size_t>(f)]);
+    return raw;
   };
   io::Image current;
   int current_source = -1, next_source = -1;

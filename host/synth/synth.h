@@ -17,6 +17,9 @@ struct SynthOptions {
   std::filesystem::path out;         // the scene directory to write
   bool force = false;                // replace the scene files in a non-empty `out`
   int threads = 0;                   // worker threads; 0: the hardware's (at most 8)
+  // A known level drift of the raw counts (host/synth/level_drift.h): a slow warm-up in gain and offset and
+  // a jump at the first NUC freeze; the true per-frame gain and offset go to gt/levels.txt.
+  bool drift = false;
 
   // Empty if valid, else the first bad field and why (std::invalid_argument from generate_* carries it).
   std::string check() const;

@@ -6,12 +6,14 @@
 
 #include "io/atomic_file.h"
 #include "io/error.h"
+#include "kernels/level/level_shared.h"
 
 namespace litgs::host {
 namespace {
 
 constexpr char kMagicV1[8] = {'L', 'I', 'T', 'G', 'S', 'C', 'K', '1'};  // without the run record
-constexpr char kMagic[8] = {'L', 'I', 'T', 'G', 'S', 'C', 'K', '2'};
+constexpr char kMagicV2[8] = {'L', 'I', 'T', 'G', 'S', 'C', 'K', '2'};  // without the level state
+constexpr char kMagic[8] = {'L', 'I', 'T', 'G', 'S', 'C', 'K', '3'};
 
 template <class T>
 void put(std::ostream& out, const T& v) {
@@ -76,6 +78,7 @@ void write_checkpoint(const std::filesystem::path& path, const Checkpoint& c) {
     put_vector(out, c.state.max_radius);
     const std::string record = to_json(c.record).dump();
     put_vector(out, std::vector<char>(record.begin(), record.end()));
+    put_vector(out, c.level_state);
   });
 }
 
@@ -106,10 +109,11 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) io::fail(path, 0, "cannot open the checkpoint");
   const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const bool v1 =
-      bytes.size() >= sizeof kMagicV1 && std::memcmp(bytes.data(), kMagicV1, sizeof kMagicV1) == 0;
-  if (!v1 && (bytes.size() < sizeof kMagic || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0))
-    io::fail_at_byte(path, 0, "not a LIT-GS checkpoint (bad magic)");
+  auto magic_is = [&](const char* magic) {
+    return bytes.size() >= sizeof kMagic && std::memcmp(bytes.data(), magic, sizeof kMagic) == 0;
+  };
+  const bool v1 = magic_is(kMagicV1), v2 = magic_is(kMagicV2);
+  if (!v1 && !v2 && !magic_is(kMagic)) io::fail_at_byte(path, 0, "not a LIT-GS checkpoint (bad magic)");
   Reader r{path, bytes, sizeof kMagic};
   Checkpoint c;
   c.iteration = r.get<uint32_t>();
@@ -142,6 +146,13 @@ Checkpoint read_checkpoint(const std::filesystem::path& path) {
     } catch (const nlohmann::json::exception& e) {
       io::fail_at_byte(path, record_at, std::string("bad run record: ") + e.what());
     }
+  }
+  if (!v1 && !v2) {
+    c.level_state = r.get_vector<float>();
+    if (c.level_state.size() % LEVEL_STRIDE != 0 || c.level_state.size() == LEVEL_STRIDE)
+      io::fail_at_byte(path, r.at,
+                       "level state of " + std::to_string(c.level_state.size()) +
+                           " values is not whole rows of frames and the shared row");
   }
   if (r.at != bytes.size()) io::fail_at_byte(path, r.at, "trailing bytes after the checkpoint");
   try {

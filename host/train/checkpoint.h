@@ -3,8 +3,10 @@
 // evaluations, counters and earlier resumes: the run record). One binary file, written atomically; the model
 // is in the scene's recentred frame, as training sees it.
 //
-// Format 2 ("LITGSCK2"): format 1's fields, then the run record as JSON text (run_record.h). Format 1
-// ("LITGSCK1", before run records) is still read: its record is empty and `has_record` false.
+// Format 3 ("LITGSCK3"): format 2's fields, then the level model's state (kernels/level/level_shared.h;
+// empty without a level model). Format 2 ("LITGSCK2"): format 1's fields, then the run record as JSON text
+// (run_record.h). Formats 1 ("LITGSCK1", before run records; its record is empty and `has_record` false)
+// and 2 are still read, with an empty level state.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +26,7 @@ struct Checkpoint {
   std::string rng_state;             // std::mt19937 state as text (operator<<)
   kernels::TrainingState state;
   RunRecord record;
+  std::vector<float> level_state;  // [frames + 1][LEVEL_STRIDE]; empty without a level model
   bool has_record = true;  // false: read from a format-1 file (no options, evaluations or counters stored)
 };
 

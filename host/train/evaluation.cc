@@ -13,13 +13,24 @@ Evaluator::Evaluator(const TrainingData& data, const TrainOptions& o, const Plan
     if (data.views[i].heldout) views_.push_back(i);
 }
 
+namespace {
+double mean_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
+  double s = 0;
+  for (size_t i = 0; i < a.size(); ++i) s += std::abs(static_cast<double>(a[i]) - b[i]);
+  return a.empty() ? 0.0 : s / static_cast<double>(a.size());
+}
+}  // namespace
+
 EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32_t iteration,
-                               std::vector<kernels::RenderImages<float>>* renders) {
+                               std::vector<kernels::RenderImages<float>>* renders, const LevelTable* levels) {
   if (renders) renders->clear();
   const uint32_t W = data_->width, H = data_->height;
   EvalResult e;
   e.iteration = iteration;
   if (views_.empty()) return e;
+  e.mae_counts = 0;
+  e.leveled = levels != nullptr;
+  if (levels) e.mae_counts_identity = 0;
   double plane_sq = 0;
   size_t plane_n = 0;
   for (uint32_t i : views_) {
@@ -27,8 +38,21 @@ EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32
     cam.sh_degree = options_->active_sh_degree(iteration);
     rasterizer_->forward(gaussians, cam);
     const auto img = rasterizer_->download_images();
-    e.psnr_db += kernels::psnr(img.image, data_->views[i].image);
-    e.ssim += kernels::ssim_reference(img.image, data_->views[i].image, 1, W, H);
+    const std::vector<float>& target = data_->views[i].image;
+    const double counts = data_->stretch_high - data_->stretch_low;
+    if (levels) {
+      const kernels::LevelGeometry g{W, H, 1, static_cast<float>(cam.cx), static_cast<float>(cam.cy)};
+      const std::vector<float> leveled = apply_level(img.image, g, levels->values(i), levels->vignetting());
+      e.psnr_db += kernels::psnr(leveled, target);
+      e.ssim += kernels::ssim_reference(leveled, target, 1, W, H);
+      e.mae_counts += counts * mean_abs_diff(leveled, target);
+      e.psnr_identity_db += kernels::psnr(img.image, target);
+      e.mae_counts_identity += counts * mean_abs_diff(img.image, target);
+    } else {
+      e.psnr_db += kernels::psnr(img.image, target);
+      e.ssim += kernels::ssim_reference(img.image, target, 1, W, H);
+      e.mae_counts += counts * mean_abs_diff(img.image, target);
+    }
     if (gt_planes_) {
       // Point-to-plane residual of the rendered depth along each pixel's ray, where a true plane is seen and
       // the render is opaque enough to have a depth.
@@ -47,8 +71,12 @@ EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32
     }
     if (renders) renders->push_back(img);
   }
-  e.psnr_db /= static_cast<double>(views_.size());
-  e.ssim /= static_cast<double>(views_.size());
+  const double n = static_cast<double>(views_.size());
+  e.psnr_db /= n;
+  e.ssim /= n;
+  e.mae_counts /= n;
+  e.psnr_identity_db /= n;
+  if (levels) e.mae_counts_identity /= n;
   if (gt_planes_ && plane_n > 0) e.depth_plane_rmse_m = std::sqrt(plane_sq / static_cast<double>(plane_n));
   return e;
 }

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "host/train/level_plan.h"
 #include "host/train/lidar_planes.h"
 #include "host/train/run_record.h"
 #include "host/train/train_options.h"
@@ -19,11 +20,13 @@ class Evaluator {
   Evaluator(const TrainingData& data, const TrainOptions& options, const PlanarMap* gt_planes,
             kernels::Rasterizer& rasterizer);
 
-  // The held-out views' mean PSNR and SSIM (zero without held-out views) after `iteration` iterations (the
-  // SH degree of that point of the ramp). `renders` (optional) receives each held-out view's render, in the
-  // order of views().
+  // The held-out views' mean PSNR, SSIM and mean absolute error in counts (zero without held-out views)
+  // after `iteration` iterations (the SH degree of that point of the ramp). `levels` (optional, a level
+  // model's table): each held-out render is scored at its interpolated level, and at identity beside it.
+  // `renders` (optional) receives each held-out view's render (before any level), in the order of views().
   EvalResult evaluate(const kernels::DeviceGaussians& gaussians, uint32_t iteration,
-                      std::vector<kernels::RenderImages<float>>* renders = nullptr);
+                      std::vector<kernels::RenderImages<float>>* renders = nullptr,
+                      const LevelTable* levels = nullptr);
   const std::vector<uint32_t>& views() const { return views_; }
 
  private:

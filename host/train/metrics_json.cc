@@ -24,6 +24,17 @@ nlohmann::json metrics_json(const TrainReport& report, const TrainingData& data,
                             {"evaluations", nlohmann::json::array()},
                             {"kernel_ms_per_iteration", nlohmann::json::object()}};
   for (const auto& [name, ms] : report.kernel_ms_per_iteration) metrics["kernel_ms_per_iteration"][name] = ms;
+  // Held-out error in the raw frames' counts (the stretch window's units); with a level model, heldout_psnr,
+  // heldout_ssim and heldout_mae_counts score each held-out render at the level interpolated from the
+  // training frames around it in time, and the *_identity_level fields score it at the identity level.
+  metrics["level_model"] = o.level_model;
+  if (report.final_eval.mae_counts >= 0) metrics["heldout_mae_counts"] = report.final_eval.mae_counts;
+  if (report.final_eval.leveled) {
+    metrics["heldout_psnr_identity_level"] = report.final_eval.psnr_identity_db;
+    metrics["heldout_mae_counts_identity_level"] = report.final_eval.mae_counts_identity;
+    metrics["level_nonfinite_skips"] = report.level_nonfinite_skips;
+  }
+  metrics["stretch_counts"] = {data.stretch_low, data.stretch_high};
   if (report.final_eval.depth_plane_rmse_m >= 0)
     metrics["heldout_depth_plane_rmse_m"] = report.final_eval.depth_plane_rmse_m;
   for (const auto& e : report.evals) metrics["evaluations"].push_back(to_json(e));

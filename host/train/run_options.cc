@@ -74,7 +74,13 @@ std::string flag_of(const std::string& section, const std::string& key) {
       {"deterministic", "--deterministic"},
       {"seed", "--seed"},
       {"progress_every", "--progress-every"},
-      {"recentred_output", "--recentred-output"}};
+      {"recentred_output", "--recentred-output"},
+      {"level_model", "--level-model"},
+      {"level_lr_log_gain", "--level-lr-gain"},
+      {"level_lr_offset", "--level-lr-offset"},
+      {"level_lr_vignetting", "--level-lr-vignetting"},
+      {"level_lambda_identity", "--level-lambda-identity"},
+      {"level_lambda_smooth", "--level-lambda-smooth"}};
   static const std::map<std::string, std::string> data = {{"downscale", "--downscale"},
                                                           {"holdout_every", "--holdout-every"},
                                                           {"intensity", "--intensity"},
@@ -141,7 +147,13 @@ json run_options_json(const TrainOptions& o, const TrainingData& data) {
                 {"deterministic", o.deterministic},
                 {"seed", o.seed},
                 {"progress_every", o.progress_every},
-                {"recentred_output", o.recentred_output}};
+                {"recentred_output", o.recentred_output},
+                {"level_model", o.level_model},
+                {"level_lr_log_gain", shortest(o.level_lr_log_gain)},
+                {"level_lr_offset", shortest(o.level_lr_offset)},
+                {"level_lr_vignetting", shortest(o.level_lr_vignetting)},
+                {"level_lambda_identity", shortest(o.level_lambda_identity)},
+                {"level_lambda_smooth", shortest(o.level_lambda_smooth)}};
   const TrainingDataOptions& d = data.options;
   json data_options = {{"downscale", d.downscale},
                        {"holdout_every", d.holdout_every},

@@ -19,6 +19,13 @@ struct EvalResult {
   double psnr_db = 0;  // mean over held-out views
   double ssim = 0;
   double depth_plane_rmse_m = -1;  // against ground-truth planes where the scene has them; -1 otherwise
+  // Mean |render - target| in the raw frames' counts (the stretch window's units) of the image psnr_db
+  // scores; -1 when not measured.
+  double mae_counts = -1;
+  // With a level model, psnr_db and mae_counts score the render at the held-out view's interpolated level;
+  // these score it at the identity level (the map as it is).
+  bool leveled = false;
+  double psnr_identity_db = 0, mae_counts_identity = -1;
 };
 
 // Events of a run that change what is learnt without stopping it, summed over every iteration of the run (a
@@ -72,6 +79,11 @@ struct RunRecord {
 inline nlohmann::json to_json(const EvalResult& e) {
   nlohmann::json j = {{"iteration", e.iteration}, {"psnr_db", e.psnr_db}, {"ssim", e.ssim}};
   if (e.depth_plane_rmse_m >= 0) j["depth_plane_rmse_m"] = e.depth_plane_rmse_m;
+  if (e.mae_counts >= 0) j["mae_counts"] = e.mae_counts;
+  if (e.leveled) {
+    j["psnr_identity_level_db"] = e.psnr_identity_db;
+    j["mae_counts_identity_level"] = e.mae_counts_identity;
+  }
   return j;
 }
 // JSON has no NaN or infinity: nlohmann writes them as null, read back as NaN.
@@ -84,6 +96,12 @@ inline EvalResult eval_from_json(const nlohmann::json& j) {
   e.psnr_db = number_or_nan(j.at("psnr_db"));
   e.ssim = number_or_nan(j.at("ssim"));
   if (j.contains("depth_plane_rmse_m")) e.depth_plane_rmse_m = number_or_nan(j.at("depth_plane_rmse_m"));
+  if (j.contains("mae_counts")) e.mae_counts = number_or_nan(j.at("mae_counts"));
+  e.leveled = j.contains("psnr_identity_level_db");
+  if (e.leveled) {
+    e.psnr_identity_db = number_or_nan(j.at("psnr_identity_level_db"));
+    e.mae_counts_identity = number_or_nan(j.at("mae_counts_identity_level"));
+  }
   return e;
 }
 

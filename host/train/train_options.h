@@ -48,6 +48,16 @@ struct TrainOptions {
       0.01f;  // MCMC: L1 weights, relative to the photometric loss (photometric_weight())
   float mcmc_scale_reg = 0.01f;
   float lr_scale = 1.0f;  // multiplies every learning rate (stability tests, tuning)
+  // The radiometric level model (host/train/level_plan.h, kernels/level/): "none", "affine" (a gain and an
+  // offset per training frame) or "affine-vignetting" (and a vignetting shared by all frames), applied to the
+  // render before the photometric loss. Adam rates (decaying log-linearly to a tenth over the run), and the
+  // regularizers' weights toward identity and toward smoothness in time, relative to the photometric loss.
+  std::string level_model = "none";
+  float level_lr_log_gain = 0.02f;
+  float level_lr_offset = 0.02f;
+  float level_lr_vignetting = 0.002f;
+  float level_lambda_identity = 1e-3f;
+  float level_lambda_smooth = 1e-2f;
   // Evaluation, checkpoints, reproducibility.
   uint32_t eval_every = 0;        // 0: only at the end
   uint32_t checkpoint_every = 0;  // 0: none

@@ -6,10 +6,12 @@
 #include <limits>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include "engine/buffer.h"
 #include "host/train/checkpoint.h"
 #include "host/train/evaluation.h"
+#include "host/train/level_plan.h"
 #include "host/train/metrics_json.h"
 #include "host/train/output_frame.h"
 #include "host/train/refinement.h"
@@ -17,6 +19,7 @@
 #include "host/train/training_step.h"
 #include "host/train/view_sampler.h"
 #include "io/gaussian_ply.h"
+#include "kernels/level/level_model.h"
 #include "kernels/mcmc/mcmc.h"
 #include "kernels/optim/trainable_gaussians.h"
 #include "kernels/splat/rasterizer.h"
@@ -33,6 +36,7 @@ struct RunStart {
   std::unique_ptr<kernels::TrainableGaussians> model;
   uint32_t iteration = 0;
   RunRecord record;
+  std::vector<float> level_state;  // the checkpoint's (empty: identity, or no level model)
 };
 
 RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, const TrainOptions& o,
@@ -71,6 +75,7 @@ RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, 
          std::to_string(o.iterations) + ")");
   s.model = std::make_unique<kernels::TrainableGaussians>(ctx, c.state);
   s.iteration = c.iteration;
+  s.level_state = std::move(c.level_state);
   s.record = std::move(c.record);
   s.record.options = options;  // later checkpoints store this run's options (an extended --iterations)
   s.record.resumes.push_back({c.iteration, c.has_record});
@@ -78,11 +83,13 @@ RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, 
 }
 
 void save_checkpoint(const fs::path& out_dir, uint32_t step, const ViewSampler& sampler,
-                     const kernels::TrainableGaussians& model, const RunRecord& record) {
+                     const kernels::TrainableGaussians& model, const kernels::LevelModel* level,
+                     const RunRecord& record) {
   Checkpoint c;
   c.iteration = step;
   sampler.save(c);
   c.state = model.download_state();
+  if (level) c.level_state = level->download_state();
   c.record = record;
   write_checkpoint(checkpoint_path(out_dir, step), c);
 }
@@ -161,6 +168,13 @@ void TrainOptions::check() const {
   if (!(lr_scale > 0) || !std::isfinite(lr_scale)) bad("lr_scale must be positive");
   if (strategy != "adc" && strategy != "mcmc") bad("strategy must be adc or mcmc, not '" + strategy + "'");
   if (strategy == "mcmc") mcmc_options().check();
+  parse_level_model(level_model);
+  for (const auto& [name, value] : {std::pair{"level_lr_log_gain", level_lr_log_gain},
+                                    {"level_lr_offset", level_lr_offset},
+                                    {"level_lr_vignetting", level_lr_vignetting},
+                                    {"level_lambda_identity", level_lambda_identity},
+                                    {"level_lambda_smooth", level_lambda_smooth}})
+    if (!(value >= 0) || !std::isfinite(value)) bad(std::string(name) + " must be finite and >= 0");
 }
 
 kernels::McmcOptions TrainOptions::mcmc_options() const {
@@ -203,6 +217,27 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   std::unique_ptr<kernels::McmcStrategy> mcmc;
   if (o.strategy == "mcmc") mcmc = std::make_unique<kernels::McmcStrategy>(ctx);
   Refinement refinement(ctx, o, planes, static_cast<float>(data.scene_extent_m));
+  // The level model: one row per view (held-out rows stay at identity: their level is interpolated).
+  const LevelModelKind level_kind = parse_level_model(o.level_model);
+  const LevelPlan level_plan(data);
+  std::unique_ptr<kernels::LevelModel> level;
+  if (level_kind != LevelModelKind::kNone) {
+    level = std::make_unique<kernels::LevelModel>(ctx, level_plan.trained,
+                                                  level_kind == LevelModelKind::kAffineVignetting);
+    level->reserve(uint64_t{data.width} * data.height);
+    if (o.resume) {
+      if (run.level_state.empty())
+        throw std::invalid_argument(
+            "--resume: the checkpoint holds no level model state (it was written "
+            "without one); resume with --level-model none");
+      level->upload_state(run.level_state);
+    }
+  }
+  const auto evaluate = [&](uint32_t step) {
+    if (!level) return evaluator.evaluate(model.gaussians(), step);
+    const LevelTable table = make_level_table(data, level_plan, level_kind, level->download_state());
+    return evaluator.evaluate(model.gaussians(), step, nullptr, &table);
+  };
 
   // Adam counts its skips per model object: this call's, on top of the checkpoint's.
   const auto adam_before = record.counters.adam_nonfinite_skips;
@@ -219,18 +254,21 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   double wall = 0;
   for (uint32_t it = start; it < o.iterations; ++it) {
     const uint32_t step = it + 1;
-    training_step.run(model, mcmc.get(), it, sampler.next(), kernel_ms, record.counters);
+    const uint32_t view = sampler.next();
+    training_step.run(model, mcmc.get(), level.get(),
+                      level ? level_plan.step(view, it, o) : kernels::LevelStep{}, it, view, kernel_ms,
+                      record.counters);
     refinement.after_step(model, mcmc.get(), step, record.counters);
     const bool last = step == o.iterations;
     if (last) wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     // At the last step the final evaluation, so that a checkpoint there holds it.
     if (last || (o.eval_every > 0 && step % o.eval_every == 0)) {
-      add_evaluation(record, evaluator.evaluate(model.gaussians(), step));
+      add_evaluation(record, evaluate(step));
       last_psnr = record.evaluations.back().psnr_db;
     }
     if (o.checkpoint_every > 0 && step % o.checkpoint_every == 0) {
       count_adam_skips();
-      save_checkpoint(out_dir, step, sampler, model, record);
+      save_checkpoint(out_dir, step, sampler, model, level.get(), record);
     }
     if (progress && (step % o.progress_every == 0 || last || step == start + 1)) {
       count_adam_skips();
@@ -240,12 +278,15 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
                 (step - start) / std::max(secs, 1e-9), record.counters});
     }
   }
-  if (start == o.iterations)
-    add_evaluation(record, evaluator.evaluate(model.gaussians(), o.iterations));  // nothing ran
+  if (start == o.iterations) add_evaluation(record, evaluate(o.iterations));  // nothing ran
   count_adam_skips();
 
-  const TrainReport report = make_report(record, model, o, start, wall, kernel_ms);
+  TrainReport report = make_report(record, model, o, start, wall, kernel_ms);
+  const std::vector<float> level_state = level ? level->download_state() : std::vector<float>{};
+  report.levels = make_level_table(data, level_plan, level_kind, level_state);
+  if (level) report.level_nonfinite_skips = static_cast<uint64_t>(level_state.back());
   write_model(out_dir / "point_cloud.ply", model, data, o);
+  write_level_table(out_dir / "levels.json", report.levels);
   write_metrics_json(out_dir / "metrics.json", report, data, o);
   return report;
 }

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "engine/context.h"
+#include "host/train/level_plan.h"
 #include "host/train/lidar_planes.h"
 #include "host/train/run_record.h"
 #include "host/train/train_options.h"
@@ -45,6 +46,8 @@ struct TrainReport {
   std::vector<ResumeRecord> resumes;  // every resume of the run, oldest first
   uint32_t start_iteration = 0;       // where this call started (the checkpoint's iteration, or 0)
   std::vector<std::pair<std::string, double>> kernel_ms_per_iteration;  // GPU timestamps, training steps only
+  LevelTable levels;                   // every view's level (identity without a level model): levels.json
+  uint64_t level_nonfinite_skips = 0;  // level updates skipped for a non-finite value
 };
 
 struct TrainProgress {

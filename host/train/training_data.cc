@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "io/scene.h"
 
@@ -204,17 +205,20 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
 
   std::vector<Eigen::Vector3d> centres;
   const std::vector<float>* previous = nullptr;
+  bool skipped_before = false;
   for (size_t i = 0; i < scene.frames.size(); ++i) {
     if (previous) {
       double diff = 0;
       for (size_t p = 0; p < raw[i].size(); ++p) diff += std::abs(raw[i][p] - (*previous)[p]);
       if (diff / static_cast<double>(raw[i].size()) < o.frozen_threshold) {
         ++out.frozen_skipped;
+        skipped_before = true;
         continue;
       }
     }
     previous = &raw[i];
     TrainingView view;
+    view.after_frozen = std::exchange(skipped_before, false);
     view.name = scene.frames[i].image.filename().string();
     view.t_s = scene.frames[i].t_s;
     view.heldout = o.holdout_every > 0 && i % o.holdout_every == 0;

@@ -42,6 +42,9 @@ struct TrainingView {
   kernels::SplatCamera camera;  // pinhole, undistorted, at the training resolution
   std::vector<float> image;     // [H][W] target in [0, 1]
   bool heldout = false;
+  // Frames frozen by the camera's non-uniformity correction were skipped right before this one: its level
+  // may jump (the level model does not smooth across it).
+  bool after_frozen = false;
 };
 
 struct TrainingData {

@@ -66,7 +66,8 @@ TrainingStep::TrainingStep(engine::Context& ctx, const TrainingData& data, const
 
 TrainingStep::~TrainingStep() = default;
 
-void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc, uint32_t it,
+void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc,
+                       kernels::LevelModel* level, const kernels::LevelStep& level_step, uint32_t it,
                        uint32_t v, KernelTimes& times, TrainingCounters& counters) {
   const TrainOptions& o = *options_;
   const uint32_t W = data_->width, H = data_->height;
@@ -81,8 +82,15 @@ void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy
   const auto up = rasterizer.upstream_buffers();
 
   engine::Sequence s(*context_);
-  photometric_.record(s, *out.image, views_[v].target->buffer(), W, H, static_cast<float>(1.0 - o.lambda_geo),
-                      *up.image, losses_.buffer(), kSlotPhotometric);
+  // With a level model the loss sees g v x + o, and the level's backward turns its gradient into the
+  // image's.
+  const kernels::LevelGeometry level_geometry{W, H, 1, static_cast<float>(cam.cx),
+                                              static_cast<float>(cam.cy)};
+  if (level) level->record_apply(s, *out.image, v, level_geometry);
+  photometric_.record(s, level ? level->leveled() : *out.image, views_[v].target->buffer(), W, H,
+                      static_cast<float>(1.0 - o.lambda_geo), level ? level->grad_leveled() : *up.image,
+                      losses_.buffer(), kSlotPhotometric);
+  if (level) level->record_backward_step(s, *out.image, level_geometry, level_step, *up.image);
   if (geometric)
     geometric_.record(s, *out.depth, views_[v].points->buffer(), views_[v].normals->buffer(), W, H,
                       static_cast<float>(cam.fx), static_cast<float>(cam.fy), static_cast<float>(cam.cx),

@@ -15,6 +15,7 @@
 #include "host/train/run_record.h"
 #include "host/train/train_options.h"
 #include "host/train/training_data.h"
+#include "kernels/level/level_model.h"
 #include "kernels/loss/geometric_loss.h"
 #include "kernels/loss/photometric_loss.h"
 #include "kernels/mcmc/mcmc.h"
@@ -42,10 +43,13 @@ class TrainingStep {
   ~TrainingStep();
 
   // Iteration `it` (0-based) on training view `view`: one forward, one submit. `mcmc` is the MCMC strategy
-  // (null: ADC). GPU times are added to `times`, and the render's culls and walks cut short to `counters`
-  // (copied to host-visible memory inside the step's submit: no extra sync).
-  void run(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc, uint32_t it, uint32_t view,
-           KernelTimes& times, TrainingCounters& counters);
+  // (null: ADC). `level` (null: none, and nothing of it is recorded) levels the render before the
+  // photometric loss and takes `level_step` (its frame is the view's index). GPU times are added to `times`,
+  // and the render's culls and walks cut short to `counters` (copied to host-visible memory inside the
+  // step's submit: no extra sync).
+  void run(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc, kernels::LevelModel* level,
+           const kernels::LevelStep& level_step, uint32_t it, uint32_t view, KernelTimes& times,
+           TrainingCounters& counters);
   StepLosses last_losses() const;
 
  private:

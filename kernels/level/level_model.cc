@@ -34,16 +34,26 @@ LevelParams LevelGeometry::params(uint32_t frame, uint32_t frames, bool vignetti
   return p;
 }
 
-LevelModel::LevelModel(engine::Context& context, uint32_t frames, bool vignetting)
+std::vector<float> LevelModel::identity_state(const std::vector<bool>& trained) {
+  std::vector<float> s((trained.size() + 1) * LEVEL_STRIDE, 0.0f);
+  for (size_t f = 0; f < trained.size(); ++f) s[f * LEVEL_STRIDE + LEVEL_TRAINED] = trained[f] ? 1.0f : 0.0f;
+  return s;
+}
+
+LevelModel::LevelModel(engine::Context& context, const std::vector<bool>& trained, bool vignetting)
     : context_(&context),
-      frames_(frames),
+      frames_(static_cast<uint32_t>(trained.size())),
       vignetting_(vignetting),
-      state_(context, "level: state", (size_t{frames} + 1) * LEVEL_STRIDE) {
-  if (frames == 0) throw std::invalid_argument("LevelModel: no frames");
+      state_(context, "level: state", (trained.size() + 1) * LEVEL_STRIDE) {
+  if (trained.empty()) throw std::invalid_argument("LevelModel: no frames");
+  // level_step walks the frames 256 at a time: stay within lavapipe's loop budget (limits.h).
+  if (trained.size() > size_t{256} * MAX_BATCHES_PER_WORKGROUP)
+    throw std::length_error("LevelModel: " + std::to_string(trained.size()) +
+                            " frames exceed the step's capacity");
   apply_ = make_kernel(context, "level/level_apply", LEVEL_APPLY_BINDING_COUNT, sizeof(LevelParams));
   backward_ = make_kernel(context, "level/level_backward", LEVEL_BACKWARD_BINDING_COUNT, sizeof(LevelParams));
   step_ = make_kernel(context, "level/level_step", LEVEL_STEP_BINDING_COUNT, sizeof(LevelStepParams));
-  upload_state(std::vector<float>((size_t{frames} + 1) * LEVEL_STRIDE, 0.0f));
+  upload_state(identity_state(trained));
 }
 
 LevelModel::~LevelModel() = default;
@@ -107,7 +117,7 @@ void LevelModel::record_backward_step(engine::Sequence& s, const engine::Buffer&
   q.frame = step.frame;
   q.prev = step.prev;
   q.next = step.next;
-  q.update_frame = step.update_frame ? 1u : 0u;
+  q.center = step.center ? 1u : 0u;
   q.vignetting = vignetting_ ? 1u : 0u;
   q.lr_log_gain = step.lr_log_gain;
   q.lr_offset = step.lr_offset;

@@ -27,7 +27,7 @@ struct LevelGeometry {
 struct LevelStep {
   uint32_t frame = 0;
   int prev = -1, next = -1;  // the frame's neighbours in time for the smoothness term (-1: none)
-  bool update_frame = true;  // false: its gain and offset stay (the anchor frame)
+  bool center = true;        // re-centre the trained frames on their mean (the map's level, level_shared.h)
   float lr_log_gain = 0, lr_offset = 0, lr_vignetting = 0;
   float lambda_identity = 0, lambda_smooth = 0;
   float beta1 = 0.9f, beta2 = 0.999f, eps = 1e-8f;
@@ -35,8 +35,9 @@ struct LevelStep {
 
 class LevelModel {
  public:
-  // `frames` rows at identity; `vignetting`: learn the shared vignetting too (else v = 1).
-  LevelModel(engine::Context& context, uint32_t frames, bool vignetting);
+  // One row per frame at identity, `trained[f]` marking the frames that are trained (the others, held out,
+  // stay at identity and out of the mean); `vignetting`: learn the shared vignetting too (else v = 1).
+  LevelModel(engine::Context& context, const std::vector<bool>& trained, bool vignetting);
   ~LevelModel();
 
   uint32_t frames() const { return frames_; }
@@ -57,6 +58,8 @@ class LevelModel {
   const engine::Buffer& leveled() const { return leveled_->buffer(); }
   const engine::Buffer& grad_leveled() const { return grad_leveled_->buffer(); }
 
+  // The identity state of `trained.size()` frames.
+  static std::vector<float> identity_state(const std::vector<bool>& trained);
   // The state, [frames + 1][LEVEL_STRIDE] (level_shared.h): for checkpoints, evaluation and tests.
   std::vector<float> download_state() const;
   // Throws std::invalid_argument when `state` does not hold (frames + 1) * LEVEL_STRIDE values.

@@ -108,15 +108,29 @@ void level_step_reference(std::vector<double>& s, uint32_t frames, bool vignetti
   const size_t shared_row = size_t{frames} * LEVEL_STRIDE;
   const std::array<double, 4> g = level_step_gradient_reference(s, frames, grad, p);
   double skipped = 0;
-  if (p.update_frame && !adam2(s, size_t{p.frame} * LEVEL_STRIDE, {g[0], g[1]}, {p.lr_log_gain, p.lr_offset},
-                               {LEVEL_LOG_GAIN_LIMIT, 0.0}, p))
+  if (!adam2(s, size_t{p.frame} * LEVEL_STRIDE, {g[0], g[1]}, {p.lr_log_gain, p.lr_offset},
+             {LEVEL_LOG_GAIN_LIMIT, 0.0}, p))
     skipped += 1;
-  if (vignetting) {
-    if (!adam2(s, shared_row, {g[2], g[3]}, {p.lr_vignetting, p.lr_vignetting},
-               {LEVEL_VIGNETTING_LIMIT, LEVEL_VIGNETTING_LIMIT}, p))
-      skipped += 1;
-  }
+  if (vignetting && !adam2(s, shared_row, {g[2], g[3]}, {p.lr_vignetting, p.lr_vignetting},
+                           {LEVEL_VIGNETTING_LIMIT, LEVEL_VIGNETTING_LIMIT}, p))
+    skipped += 1;
   s[shared_row + LEVEL_SKIPS] += skipped;
+  if (!p.center) return;
+  // The mean's gauge: trained frames' log-gains clamped, then both means subtracted.
+  double lg = 0, o = 0, n = 0;
+  for (size_t f = 0; f < frames; ++f) {
+    const size_t r = f * LEVEL_STRIDE;
+    if (s[r + LEVEL_TRAINED] == 0) continue;
+    s[r] = std::clamp(s[r], -LEVEL_LOG_GAIN_LIMIT, LEVEL_LOG_GAIN_LIMIT);
+    lg += s[r], o += s[r + 1], n += 1;
+  }
+  if (n == 0) return;
+  for (size_t f = 0; f < frames; ++f) {
+    const size_t r = f * LEVEL_STRIDE;
+    if (s[r + LEVEL_TRAINED] == 0) continue;
+    s[r] -= lg / n;
+    s[r + 1] -= o / n;
+  }
 }
 
 }  // namespace litgs::kernels

@@ -41,7 +41,8 @@ std::array<double, 4> level_step_gradient_reference(const std::vector<double>& s
                                                     const std::array<double, 4>& grad, const LevelStep& step);
 
 // One step as level_step.comp: `grad` from the backward, the regularizers' gradient of step.frame's row
-// (and of the vignetting), Adam, the clamps. A non-finite update leaves its row and counts a skip.
+// (and of the vignetting), Adam, the clamps (a non-finite update leaves its row and counts a skip), then with
+// step.center the trained frames re-centred on their mean (level_shared.h).
 void level_step_reference(std::vector<double>& state, uint32_t frames, bool vignetting,
                           const std::array<double, 4>& grad, const LevelStep& step);
 

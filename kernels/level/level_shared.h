@@ -5,8 +5,13 @@
 // distance of pixel p's centre from the principal point over the squared half diagonal of the image.
 //
 // State: float [frames + 1][LEVEL_STRIDE]. Frame f's row: lg, o, Adam m(lg), m(o), v(lg), v(o), Adam steps,
-// unused. The last row is the shared vignetting: k1, k2, m(k1), m(k2), v(k1), v(k2), Adam steps, updates
-// skipped for a non-finite value (over every row). Identity: every value 0.
+// 1 if the frame is trained (else 0). The last row is the shared vignetting: k1, k2, m(k1), m(k2), v(k1),
+// v(k2), Adam steps, updates skipped for a non-finite value (over every row). Identity: lg = o = k = 0.
+//
+// The map's own level: the gauge (g, o) -> (g / a, o - g b / a) with the map -> a map + b changes nothing
+// rendered, so the step re-centres: after each update the trained frames' mean log-gain and mean offset are
+// subtracted from every trained frame (their log-gains clamped first). The map then takes on the frames'
+// average level, and every frame's loss, not one anchor frame's, pulls the map there.
 #ifndef LITGS_KERNELS_LEVEL_SHARED_H
 #define LITGS_KERNELS_LEVEL_SHARED_H
 
@@ -18,6 +23,7 @@ using uint = uint32_t;
 
 #define LEVEL_STRIDE 8
 #define LEVEL_STEPS 6               // row element: Adam steps taken
+#define LEVEL_TRAINED 7             // frame row element: 1 if the frame is trained (in the mean), else 0
 #define LEVEL_SKIPS 7               // shared row element: updates skipped for a non-finite value
 #define LEVEL_LOG_GAIN_LIMIT 4.0    // |lg| <= this: gain in [0.018, 55]
 #define LEVEL_VIGNETTING_LIMIT 0.5  // |k1|, |k2| <= this: v >= 0 over the image
@@ -58,11 +64,11 @@ struct LevelParams {
 
 // Push constants of level_step.
 struct LevelStepParams {
-  uint blocks;        // block sums to add
-  uint frame;         // the frame whose gradient the sums are
-  int prev, next;     // its neighbours in time for the smoothness term (-1: none)
-  uint update_frame;  // 0: the frame's gain and offset stay (the anchor frame that fixes the map's level)
-  uint vignetting;    // 0: the shared row stays
+  uint blocks;      // block sums to add
+  uint frame;       // the frame whose gradient the sums are
+  int prev, next;   // its neighbours in time for the smoothness term (-1: none)
+  uint center;      // 1: re-centre the trained frames (the mean's gauge, above); 0: leave the other rows
+  uint vignetting;  // 0: the shared row stays
   float lr_log_gain, lr_offset, lr_vignetting;
   float lambda_identity;  // adds lambda (lg^2 + o^2) per frame, lambda (k1^2 + k2^2)
   float lambda_smooth;    // adds lambda sum over neighbours ((lg - lg_n)^2 + (o - o_n)^2)

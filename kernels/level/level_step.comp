@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 // One workgroup: the level parameters' gradient (the block sums of level_backward, in a fixed order, plus the
 // regularizers' gradients), then Adam (bias-corrected as torch.optim.Adam) on the frame's log-gain and offset
-// and on the shared vignetting. A row whose update is not finite is left unchanged and counted.
+// and on the shared vignetting (a row whose update is not finite is left unchanged and counted), then the
+// trained frames re-centred on their mean (level_shared.h).
 #include "limits.h"
 #include "level/level_shared.h"
 
@@ -49,11 +50,10 @@ void main() {
     if (t < stride) partial[t] += partial[t + stride];
     barrier();
   }
-  if (t != 0u) return;
-  const vec4 total = partial[0];
   const uint shared_row = p.frames * LEVEL_STRIDE;
-  uint skipped = 0u;
-  if (p.update_frame != 0u) {
+  if (t == 0u) {
+    const vec4 total = partial[0];
+    uint skipped = 0u;
     const uint row = p.frame * LEVEL_STRIDE;
     const vec2 x = vec2(state[row], state[row + 1]);
     vec2 g = total.xy + 2.0 * p.lambda_identity * x;
@@ -65,11 +65,36 @@ void main() {
     }
     const vec2 limit = vec2(LEVEL_LOG_GAIN_LIMIT, 0.0);
     if (!adam2(row, g, vec2(p.lr_log_gain, p.lr_offset), limit)) skipped += 1u;
+    if (p.vignetting != 0u) {
+      const vec2 k = vec2(state[shared_row], state[shared_row + 1]);
+      const vec2 gk = total.zw + 2.0 * p.lambda_identity * k;
+      if (!adam2(shared_row, gk, vec2(p.lr_vignetting), vec2(LEVEL_VIGNETTING_LIMIT))) skipped += 1u;
+    }
+    state[shared_row + LEVEL_SKIPS] += float(skipped);
   }
-  if (p.vignetting != 0u) {
-    const vec2 k = vec2(state[shared_row], state[shared_row + 1]);
-    const vec2 g = total.zw + 2.0 * p.lambda_identity * k;
-    if (!adam2(shared_row, g, vec2(p.lr_vignetting), vec2(LEVEL_VIGNETTING_LIMIT))) skipped += 1u;
+  if (p.center == 0u) return;  // uniform: every invocation returns
+  memoryBarrierBuffer();
+  barrier();
+  // The trained frames' mean log-gain (each clamped) and mean offset, summed in a fixed order.
+  vec4 c = vec4(0.0);
+  for (uint f = t; f < p.frames; f += 256u) {
+    const uint r = f * LEVEL_STRIDE;
+    if (state[r + LEVEL_TRAINED] != 0.0)
+      c += vec4(clamp(state[r], -LEVEL_LOG_GAIN_LIMIT, LEVEL_LOG_GAIN_LIMIT), state[r + 1], 1.0, 0.0);
   }
-  state[shared_row + LEVEL_SKIPS] += float(skipped);
+  partial[t] = c;
+  barrier();
+  for (uint stride = 128u; stride > 0u; stride >>= 1u) {
+    if (t < stride) partial[t] += partial[t + stride];
+    barrier();
+  }
+  const vec4 sum = partial[0];
+  if (sum.z == 0.0) return;
+  const vec2 mean = sum.xy / sum.z;
+  for (uint f = t; f < p.frames; f += 256u) {
+    const uint r = f * LEVEL_STRIDE;
+    if (state[r + LEVEL_TRAINED] == 0.0) continue;
+    state[r] = clamp(state[r], -LEVEL_LOG_GAIN_LIMIT, LEVEL_LOG_GAIN_LIMIT) - mean.x;
+    state[r + 1] -= mean.y;
+  }
 }

@@ -24,9 +24,10 @@ namespace litgs::testing {
 class SmallTrainingSceneTest : public GpuTest {
  protected:
   // Call from the suite's SetUpTestSuite. `name` prefixes the temporary folder; `edit_scene` may change the
-  // generated scene folder (root_ / "scene") before it is loaded.
+  // generated scene folder (root_ / "scene") before it is loaded; `edit_options` the generator's options.
   static void set_up_scene(const std::string& name,
-                           const std::function<void(const std::filesystem::path&)>& edit_scene = {}) {
+                           const std::function<void(const std::filesystem::path&)>& edit_scene = {},
+                           const std::function<void(host::synth::SynthOptions&)>& edit_options = {}) {
     GpuTest::SetUpTestSuite();
     root_ = std::filesystem::temp_directory_path() / (name + "-" + std::to_string(::getpid()));
     std::filesystem::remove_all(root_);
@@ -35,6 +36,7 @@ class SmallTrainingSceneTest : public GpuTest {
     s.width = 64;
     s.height = 48;
     s.out = root_ / "scene";
+    if (edit_options) edit_options(s);
     host::synth::generate_synthetic_scene(s);
     if (edit_scene) edit_scene(s.out);
     host::TrainingDataOptions d;

@@ -35,9 +35,12 @@ std::vector<float> random_values(size_t n, uint32_t seed, float lo, float hi) {
 
 class LevelTest : public testing::GpuTest {
  protected:
-  // A state with every frame's log-gain and offset and the vignetting set to small random values.
-  static std::vector<float> random_state(uint32_t frames, uint32_t seed) {
-    std::vector<float> s((frames + 1) * LEVEL_STRIDE, 0.0f);
+  // A state with every frame's log-gain and offset and the vignetting set to small random values; frames
+  // marked trained where `trained` says so (none when empty).
+  static std::vector<float> random_state(uint32_t frames, uint32_t seed,
+                                         const std::vector<bool>& trained = {}) {
+    std::vector<float> s = trained.empty() ? std::vector<float>((frames + 1) * LEVEL_STRIDE, 0.0f)
+                                           : LevelModel::identity_state(trained);
     const std::vector<float> r = random_values(2 * (frames + 1), seed, -0.3f, 0.3f);
     for (uint32_t f = 0; f <= frames; ++f) {
       s[f * LEVEL_STRIDE] = r[2 * f];
@@ -84,17 +87,17 @@ TEST_F(LevelTest, StepsMatchReference) {
     const std::vector<float> image_values = random_values(n, 1, 0.0f, 1.0f);
     DeviceArray<float> image(context(), "test: image", n);
     image.upload(image_values);
-    LevelModel level(context(), frames, vignetting);
-    std::vector<float> state = random_state(frames, 2);
+    const std::vector<bool> trained = {true, true, true, true, false, true};  // frame 4 held out
+    LevelModel level(context(), trained, vignetting);
+    std::vector<float> state = random_state(frames, 2, trained);
     level.upload_state(state);
     std::vector<double> ref(state.begin(), state.end());
-    const uint32_t order[] = {3, 0, 5, 3, 2};
+    const uint32_t order[] = {3, 0, 5, 3, 2};  // never 4
     for (uint32_t k = 0; k < 5; ++k) {
       LevelStep step;
       step.frame = order[k];
       step.prev = order[k] > 0 ? static_cast<int>(order[k]) - 1 : -1;
       step.next = order[k] + 2 < frames ? static_cast<int>(order[k]) + 2 : -1;
-      step.update_frame = order[k] != 2;  // frame 2 plays the anchor
       step.lr_log_gain = 0.01f, step.lr_offset = 0.02f, step.lr_vignetting = 0.005f;
       step.lambda_identity = 0.05f, step.lambda_smooth = 0.2f;
       // The gradient scale of a mean loss: 1/N per element.
@@ -123,10 +126,15 @@ TEST_F(LevelTest, StepsMatchReference) {
         EXPECT_EQ(device_state[frames * LEVEL_STRIDE], state[frames * LEVEL_STRIDE]);  // untouched
       }
     }
+    // The map's level: the trained frames' mean log-gain and offset are 0; the held-out row never moves.
     const std::vector<float> final_state = level.download_state();
-    EXPECT_EQ(final_state[2 * LEVEL_STRIDE], state[2 * LEVEL_STRIDE]) << "the anchor moved";
-    EXPECT_EQ(final_state[2 * LEVEL_STRIDE + 1], state[2 * LEVEL_STRIDE + 1]) << "the anchor moved";
-    EXPECT_NE(final_state[3 * LEVEL_STRIDE], state[3 * LEVEL_STRIDE]) << "a visited frame did not move";
+    double mean_lg = 0, mean_o = 0;
+    for (uint32_t f = 0; f < frames; ++f)
+      if (trained[f]) mean_lg += final_state[f * LEVEL_STRIDE], mean_o += final_state[f * LEVEL_STRIDE + 1];
+    EXPECT_NEAR(mean_lg, 0.0, 1e-6);
+    EXPECT_NEAR(mean_o, 0.0, 1e-6);
+    EXPECT_EQ(final_state[4 * LEVEL_STRIDE], state[4 * LEVEL_STRIDE]) << "the held-out row moved";
+    EXPECT_EQ(final_state[4 * LEVEL_STRIDE + 1], state[4 * LEVEL_STRIDE + 1]) << "the held-out row moved";
   }
 }
 
@@ -140,7 +148,7 @@ TEST_F(LevelTest, IdentityLeavesImageAndGradientBitForBit) {
   DeviceArray<float> image(context(), "test: image", n);
   image.upload(values);
   for (bool vignetting : {false, true}) {
-    LevelModel level(context(), 1, vignetting);
+    LevelModel level(context(), {true}, vignetting);
     std::vector<float> grad_image;
     const std::vector<float> leveled = device_step(level, image, G, g, LevelStep{}, grad_image);
     EXPECT_EQ(leveled, values);
@@ -158,7 +166,7 @@ TEST_F(LevelTest, HardCaseConstantFrameHasNoGradientAndStaysFinite) {
   const size_t n = size_t{g.width} * g.height;
   DeviceArray<float> image(context(), "test: image", n);
   image.upload(std::vector<float>(n, 0.5f));
-  LevelModel level(context(), 2, true);
+  LevelModel level(context(), {true, true}, true);
   LevelStep step;
   step.lr_log_gain = step.lr_offset = step.lr_vignetting = 0.05f;
   std::vector<float> grad_image;
@@ -178,12 +186,13 @@ TEST_F(LevelTest, HardCaseGainDrivenTowardZeroStaysPositiveAndRecovers) {
   const size_t n = size_t{g.width} * g.height;
   DeviceArray<float> image(context(), "test: image", n);
   image.upload(random_values(n, 7, 0.2f, 1.0f));
-  LevelModel level(context(), 1, false);
+  LevelModel level(context(), {true}, false);
   std::vector<float> s = level.download_state();
   s[0] = -30.0f;
   level.upload_state(s);
   LevelStep step;
   step.lr_log_gain = 0.1f;
+  step.center = false;  // a lone frame is its own mean: re-centring would hide the clamp
   std::vector<float> grad_image;
   // dL/dx' > 0 with x > 0: the loss wants a smaller gain.
   for (int k = 0; k < 5; ++k)
@@ -203,8 +212,8 @@ TEST_F(LevelTest, HardCaseNonFiniteGradientIsSkippedAndCounted) {
   const size_t n = size_t{g.width} * g.height;
   DeviceArray<float> image(context(), "test: image", n);
   image.upload(random_values(n, 8, 0.0f, 1.0f));
-  LevelModel level(context(), 3, false);
-  const std::vector<float> before = random_state(3, 9);
+  LevelModel level(context(), {true, true, true}, false);
+  const std::vector<float> before = random_state(3, 9);  // no frame marked trained: no re-centring
   level.upload_state(before);
   std::vector<float> G(n, 0.01f);
   G[37] = std::numeric_limits<float>::quiet_NaN();
@@ -219,13 +228,13 @@ TEST_F(LevelTest, HardCaseNonFiniteGradientIsSkippedAndCounted) {
 }
 
 TEST_F(LevelTest, RefusesBadFramesAndStates) {
-  LevelModel level(context(), 2, false);
+  LevelModel level(context(), {true, true}, false);
   EXPECT_THROW(level.upload_state(std::vector<float>(5)), std::invalid_argument);
   DeviceArray<float> image(context(), "test: image", 16);
   engine::Sequence s(context());
   EXPECT_THROW(level.record_apply(s, image.buffer(), 2, LevelGeometry{4, 4, 1, 2, 2}), std::invalid_argument);
   EXPECT_THROW(level.record_apply(s, image.buffer(), 0, LevelGeometry{8, 4, 1, 2, 2}), std::invalid_argument);
-  EXPECT_THROW(LevelModel(context(), 0, false), std::invalid_argument);
+  EXPECT_THROW(LevelModel(context(), std::vector<bool>{}, false), std::invalid_argument);
 }
 
 }  // namespace

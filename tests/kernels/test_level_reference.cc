@@ -118,9 +118,30 @@ TEST(LevelReferenceTest, FirstAdamStepMovesEachParameterByItsRateAgainstTheGradi
   EXPECT_NEAR(s[LEVEL_STRIDE + 1], 0.02, 1e-9);
   EXPECT_NEAR(s[frames * LEVEL_STRIDE], -0.003, 1e-9);
   EXPECT_NEAR(s[frames * LEVEL_STRIDE + 1], 0.003, 1e-9);
-  EXPECT_EQ(s[LEVEL_STRIDE + LEVEL_STEPS], 1.0);
-  EXPECT_EQ(s[0], 0.0);  // other frames untouched
+  EXPECT_EQ(s[LEVEL_STRIDE + LEVEL_STEPS], 1.0);  // no frame marked trained: nothing re-centred
+  EXPECT_EQ(s[0], 0.0);                           // other frames untouched
   EXPECT_EQ(s[2 * LEVEL_STRIDE], 0.0);
+}
+
+TEST(LevelReferenceTest, RecentresTheTrainedFramesOnTheirMean) {
+  const uint32_t frames = 4;
+  std::vector<double> s((frames + 1) * LEVEL_STRIDE, 0.0);
+  const double lg[] = {0.2, -0.1, 9.0, 0.5}, o[] = {0.3, 0.1, -0.2, 7.0};
+  for (uint32_t f = 0; f < frames; ++f) {
+    s[f * LEVEL_STRIDE] = lg[f];
+    s[f * LEVEL_STRIDE + 1] = o[f];
+    s[f * LEVEL_STRIDE + LEVEL_TRAINED] = f == 3 ? 0.0 : 1.0;  // frame 3 held out
+  }
+  LevelStep step;  // zero rates: only the re-centring acts
+  step.frame = 1;
+  level_step_reference(s, frames, false, {0, 0, 0, 0}, step);
+  // Frame 2's log-gain is clamped to the limit before the mean: (0.2 - 0.1 + 4) / 3.
+  const double mean_lg = (0.2 - 0.1 + LEVEL_LOG_GAIN_LIMIT) / 3, mean_o = (0.3 + 0.1 - 0.2) / 3;
+  EXPECT_NEAR(s[0], 0.2 - mean_lg, 1e-12);
+  EXPECT_NEAR(s[2 * LEVEL_STRIDE], LEVEL_LOG_GAIN_LIMIT - mean_lg, 1e-12);
+  EXPECT_NEAR(s[LEVEL_STRIDE + 1], 0.1 - mean_o, 1e-12);
+  EXPECT_EQ(s[3 * LEVEL_STRIDE], 0.5);  // held out: untouched
+  EXPECT_EQ(s[3 * LEVEL_STRIDE + 1], 7.0);
 }
 
 TEST(LevelReferenceTest, ClampsLogGainAndVignettingAndSkipsNonFiniteRows) {
