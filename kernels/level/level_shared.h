@@ -25,7 +25,7 @@ using uint = uint32_t;
 #define LEVEL_STEPS 6               // row element: Adam steps taken
 #define LEVEL_TRAINED 7             // frame row element: 1 if the frame is trained (in the mean), else 0
 #define LEVEL_SKIPS 7               // shared row element: updates skipped for a non-finite value
-#define LEVEL_LOG_GAIN_LIMIT 4.0    // |lg| <= this: gain in [0.018, 55]
+#define LEVEL_LOG_GAIN_LIMIT 1.0    // |lg| <= this: gain in [0.37, 2.7], beyond any sensor drift
 #define LEVEL_VIGNETTING_LIMIT 0.5  // |k1|, |k2| <= this: v >= 0 over the image
 #define LEVEL_ROWS_PER_THREAD 16
 #define LEVEL_ROWS_PER_GROUP (256 * LEVEL_ROWS_PER_THREAD)

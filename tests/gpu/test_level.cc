@@ -181,7 +181,7 @@ TEST_F(LevelTest, HardCaseConstantFrameHasNoGradientAndStaysFinite) {
 
 TEST_F(LevelTest, HardCaseGainDrivenTowardZeroStaysPositiveAndRecovers) {
   // A bad initialization (log-gain -30: gain 1e-13) and a gradient that keeps pushing it down: the
-  // log-gain is clamped at -LEVEL_LOG_GAIN_LIMIT (gain 0.018 > 0); pushed up again it leaves the clamp.
+  // log-gain is clamped at -LEVEL_LOG_GAIN_LIMIT (gain 0.37 > 0); pushed up again it leaves the clamp.
   const LevelGeometry g{40, 30, 1, 20.0f, 15.0f};
   const size_t n = size_t{g.width} * g.height;
   DeviceArray<float> image(context(), "test: image", n);

@@ -357,9 +357,10 @@ TEST_F(TrainLevelTest, HardCaseLargeJump) {
 TEST_F(TrainLevelTest, HardCaseGainDrivenTowardZero) {
   // A bad initialization: half the trained frames' log-gains at -30 (gain 1e-13) in a checkpoint, then
   // resumed. The log-gains are clamped at -LEVEL_LOG_GAIN_LIMIT before the mean is taken, every gain stays
-  // positive and finite, and the loss still falls. Measured: the clamp and the re-centring leave the two
-  // halves at log-gains -1.8 and +1.8, and 280 iterations (about 30 visits per frame, Adam steps of at most
-  // the rate, 0.02 decaying) do not bring them back: the views render at a level error of 160..2900 counts.
+  // positive and finite, and the loss still falls. Measured: the clamp (log-gain +-1) and the re-centring
+  // leave the two halves near log-gains -0.5 and +0.5, and 280 iterations (about 30 visits per frame, Adam
+  // steps of at most the rate, 0.02 decaying) bring them only part of the way back: level errors 67..126
+  // counts (with a clamp at +-4 they stayed at gains 0.17 and 6, level errors up to 2900 counts).
   host::TrainOptions o = options("affine", 20);
   o.checkpoint_every = 20;
   run(o, "toward_zero");
@@ -373,7 +374,8 @@ TEST_F(TrainLevelTest, HardCaseGainDrivenTowardZero) {
   const Run r = run(o, "toward_zero");
   for (const auto& e : r.report.levels.entries)
     EXPECT_GE(e.log_gain, -2 * LEVEL_LOG_GAIN_LIMIT) << e.name;  // clamped, then shifted by at most the mean
-  level_errors(r.report, *data_, true_levels(*data_));
+  const LevelErrors worst = level_errors(r.report, *data_, true_levels(*data_));
+  EXPECT_LT(worst.trained[2], 200.0);
   expect_healthy(r, 0.8);
 }
 

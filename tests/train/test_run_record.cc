@@ -16,6 +16,7 @@
 #include "host/train/run_options.h"
 #include "io/error.h"
 #include "io/gaussian_ply.h"
+#include "kernels/level/level_shared.h"
 
 namespace litgs::host {
 namespace {
@@ -102,12 +103,44 @@ TEST_F(RunRecordTest, CheckpointKeepsOptionsEvaluationsCountersAndResumes) {
   EXPECT_EQ(r.state.model.means, c.state.model.means);
 }
 
-// A format-1 file (the layout before run records): the same fields, magic "LITGSCK1", nothing after
-// max_radius. Made from a format-2 file by cutting its record off.
-TEST_F(RunRecordTest, FormatOneCheckpointIsReadWithoutARecord) {
-  write_checkpoint(dir_ / "v2.ckpt", checkpoint());
-  std::ifstream in(dir_ / "v2.ckpt", std::ios::binary);
+// A format-3 file without a level model ends with an empty level state: its 8-byte count, 0. Returns the
+// file without it.
+std::vector<char> without_level_state(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
   std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(std::string(bytes.end() - 8, bytes.end()), std::string(8, '\0'));
+  bytes.resize(bytes.size() - 8);
+  return bytes;
+}
+
+// A format-2 file (before the level state): format 3 without its last array, magic "LITGSCK2".
+TEST_F(RunRecordTest, FormatTwoCheckpointIsReadWithoutALevelState) {
+  write_checkpoint(dir_ / "v3.ckpt", checkpoint());
+  std::vector<char> bytes = without_level_state(dir_ / "v3.ckpt");
+  bytes[7] = '2';
+  std::ofstream(dir_ / "v2.ckpt", std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  const Checkpoint r = read_checkpoint(dir_ / "v2.ckpt");
+  EXPECT_TRUE(r.has_record);
+  EXPECT_TRUE(r.level_state.empty());
+  EXPECT_EQ(r.record.evaluations.size(), checkpoint().record.evaluations.size());
+}
+
+TEST_F(RunRecordTest, LevelStateRoundTripsAndMustBeWholeRows) {
+  Checkpoint c = checkpoint();
+  c.level_state.assign(3 * LEVEL_STRIDE, 0.25f);  // two frames and the shared row
+  write_checkpoint(dir_ / "level.ckpt", c);
+  EXPECT_EQ(read_checkpoint(dir_ / "level.ckpt").level_state, c.level_state);
+  c.level_state.resize(LEVEL_STRIDE + 3);
+  write_checkpoint(dir_ / "bad.ckpt", c);
+  EXPECT_THROW(read_checkpoint(dir_ / "bad.ckpt"), io::IoError);
+}
+
+// A format-1 file (the layout before run records): the same fields, magic "LITGSCK1", nothing after
+// max_radius. Made from a format-3 file by cutting its level state and record off.
+TEST_F(RunRecordTest, FormatOneCheckpointIsReadWithoutARecord) {
+  write_checkpoint(dir_ / "v3.ckpt", checkpoint());
+  std::vector<char> bytes = without_level_state(dir_ / "v3.ckpt");
   const std::string record = to_json(checkpoint().record).dump();
   ASSERT_GT(bytes.size(), record.size() + 8);
   ASSERT_EQ(std::string(bytes.end() - static_cast<long>(record.size()), bytes.end()), record);
@@ -126,8 +159,8 @@ TEST_F(RunRecordTest, FormatOneCheckpointIsReadWithoutARecord) {
 TEST_F(RunRecordTest, BadRecordIsAnErrorNamingTheFile) {
   write_checkpoint(dir_ / "a.ckpt", checkpoint());
   std::fstream f(dir_ / "a.ckpt", std::ios::in | std::ios::out | std::ios::binary);
-  f.seekp(-2, std::ios::end);
-  f.put('#');  // the JSON's last characters: no longer JSON
+  f.seekp(-2 - 8, std::ios::end);  // before the (empty) level state's count
+  f.put('#');                      // the JSON's last characters: no longer JSON
   f.close();
   try {
     read_checkpoint(dir_ / "a.ckpt");
