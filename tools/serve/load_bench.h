@@ -1,0 +1,38 @@
+// `litgs-engine bench serve`: a loopback load test of the render service. Starts `litgs-engine serve` as a
+// child process on an ephemeral 127.0.0.1 port, then N client threads send a fixed number of POST /render
+// requests (views orbiting the model) per image size, bounded in time.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace litgs::serve {
+
+struct LoadBenchOptions {
+  std::string binary;  // litgs-engine
+  std::string model;
+  std::vector<std::pair<uint32_t, uint32_t>> sizes = {{320, 256}, {640, 512}};
+  int clients = 64;
+  int requests = 256;          // per size
+  double max_seconds = 300;    // per size: clients stop sending after this
+  size_t max_queue = 64;       // the server's --max-queue
+};
+
+struct LoadBenchResult {
+  uint32_t width = 0, height = 0;
+  int sent = 0, ok = 0, rejected_503 = 0, errors = 0;  // errors: anything but 200 and 503
+  double seconds = 0, throughput = 0, p50_ms = 0, p99_ms = 0, mean_device_ms = 0;
+  uint64_t rss_before = 0, rss_after = 0;  // server resident memory before and after this size's load
+  std::string first_error;
+};
+
+struct LoadBenchReport {
+  uint64_t rss_started = 0;  // after the model loaded, before any render
+  std::vector<LoadBenchResult> results;
+  std::string device;
+};
+
+LoadBenchReport run_load_bench(const LoadBenchOptions& options);
+
+}  // namespace litgs::serve
