@@ -38,7 +38,9 @@ void ServeTest::TearDownTestSuite() {
     auto c = client();
     if (const auto res = c->Get("/healthz"); res && res->status == 200) {
       const auto j = nlohmann::json::parse(res->body);
-      if (j.contains("validation_errors")) EXPECT_EQ(j["validation_errors"], 0) << res->body;
+      if (j.contains("validation_errors")) {
+        EXPECT_EQ(j["validation_errors"], 0) << res->body;
+      }
     }
     EXPECT_EQ(server_->stop(SIGTERM), 0) << server_->output();
     server_.reset();

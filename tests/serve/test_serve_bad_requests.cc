@@ -50,7 +50,7 @@ TEST_F(ServeBadRequest, NanAndInfinity) {
                400, "'t' is not a number");
   std::string inf = render_json();
   inf.replace(inf.find("\"fx\": 60"), 8, "\"fx\": 1e999");
-  expect_error(post("/render", inf), 400, "intrinsics.fx");
+  expect_error(post("/render", inf), 400, "number overflow parsing '1e999'");
   expect_error(post("/render", R"({"width": NaN})"), 400, "malformed JSON");
 }
 

@@ -30,18 +30,31 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
   if (status == 503) res.set_header("Retry-After", "1");
 }
 
+std::string endpoint_label(const std::string& path) {
+  static const char* known[] = {"/", "/viewer.js", "/palettes", "/healthz", "/metrics",
+                                "/model", "/models", "/models/load", "/render"};
+  for (const char* k : known)
+    if (path == k) return path;
+  return path.rfind("/scene/frames/", 0) == 0 ? "/scene/frames" : "other";
+}
+
 // Every handler runs inside this: RequestError becomes its status with a JSON error, anything else a 500
-// (the server's fault, never the client's).
+// (the server's fault, never the client's); the answer is counted before it is sent, so /metrics is
+// up to date for the next request.
 template <class Handler>
-httplib::Server::Handler guarded(Handler handler) {
-  return [handler](const httplib::Request& req, httplib::Response& res) {
+httplib::Server::Handler guarded(Metrics& metrics, Handler handler) {
+  return [&metrics, handler](const httplib::Request& req, httplib::Response& res) {
+    const auto start = std::chrono::steady_clock::now();
     try {
       handler(req, res);
+      if (res.status == -1) res.status = 200;  // httplib's "not set"
     } catch (const RequestError& e) {
       send_error(res, e.status, e.what());
     } catch (const std::exception& e) {
       send_error(res, 500, std::string("internal error: ") + e.what());
     }
+    metrics.count_request(endpoint_label(req.path), res.status,
+                          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   };
 }
 
@@ -97,25 +110,16 @@ json camera_json(const SceneCamera& c) {
               {"t", {K.t_cam_world.x, K.t_cam_world.y, K.t_cam_world.z}}}}}}};
 }
 
-std::string endpoint_label(const std::string& path) {
-  static const char* known[] = {"/", "/viewer.js", "/palettes", "/healthz", "/metrics",
-                                "/model", "/models", "/models/load", "/render"};
-  for (const char* k : known)
-    if (path == k) return path;
-  return path.rfind("/scene/frames/", 0) == 0 ? "/scene/frames" : "other";
-}
-
-thread_local std::chrono::steady_clock::time_point request_start;
-
 void add_routes(httplib::Server& svr, Service& service) {
-  const auto asset = [](const unsigned char* data, size_t size, const char* type) {
-    return [data, size, type](const httplib::Request&, httplib::Response& res) {
+  Metrics& metrics = service.metrics();
+  const auto asset = [&metrics](const unsigned char* data, size_t size, const char* type) {
+    return guarded(metrics, [data, size, type](const httplib::Request&, httplib::Response& res) {
       res.set_content(reinterpret_cast<const char*>(data), size, type);
-    };
+    });
   };
   svr.Get("/", asset(litgs_viewer_index_html, sizeof litgs_viewer_index_html, "text/html; charset=utf-8"));
   svr.Get("/viewer.js", asset(litgs_viewer_js, sizeof litgs_viewer_js, "text/javascript; charset=utf-8"));
-  svr.Get("/palettes", guarded([](const httplib::Request& req, httplib::Response& res) {
+  svr.Get("/palettes", guarded(metrics, [](const httplib::Request& req, httplib::Response& res) {
     refuse_query(req, {});
     json j = json::object();
     for (const std::string& name : io::palette_names()) {
@@ -125,13 +129,13 @@ void add_routes(httplib::Server& svr, Service& service) {
     }
     send_json(res, 200, j);
   }));
-  svr.Get("/healthz", guarded([&service](const httplib::Request& req, httplib::Response& res) {
+  svr.Get("/healthz", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
     refuse_query(req, {});
     json j = {{"status", "ok"}, {"models", service.models().summaries().size()}, {"queue", service.queue_depth()}};
     if (const auto errors = service.validation_errors()) j["validation_errors"] = *errors;
     send_json(res, 200, j);
   }));
-  svr.Get("/metrics", guarded([&service](const httplib::Request& req, httplib::Response& res) {
+  svr.Get("/metrics", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
     refuse_query(req, {});
     std::string gauges = "# HELP litgs_queue_depth Device jobs waiting.\n# TYPE litgs_queue_depth gauge\n";
     gauges += "litgs_queue_depth " + std::to_string(service.queue_depth()) + "\n";
@@ -144,7 +148,7 @@ void add_routes(httplib::Server& svr, Service& service) {
     }
     res.set_content(service.metrics().text(gauges + bytes), "text/plain; version=0.0.4");
   }));
-  svr.Get("/model", guarded([&service](const httplib::Request& req, httplib::Response& res) {
+  svr.Get("/model", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
     refuse_query(req, {"name"});
     const std::string name = req.has_param("name") ? req.get_param_value("name") : "default";
     const std::optional<ModelSummary> s = service.models().summary(name);
@@ -158,18 +162,18 @@ void add_routes(httplib::Server& svr, Service& service) {
                                                  : json{{"dir", service.options().scene}, {"cameras", cameras}};
     send_json(res, 200, j);
   }));
-  svr.Get("/models", guarded([&service](const httplib::Request& req, httplib::Response& res) {
+  svr.Get("/models", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
     refuse_query(req, {});
     json list = json::array();
     for (const ModelSummary& m : service.models().summaries()) list.push_back(summary_json(m));
     send_json(res, 200, {{"models", list}});
   }));
-  svr.Post("/models/load", guarded([&service](const httplib::Request& req, httplib::Response& res) {
+  svr.Post("/models/load", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
     require_json(req);
     json j;
     try {
       j = json::parse(req.body);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {
       throw RequestError(400, std::string("malformed JSON: ") + e.what());
     }
     if (!j.is_object()) throw RequestError(400, "the request body must be a JSON object {name, path}");
@@ -206,14 +210,14 @@ void add_routes(httplib::Server& svr, Service& service) {
     res.set_content(std::move(body.body), body.content_type);
   };
   const RequestLimits limits{service.options().max_pixels};
-  svr.Post("/render", guarded([render, limits](const httplib::Request& req, httplib::Response& res) {
+  svr.Post("/render", guarded(metrics, [render, limits](const httplib::Request& req, httplib::Response& res) {
     require_json(req);
     render(parse_render_json(req.body, limits), res);
   }));
-  svr.Get("/render", guarded([render, limits](const httplib::Request& req, httplib::Response& res) {
+  svr.Get("/render", guarded(metrics, [render, limits](const httplib::Request& req, httplib::Response& res) {
     render(parse_render_query(query(req), limits), res);
   }));
-  svr.Get(R"(/scene/frames/(\d{1,9})\.png)", guarded([&service](const httplib::Request& req, httplib::Response& res) {
+  svr.Get(R"(/scene/frames/(\d{1,9})\.png)", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
     refuse_query(req, {});
     const std::vector<uint8_t> png = service.scene_frame_png(std::stoul(req.matches[1].str()));
     res.set_content(reinterpret_cast<const char*>(png.data()), png.size(), "image/png");
@@ -225,10 +229,11 @@ void add_routes(httplib::Server& svr, Service& service) {
       {"/metrics", "GET"}, {"/model", "GET"},     {"/models", "GET"},          {"/models/load", "POST"},
       {"/render", "GET, POST"}};
   for (const auto& [path, allowed] : methods) {
-    const auto refuse = [allowed = std::string(allowed)](const httplib::Request& req, httplib::Response& res) {
-      send_error(res, 405, req.method + " is not allowed on " + req.path + " (allowed: " + allowed + ")");
-      res.set_header("Allow", allowed);
-    };
+    const auto refuse =
+        guarded(metrics, [allowed = std::string(allowed)](const httplib::Request& req, httplib::Response& res) {
+          send_error(res, 405, req.method + " is not allowed on " + req.path + " (allowed: " + allowed + ")");
+          res.set_header("Allow", allowed);
+        });
     if (std::string(allowed).find("POST") == std::string::npos) svr.Post(path, refuse);
     if (std::string(allowed).find("GET") == std::string::npos) svr.Get(path, refuse);
     svr.Put(path, refuse);
@@ -245,14 +250,11 @@ void configure(httplib::Server& svr, Service& service) {
   svr.set_read_timeout(o.read_timeout_s, 0);
   svr.set_write_timeout(o.read_timeout_s, 0);
   svr.set_keep_alive_timeout(o.read_timeout_s);
-  svr.set_pre_routing_handler([](const httplib::Request&, httplib::Response&) {
-    request_start = std::chrono::steady_clock::now();
-    return httplib::Server::HandlerResponse::Unhandled;
-  });
   // httplib's own refusals (unknown path, oversized body, malformed request line) get a JSON error too.
   svr.set_error_handler(httplib::Server::HandlerWithResponse(
-      [max_body = o.max_body_bytes](const httplib::Request& req, httplib::Response& res) {
-        if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+      [max_body = o.max_body_bytes, &service](const httplib::Request& req, httplib::Response& res) {
+        if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;  // ours: counted already
+        service.metrics().count_request(endpoint_label(req.path), res.status, 0.0);
         std::string message = "error " + std::to_string(res.status);
         if (res.status == 404) message = "no such endpoint: " + req.method + " " + req.path;
         if (res.status == 413)
@@ -262,13 +264,6 @@ void configure(httplib::Server& svr, Service& service) {
         send_error(res, res.status, message);
         return httplib::Server::HandlerResponse::Handled;
       }));
-  svr.set_logger([&service](const httplib::Request& req, const httplib::Response& res) {
-    const double seconds = request_start.time_since_epoch().count() == 0
-                               ? 0.0
-                               : std::chrono::duration<double>(std::chrono::steady_clock::now() - request_start).count();
-    request_start = {};
-    service.metrics().count_request(endpoint_label(req.path), res.status, seconds);
-  });
 }
 
 }  // namespace

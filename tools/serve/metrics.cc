@@ -50,7 +50,7 @@ std::string Metrics::text(const std::string& gauges) const {
   for (const auto& [key, n] : requests_)
     out += "litgs_http_requests_total{endpoint=\"" + key.first + "\",status=\"" + std::to_string(key.second) +
            "\"} " + std::to_string(n) + "\n";
-  out += "# HELP litgs_render_latency_seconds Time from a /render request's arrival to its answer (200s).\n";
+  out += "# HELP litgs_render_latency_seconds Time from a /render request read to its answer ready (200s).\n";
   out += "# TYPE litgs_render_latency_seconds histogram\n";
   render_latency_.write(out, "litgs_render_latency_seconds", "");
   out += "# HELP litgs_render_device_seconds Time on the device thread per render (forward and download).\n";

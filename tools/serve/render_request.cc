@@ -243,7 +243,7 @@ RenderRequest parse_render_json(const std::string& body, const RequestLimits& li
   json j;
   try {
     j = json::parse(body);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error, or out_of_range for a number like 1e999
     bad(std::string("malformed JSON: ") + e.what());
   }
   return from_json(j, limits);
