@@ -14,8 +14,8 @@ struct Stop {
 
 // Ironbow-like: black through deep blue-violet, magenta, orange and yellow to white, rising in lightness so
 // that hotter reads brighter in gray too. Our own stops, not a copied table.
-constexpr Stop kIronbowStops[] = {{0.00, 0, 0, 0},      {0.18, 40, 0, 120},   {0.38, 150, 0, 150},
-                                  {0.58, 225, 60, 40},  {0.78, 250, 165, 0},  {0.92, 255, 230, 90},
+constexpr Stop kIronbowStops[] = {{0.00, 0, 0, 0},      {0.18, 40, 0, 120},  {0.38, 150, 0, 150},
+                                  {0.58, 225, 60, 40},  {0.78, 250, 165, 0}, {0.92, 255, 230, 90},
                                   {1.00, 255, 255, 255}};
 
 std::array<Rgb, 256> make_table(Palette p) {
@@ -49,7 +49,8 @@ Palette parse_palette(const std::string& name) {
 }
 
 const std::array<Rgb, 256>& palette_table(Palette palette) {
-  static const std::array<Rgb, 256> gray = make_table(Palette::kGray), ironbow = make_table(Palette::kIronbow);
+  static const std::array<Rgb, 256> gray = make_table(Palette::kGray),
+                                    ironbow = make_table(Palette::kIronbow);
   return palette == Palette::kGray ? gray : ironbow;
 }
 

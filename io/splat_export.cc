@@ -24,18 +24,20 @@ std::vector<uint8_t> encode_splat(const kernels::GaussianModel& m, const SplatCo
   if (colouring.palette && m.channels != 1)
     throw std::invalid_argument("a palette needs a one-channel model; this one has " +
                                 std::to_string(m.channels) + " channels");
-  if (colouring.palette && !(colouring.hi > colouring.lo && std::isfinite(colouring.lo) &&
-                             std::isfinite(colouring.hi)))
+  if (colouring.palette &&
+      !(colouring.hi > colouring.lo && std::isfinite(colouring.lo) && std::isfinite(colouring.hi)))
     throw std::invalid_argument("the palette range needs finite LO < HI");
   const size_t n = m.size(), k = m.sh_coeffs(), c = m.channels;
   auto opacity = [&](size_t i) { return 1.0 / (1.0 + std::exp(-double(m.opacity_logits[i]))); };
   std::vector<double> importance(n);
   for (size_t i = 0; i < n; ++i)
-    importance[i] = std::exp(double(m.log_scales[3 * i]) + m.log_scales[3 * i + 1] + m.log_scales[3 * i + 2]) *
-                    opacity(i);
+    importance[i] =
+        std::exp(double(m.log_scales[3 * i]) + m.log_scales[3 * i + 1] + m.log_scales[3 * i + 2]) *
+        opacity(i);
   std::vector<size_t> order(n);
   std::iota(order.begin(), order.end(), size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return importance[a] > importance[b]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return importance[a] > importance[b]; });
 
   std::vector<uint8_t> out(n * 32);
   for (size_t row = 0; row < n; ++row) {
@@ -59,7 +61,8 @@ std::vector<uint8_t> encode_splat(const kernels::GaussianModel& m, const SplatCo
     }
     p[27] = unit_to_byte(opacity(i));
     const float* q = &m.quats[4 * i];
-    const double norm = std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3]);
+    const double norm =
+        std::sqrt(double(q[0]) * q[0] + double(q[1]) * q[1] + double(q[2]) * q[2] + double(q[3]) * q[3]);
     for (int a = 0; a < 4; ++a) {
       const double u = norm > 0 && std::isfinite(norm) ? q[a] / norm : (a == 0 ? 1.0 : 0.0);
       p[28 + a] = static_cast<uint8_t>(std::clamp(std::lround(u * 128.0 + 128.0), 0L, 255L));

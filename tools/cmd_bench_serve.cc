@@ -32,26 +32,36 @@ void add_bench_serve_command(CLI::App& bench) {
     o->binary = "/proc/self/exe";
     const serve::LoadBenchReport report = serve::run_load_bench(*o);
     if (*json_out) {
-      nlohmann::json j = {{"device", report.device}, {"rss_started", report.rss_started}, {"clients", o->clients}};
+      nlohmann::json j = {
+          {"device", report.device}, {"rss_started", report.rss_started}, {"clients", o->clients}};
       for (const auto& r : report.results)
-        j["sizes"].push_back({{"width", r.width},         {"height", r.height},       {"ok", r.ok},
-                              {"rejected_503", r.rejected_503}, {"errors", r.errors},   {"seconds", r.seconds},
-                              {"throughput", r.throughput}, {"p50_ms", r.p50_ms},     {"p99_ms", r.p99_ms},
-                              {"mean_device_ms", r.mean_device_ms}, {"rss_before", r.rss_before},
+        j["sizes"].push_back({{"width", r.width},
+                              {"height", r.height},
+                              {"ok", r.ok},
+                              {"rejected_503", r.rejected_503},
+                              {"errors", r.errors},
+                              {"seconds", r.seconds},
+                              {"throughput", r.throughput},
+                              {"p50_ms", r.p50_ms},
+                              {"p99_ms", r.p99_ms},
+                              {"mean_device_ms", r.mean_device_ms},
+                              {"rss_before", r.rss_before},
                               {"rss_after", r.rss_after}});
       std::cout << j.dump(2) << "\n";
     } else {
       std::cout << "bench serve: " << o->clients << " clients, " << o->requests << " requests per size, on "
                 << report.device << "; server RSS after loading " << mib(report.rss_started) << " MiB\n";
-      std::cout << "  size      ok    503  errors  req/s   p50 ms   p99 ms  device ms  RSS before -> after (MiB)\n";
+      std::cout
+          << "  size      ok    503  errors  req/s   p50 ms   p99 ms  device ms  RSS before -> after (MiB)\n";
       for (const auto& r : report.results)
-        std::cout << "  " << std::setw(3) << r.width << "x" << std::left << std::setw(4) << r.height << std::right
-                  << std::setw(6) << r.ok << std::setw(7) << r.rejected_503 << std::setw(8) << r.errors
-                  << std::fixed << std::setprecision(1) << std::setw(7) << r.throughput << std::setw(9) << r.p50_ms
-                  << std::setw(9) << r.p99_ms << std::setw(11) << r.mean_device_ms << "  " << mib(r.rss_before)
-                  << " -> " << mib(r.rss_after) << "\n";
+        std::cout << "  " << std::setw(3) << r.width << "x" << std::left << std::setw(4) << r.height
+                  << std::right << std::setw(6) << r.ok << std::setw(7) << r.rejected_503 << std::setw(8)
+                  << r.errors << std::fixed << std::setprecision(1) << std::setw(7) << r.throughput
+                  << std::setw(9) << r.p50_ms << std::setw(9) << r.p99_ms << std::setw(11) << r.mean_device_ms
+                  << "  " << mib(r.rss_before) << " -> " << mib(r.rss_after) << "\n";
       for (const auto& r : report.results)
-        if (!r.first_error.empty()) std::cout << "  first error at " << r.width << "x" << r.height << ": " << r.first_error << "\n";
+        if (!r.first_error.empty())
+          std::cout << "  first error at " << r.width << "x" << r.height << ": " << r.first_error << "\n";
     }
     for (const auto& r : report.results)
       if (r.errors > 0) throw std::runtime_error("bench serve: requests failed (see above)");

@@ -24,7 +24,8 @@ struct SplatOptions {
 void add_export_splat_command(CLI::App& exp) {
   auto o = std::make_shared<SplatOptions>();
   CLI::App* cmd = exp.add_subcommand(
-      "splat", "A 3DGS PLY as the 32-byte .splat layout of web viewers (one-channel models: gray or a palette)");
+      "splat",
+      "A 3DGS PLY as the 32-byte .splat layout of web viewers (one-channel models: gray or a palette)");
   cmd->add_option("--model", o->model, "3DGS PLY model")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out", o->out, ".splat file to write")->required();
   cmd->add_option("--palette", o->palette, "gray or ironbow: colour one-channel values over --range");

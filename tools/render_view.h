@@ -23,7 +23,7 @@ glm::dmat3 rotation_from_quat(double w, double x, double y, double z);
 // A 3DGS PLY moved into the frame its poses are given in (see cmd_render.cc's top comment).
 struct FramedModel {
   kernels::GaussianModel model;
-  std::string frame;  // "scene", "original" or "model"
+  std::string frame;                                       // "scene", "original" or "model"
   Eigen::Vector3d frame_offset = Eigen::Vector3d::Zero();  // pose-frame coordinates + this = original world
 };
 // pose_frame: auto | scene | original | model. scene_offset: the --scene's world_offset_m, if given (it wins

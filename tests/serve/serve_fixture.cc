@@ -15,8 +15,8 @@ namespace fs = std::filesystem;
 
 void ServeTest::SetUpTestSuite() {
   dir_ = fs::temp_directory_path() /
-         ("litgs-serve-" + std::string(::testing::UnitTest::GetInstance()->current_test_suite()->name()) + "-" +
-          std::to_string(::getpid()));
+         ("litgs-serve-" + std::string(::testing::UnitTest::GetInstance()->current_test_suite()->name()) +
+          "-" + std::to_string(::getpid()));
   fs::remove_all(dir_);
   fs::create_directories(dir_ / "models");
   io::write_gaussian_ply(dir_ / "model.ply", random_scene(300, 1, 3, 5));
@@ -25,9 +25,8 @@ void ServeTest::SetUpTestSuite() {
   io::write_gaussian_ply(dir_ / "outside.ply", random_scene(10, 1, 0, 1));
   fs::create_symlink(dir_ / "outside.ply", dir_ / "models" / "link.ply");
   std::ofstream(dir_ / "models" / "broken.ply") << "ply\nformat ascii 1.0\nend_header\n";
-  std::vector<std::string> args = {"--model",      model_path(),  "--models-dir", path("models"),
-                                   "--max-pixels", "400000",      "--max-body",   "65536",
-                                   "--read-timeout", "1"};
+  std::vector<std::string> args = {"--model", model_path(), "--models-dir", path("models"),   "--max-pixels",
+                                   "400000",  "--max-body", "65536",        "--read-timeout", "1"};
   args.insert(args.end(), extra_args_.begin(), extra_args_.end());
   server_ = std::make_unique<serve::ServerProcess>(LITGS_ENGINE_BINARY, args);
 }

@@ -35,7 +35,8 @@ class ServeTest : public ::testing::Test {
 };
 
 // The camera the tests render: 64x48, looking down +z at the random scene, as `render` flags and as JSON.
-inline constexpr const char* kCliCamera = "--pose 1 0 0 0 0 0 0 --intrinsics 60 60 32 24 --width 64 --height 48";
+inline constexpr const char* kCliCamera =
+    "--pose 1 0 0 0 0 0 0 --intrinsics 60 60 32 24 --width 64 --height 48";
 std::string render_json(const std::string& outputs = "", const std::string& extra = "");
 inline constexpr const char* kQueryCamera =
     "pose=T_cam_world&q=1,0,0,0&t=0,0,0&fx=60&fy=60&cx=32&cy=24&width=64&height=48";

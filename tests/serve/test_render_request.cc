@@ -115,10 +115,13 @@ TEST(RenderRequest, OutputsAndPalettes) {
     b.insert(b.size() - 1, ", \"outputs\": " + outputs);
     return error_of(b);
   };
-  EXPECT_NE(with_outputs(R"({"image": {"palette": "jet"}})").find("unknown palette 'jet'"), std::string::npos);
-  EXPECT_NE(with_outputs(R"({"image": {"format": "png16", "palette": "gray"}})").find("png8"), std::string::npos);
+  EXPECT_NE(with_outputs(R"({"image": {"palette": "jet"}})").find("unknown palette 'jet'"),
+            std::string::npos);
+  EXPECT_NE(with_outputs(R"({"image": {"format": "png16", "palette": "gray"}})").find("png8"),
+            std::string::npos);
   EXPECT_NE(with_outputs(R"({"depth": {"palette": "gray"}})").find("outputs.depth.range"), std::string::npos);
-  EXPECT_NE(with_outputs(R"({"image": {"palette": "gray", "range": [1, 1]}})").find("LO < HI"), std::string::npos);
+  EXPECT_NE(with_outputs(R"({"image": {"palette": "gray", "range": [1, 1]}})").find("LO < HI"),
+            std::string::npos);
   EXPECT_NE(with_outputs("{}").find("asks for nothing"), std::string::npos);
   EXPECT_NE(with_outputs(R"({"normals": {}})").find("unknown field 'outputs.normals'"), std::string::npos);
 }

@@ -80,7 +80,8 @@ TEST_F(ServeBadRequest, UnknownModel) {
 }
 
 TEST_F(ServeBadRequest, PathTraversalAndSymlinksOutOfModelsDir) {
-  expect_error(post("/models/load", R"({"name": "x", "path": "../outside.ply"})"), 403, "outside --models-dir");
+  expect_error(post("/models/load", R"({"name": "x", "path": "../outside.ply"})"), 403,
+               "outside --models-dir");
   expect_error(post("/models/load", R"({"name": "x", "path": "link.ply"})"), 403, "outside --models-dir");
   expect_error(post("/models/load", R"({"name": "x", "path": "/etc/passwd"})"), 403, "outside --models-dir");
   expect_error(post("/models/load", R"({"name": "x", "path": "missing.ply"})"), 404, "missing.ply");
@@ -100,7 +101,8 @@ TEST_F(ServeBadRequest, WrongMethodAndContentType) {
   EXPECT_EQ(put->get_header_value("Allow"), "GET, POST");
   expect_error(client()->Get("/models/load"), 405, "GET is not allowed on /models/load");
   expect_error(client()->Delete("/model"), 405, "allowed: GET");
-  expect_error(client()->Post("/render", render_json(), "text/plain"), 415, "Content-Type must be application/json");
+  expect_error(client()->Post("/render", render_json(), "text/plain"), 415,
+               "Content-Type must be application/json");
   expect_error(client()->Get("/nowhere"), 404, "no such endpoint: GET /nowhere");
 }
 
@@ -148,7 +150,8 @@ TEST_F(ServeBadRequest, SlowClientIsDisconnectedWithoutBlockingOthers) {
 TEST_F(ServeBadRequest, HalfClosedClientGetsAnErrorOrAClose) {
   const int fd = connect_to(port());
   const std::string partial =
-      "POST /render HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: 500\r\n\r\n{\"pose\"";
+      "POST /render HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: "
+      "500\r\n\r\n{\"pose\"";
   ASSERT_EQ(send(fd, partial.data(), partial.size(), 0), static_cast<ssize_t>(partial.size()));
   shutdown(fd, SHUT_WR);  // the body will never come
   const std::string got = read_all(fd, 10);

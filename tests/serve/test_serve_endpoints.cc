@@ -22,9 +22,9 @@ struct CliRender {
 };
 CliRender cli_render(const std::string& model, int bit_depth) {
   const std::string out = "/tmp/litgs-serve-cli-" + std::to_string(::getpid());
-  const CommandResult r = run_engine("render --model " + model + " " + kCliCamera + " --bit-depth " +
-                                     std::to_string(bit_depth) + " --out " + out + "-image.png --depth " + out +
-                                     "-depth.png --alpha " + out + "-alpha.png");
+  const CommandResult r =
+      run_engine("render --model " + model + " " + kCliCamera + " --bit-depth " + std::to_string(bit_depth) +
+                 " --out " + out + "-image.png --depth " + out + "-depth.png --alpha " + out + "-alpha.png");
   EXPECT_EQ(r.status, 0) << r.output;
   CliRender c{file_bytes(out + "-image.png"), file_bytes(out + "-depth.png"), file_bytes(out + "-alpha.png")};
   for (const char* k : {"-image.png", "-depth.png", "-alpha.png"}) std::filesystem::remove(out + k);
@@ -49,7 +49,8 @@ TEST_F(ServeTest, RenderPngEqualsTheCommandLineBitForBit) {
   EXPECT_EQ(post->get_header_value("Content-Type"), "image/png");
   EXPECT_EQ(post->body, cli.image);
   EXPECT_EQ(post->get_header_value("X-Model-Version").rfind("default@", 0), 0u);
-  EXPECT_GE(std::stod(post->get_header_value("X-Render-Ms")), std::stod(post->get_header_value("X-Device-Ms")));
+  EXPECT_GE(std::stod(post->get_header_value("X-Render-Ms")),
+            std::stod(post->get_header_value("X-Device-Ms")));
   const auto get = client()->Get(std::string("/render?") + kQueryCamera);
   ASSERT_TRUE(get);
   ASSERT_EQ(get->status, 200) << get->body;
@@ -59,8 +60,7 @@ TEST_F(ServeTest, RenderPngEqualsTheCommandLineBitForBit) {
 TEST_F(ServeTest, BundleOf16BitImageDepthAndAlphaEqualsTheCommandLine) {
   const CliRender cli = cli_render(model_path(), 16);
   const auto res = client()->Post(
-      "/render",
-      render_json(R"({"image": {"format": "png16"}, "depth": {"format": "png16", "scale": 1000},
+      "/render", render_json(R"({"image": {"format": "png16"}, "depth": {"format": "png16", "scale": 1000},
                       "alpha": {"format": "png8"}})"),
       "application/json");
   ASSERT_TRUE(res);
@@ -74,15 +74,17 @@ TEST_F(ServeTest, BundleOf16BitImageDepthAndAlphaEqualsTheCommandLine) {
 }
 
 TEST_F(ServeTest, Float32AndPaletteOutputsAgreeWithThePng) {
-  const auto raw = client()->Post("/render", render_json(R"({"image": {"format": "float32"}})"), "application/json");
+  const auto raw =
+      client()->Post("/render", render_json(R"({"image": {"format": "float32"}})"), "application/json");
   ASSERT_TRUE(raw);
   ASSERT_EQ(raw->status, 200) << raw->body;
   EXPECT_EQ(raw->get_header_value("Content-Type"), "application/octet-stream");
   ASSERT_EQ(raw->body.size(), 64u * 48 * 4);
   std::vector<float> values(64 * 48);
   std::memcpy(values.data(), raw->body.data(), raw->body.size());
-  const auto pal = client()->Post(
-      "/render", render_json(R"({"image": {"palette": "ironbow", "range": [0.1, 0.9]}})"), "application/json");
+  const auto pal =
+      client()->Post("/render", render_json(R"({"image": {"palette": "ironbow", "range": [0.1, 0.9]}})"),
+                     "application/json");
   ASSERT_TRUE(pal);
   ASSERT_EQ(pal->status, 200) << pal->body;
   const std::string png_path = path("palette.png");
@@ -109,9 +111,11 @@ TEST_F(ServeTest, CameraToWorldPoseRendersTheSameView) {
                 {"outputs", {{"image", {{"format", "float32"}}}}}}
         .dump();
   };
-  const auto a = client()->Post("/render", body("T_cam_world", {h, 0, 0, h}, {0.1, 0, 0}), "application/json");
+  const auto a =
+      client()->Post("/render", body("T_cam_world", {h, 0, 0, h}, {0.1, 0, 0}), "application/json");
   // T_world_cam = inverse: R^T, -R^T t; R^T t for a 90 degree turn of (0.1, 0, 0) is (0, -0.1, 0).
-  const auto b = client()->Post("/render", body("T_world_cam", {h, 0, 0, -h}, {0, 0.1, 0}), "application/json");
+  const auto b =
+      client()->Post("/render", body("T_world_cam", {h, 0, 0, -h}, {0, 0.1, 0}), "application/json");
   ASSERT_TRUE(a && b);
   ASSERT_EQ(a->status, 200) << a->body;
   ASSERT_EQ(b->status, 200) << b->body;
@@ -134,7 +138,8 @@ TEST_F(ServeTest, ModelDescribesTheLoadedModel) {
   EXPECT_EQ(j["pose_frame"], "model");
   EXPECT_TRUE(j["scene"].is_null());
   EXPECT_GT(j["device_bytes"].get<double>(), 300 * 4 * 14);
-  for (int a = 0; a < 3; ++a) EXPECT_LT(j["bounds"]["min"][a].get<double>(), j["bounds"]["max"][a].get<double>());
+  for (int a = 0; a < 3; ++a)
+    EXPECT_LT(j["bounds"]["min"][a].get<double>(), j["bounds"]["max"][a].get<double>());
   EXPECT_GE(j["bounds"]["min"][2].get<double>(), 1.5);  // random_scene's depths are 1.5 - 6 m
   EXPECT_LE(j["bounds"]["max"][2].get<double>(), 6.0);
   const auto list = client()->Get("/models");
@@ -150,10 +155,11 @@ TEST_F(ServeTest, MetricsAreInPrometheusTextFormat) {
   ASSERT_EQ(res->status, 200);
   EXPECT_EQ(res->get_header_value("Content-Type").rfind("text/plain", 0), 0u);
   for (const char* line :
-       {"# TYPE litgs_http_requests_total counter", "litgs_http_requests_total{endpoint=\"/render\",status=\"200\"}",
+       {"# TYPE litgs_http_requests_total counter",
+        "litgs_http_requests_total{endpoint=\"/render\",status=\"200\"}",
         "# TYPE litgs_render_latency_seconds histogram", "litgs_render_latency_seconds_bucket{le=\"+Inf\"}",
-        "litgs_render_device_seconds_count", "litgs_queue_depth 0", "litgs_model_gaussians{model=\"default\"}",
-        "process_resident_memory_bytes"})
+        "litgs_render_device_seconds_count", "litgs_queue_depth 0",
+        "litgs_model_gaussians{model=\"default\"}", "process_resident_memory_bytes"})
     EXPECT_NE(res->body.find(line), std::string::npos) << line << "\n" << res->body;
 }
 
@@ -175,19 +181,21 @@ TEST_F(ServeTest, ViewerPageAndScriptAreServed) {
 }
 
 TEST_F(ServeTest, LoadSwapsTheModelAndBumpsItsVersion) {
-  const auto load = client()->Post("/models/load", R"({"name": "second", "path": "other.ply"})", "application/json");
+  const auto load =
+      client()->Post("/models/load", R"({"name": "second", "path": "other.ply"})", "application/json");
   ASSERT_TRUE(load);
   ASSERT_EQ(load->status, 200) << load->body;
   EXPECT_EQ(body_json(load)["gaussians"], 200);
   EXPECT_EQ(body_json(load)["version"], 1);
-  const auto res = client()->Post("/render", render_json("", R"("model": "second", "sh_degree": 1)"),
-                                  "application/json");
+  const auto res =
+      client()->Post("/render", render_json("", R"("model": "second", "sh_degree": 1)"), "application/json");
   ASSERT_TRUE(res);
   ASSERT_EQ(res->status, 200) << res->body;
   EXPECT_EQ(res->get_header_value("X-Model-Version"), "second@1");
   const CliRender cli = cli_render(path("models/other.ply"), 8);
   EXPECT_EQ(res->body, cli.image);
-  const auto again = client()->Post("/models/load", R"({"name": "second", "path": "other.ply"})", "application/json");
+  const auto again =
+      client()->Post("/models/load", R"({"name": "second", "path": "other.ply"})", "application/json");
   ASSERT_TRUE(again);
   EXPECT_EQ(body_json(again)["version"], 2);
 }
@@ -258,10 +266,8 @@ TEST_F(ServeScene, ModelListsTheScenesCamerasWithTheirFrames) {
   const io::Image image = io::read_image(path("frame.png"));
   EXPECT_EQ(image.width, 64);
   EXPECT_EQ(image.bit_depth, 8);
-  const json body = {{"pose", cameras[2]["pose"]},
-                     {"intrinsics", cameras[2]["intrinsics"]},
-                     {"width", 64},
-                     {"height", 48}};
+  const json body = {
+      {"pose", cameras[2]["pose"]}, {"intrinsics", cameras[2]["intrinsics"]}, {"width", 64}, {"height", 48}};
   const auto render = client()->Post("/render", body.dump(), "application/json");
   ASSERT_TRUE(render);
   EXPECT_EQ(render->status, 200) << render->body;

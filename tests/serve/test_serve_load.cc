@@ -11,7 +11,8 @@ namespace {
 
 TEST_F(ServeTest, ReloadUnderLoadFailsNoRequest) {
   auto loader = client();
-  const auto first = loader->Post("/models/load", R"({"name": "live", "path": "same.ply"})", "application/json");
+  const auto first =
+      loader->Post("/models/load", R"({"name": "live", "path": "same.ply"})", "application/json");
   ASSERT_TRUE(first);
   ASSERT_EQ(first->status, 200) << first->body;
   std::atomic<bool> done{false};
@@ -31,13 +32,15 @@ TEST_F(ServeTest, ReloadUnderLoadFailsNoRequest) {
           versions.insert(res->get_header_value("X-Model-Version"));
         } else {
           ++failed;
-          if (first_failure.empty()) first_failure = res ? std::to_string(res->status) + " " + res->body : "no response";
+          if (first_failure.empty())
+            first_failure = res ? std::to_string(res->status) + " " + res->body : "no response";
         }
       }
     });
   for (int i = 0; i < 6; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(60));
-    const auto res = loader->Post("/models/load", R"({"name": "live", "path": "same.ply"})", "application/json");
+    const auto res =
+        loader->Post("/models/load", R"({"name": "live", "path": "same.ply"})", "application/json");
     ASSERT_TRUE(res);
     EXPECT_EQ(res->status, 200) << res->body;
   }
@@ -85,7 +88,8 @@ TEST_F(ServeSmallQueue, FullQueueAnswers503WithRetryAfter) {
   EXPECT_EQ(missing_retry_after.load(), 0);
   const auto metrics = client()->Get("/metrics");
   ASSERT_TRUE(metrics);
-  EXPECT_NE(metrics->body.find("litgs_http_requests_total{endpoint=\"/render\",status=\"503\"}"), std::string::npos);
+  EXPECT_NE(metrics->body.find("litgs_http_requests_total{endpoint=\"/render\",status=\"503\"}"),
+            std::string::npos);
 }
 
 class ServeTimeout : public ServeTest {

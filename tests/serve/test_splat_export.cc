@@ -32,7 +32,7 @@ kernels::GaussianModel two_gaussians(uint32_t channels) {
   m.opacity_logits = {0.0f, 2.0f};
   std::fill(m.sh.begin(), m.sh.end(), 0.0f);
   for (uint32_t c = 0; c < channels; ++c) {
-    m.sh[c] = 0.8f;                        // Gaussian 0's DC term
+    m.sh[c] = 0.8f;                              // Gaussian 0's DC term
     m.sh[m.sh_coeffs() * channels + c] = -1.0f;  // Gaussian 1's
   }
   return m;

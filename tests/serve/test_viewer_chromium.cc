@@ -1,6 +1,6 @@
 // The viewer page in headless Chromium (Debian `chromium`): it loads with no console error, a camera given in
-// the URL gives a screenshot whose pixels are the model's render, and one navigation step changes the picture.
-// Skipped, saying so, only where /usr/bin/chromium is absent (ci/setup installs it).
+// the URL gives a screenshot whose pixels are the model's render, and one navigation step changes the
+// picture. Skipped, saying so, only where /usr/bin/chromium is absent (ci/setup installs it).
 #include <unistd.h>
 
 #include <cstdlib>
@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 constexpr const char* kChromium = "/usr/bin/chromium";
 // 160x128 looking down +z: the random scene fills it (fx = w for its field of view).
 constexpr const char* kViewCamera = "q=1,0,0,0&t=0,0,0&fx=160&fy=160&cx=80&cy=64&w=160&h=128";
-constexpr const char* kCliViewCamera = "--pose 1 0 0 0 0 0 0 --intrinsics 160 160 80 64 --width 160 --height 128";
+constexpr const char* kCliViewCamera =
+    "--pose 1 0 0 0 0 0 0 --intrinsics 160 160 80 64 --width 160 --height 128";
 
 class ViewerChromium : public ServeTest {
  protected:
@@ -33,10 +34,12 @@ class ViewerChromium : public ServeTest {
     const std::string cmd = std::string(kChromium) +
                             " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run"
                             " --disable-background-networking --disable-component-update --disable-sync"
-                            " --user-data-dir=" + profile.string() +
+                            " --user-data-dir=" +
+                            profile.string() +
                             " --window-size=900,400 --hide-scrollbars --force-device-scale-factor=1"
                             " --force-color-profile=srgb --enable-logging=stderr --v=0"
-                            " --virtual-time-budget=30000 " + mode + " '" + url + "' 2>&1";
+                            " --virtual-time-budget=30000 " +
+                            mode + " '" + url + "' 2>&1";
     std::string out;
     FILE* pipe = popen(cmd.c_str(), "r");
     if (!pipe) return "popen failed";

@@ -31,8 +31,8 @@ void send_error(httplib::Response& res, int status, const std::string& message) 
 }
 
 std::string endpoint_label(const std::string& path) {
-  static const char* known[] = {"/", "/viewer.js", "/palettes", "/healthz", "/metrics",
-                                "/model", "/models", "/models/load", "/render"};
+  static const char* known[] = {"/",      "/viewer.js", "/palettes",    "/healthz", "/metrics",
+                                "/model", "/models",    "/models/load", "/render"};
   for (const char* k : known)
     if (path == k) return path;
   return path.rfind("/scene/frames/", 0) == 0 ? "/scene/frames" : "other";
@@ -120,83 +120,97 @@ void add_routes(httplib::Server& svr, Service& service) {
   svr.Get("/", asset(litgs_viewer_index_html, sizeof litgs_viewer_index_html, "text/html; charset=utf-8"));
   svr.Get("/viewer.js", asset(litgs_viewer_js, sizeof litgs_viewer_js, "text/javascript; charset=utf-8"));
   svr.Get("/palettes", guarded(metrics, [](const httplib::Request& req, httplib::Response& res) {
-    refuse_query(req, {});
-    json j = json::object();
-    for (const std::string& name : io::palette_names()) {
-      json colours = json::array();
-      for (const io::Rgb& c : io::palette_table(io::parse_palette(name))) colours.push_back({c[0], c[1], c[2]});
-      j[name] = colours;
-    }
-    send_json(res, 200, j);
-  }));
+            refuse_query(req, {});
+            json j = json::object();
+            for (const std::string& name : io::palette_names()) {
+              json colours = json::array();
+              for (const io::Rgb& c : io::palette_table(io::parse_palette(name)))
+                colours.push_back({c[0], c[1], c[2]});
+              j[name] = colours;
+            }
+            send_json(res, 200, j);
+          }));
   svr.Get("/healthz", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
-    refuse_query(req, {});
-    json j = {{"status", "ok"}, {"models", service.models().summaries().size()}, {"queue", service.queue_depth()}};
-    if (const auto errors = service.validation_errors()) j["validation_errors"] = *errors;
-    send_json(res, 200, j);
-  }));
+            refuse_query(req, {});
+            json j = {{"status", "ok"},
+                      {"models", service.models().summaries().size()},
+                      {"queue", service.queue_depth()}};
+            if (const auto errors = service.validation_errors()) j["validation_errors"] = *errors;
+            send_json(res, 200, j);
+          }));
   svr.Get("/metrics", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
-    refuse_query(req, {});
-    std::string gauges = "# HELP litgs_queue_depth Device jobs waiting.\n# TYPE litgs_queue_depth gauge\n";
-    gauges += "litgs_queue_depth " + std::to_string(service.queue_depth()) + "\n";
-    gauges += "# HELP litgs_model_gaussians Gaussians of each loaded model.\n# TYPE litgs_model_gaussians gauge\n";
-    std::string bytes =
-        "# HELP litgs_model_device_bytes Device memory of each model.\n# TYPE litgs_model_device_bytes gauge\n";
-    for (const ModelSummary& m : service.models().summaries()) {
-      gauges += "litgs_model_gaussians{model=\"" + m.name + "\"} " + std::to_string(m.gaussians) + "\n";
-      bytes += "litgs_model_device_bytes{model=\"" + m.name + "\"} " + std::to_string(m.device_bytes) + "\n";
-    }
-    res.set_content(service.metrics().text(gauges + bytes), "text/plain; version=0.0.4");
-  }));
+            refuse_query(req, {});
+            std::string gauges =
+                "# HELP litgs_queue_depth Device jobs waiting.\n# TYPE litgs_queue_depth gauge\n";
+            gauges += "litgs_queue_depth " + std::to_string(service.queue_depth()) + "\n";
+            gauges +=
+                "# HELP litgs_model_gaussians Gaussians of each loaded model.\n# TYPE litgs_model_gaussians "
+                "gauge\n";
+            std::string bytes =
+                "# HELP litgs_model_device_bytes Device memory of each model.\n# TYPE "
+                "litgs_model_device_bytes gauge\n";
+            for (const ModelSummary& m : service.models().summaries()) {
+              gauges +=
+                  "litgs_model_gaussians{model=\"" + m.name + "\"} " + std::to_string(m.gaussians) + "\n";
+              bytes += "litgs_model_device_bytes{model=\"" + m.name + "\"} " +
+                       std::to_string(m.device_bytes) + "\n";
+            }
+            res.set_content(service.metrics().text(gauges + bytes), "text/plain; version=0.0.4");
+          }));
   svr.Get("/model", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
-    refuse_query(req, {"name"});
-    const std::string name = req.has_param("name") ? req.get_param_value("name") : "default";
-    const std::optional<ModelSummary> s = service.models().summary(name);
-    if (!s) throw RequestError(404, "unknown model '" + name + "'");
-    json j = summary_json(*s);
-    j["max_pixels"] = service.options().max_pixels;
-    j["device"] = service.device().name;
-    json cameras = json::array();
-    for (const SceneCamera& c : service.scene_cameras()) cameras.push_back(camera_json(c));
-    j["scene"] = service.options().scene.empty() ? json(nullptr)
-                                                 : json{{"dir", service.options().scene}, {"cameras", cameras}};
-    send_json(res, 200, j);
-  }));
+            refuse_query(req, {"name"});
+            const std::string name = req.has_param("name") ? req.get_param_value("name") : "default";
+            const std::optional<ModelSummary> s = service.models().summary(name);
+            if (!s) throw RequestError(404, "unknown model '" + name + "'");
+            json j = summary_json(*s);
+            j["max_pixels"] = service.options().max_pixels;
+            j["device"] = service.device().name;
+            json cameras = json::array();
+            for (const SceneCamera& c : service.scene_cameras()) cameras.push_back(camera_json(c));
+            j["scene"] = service.options().scene.empty()
+                             ? json(nullptr)
+                             : json{{"dir", service.options().scene}, {"cameras", cameras}};
+            send_json(res, 200, j);
+          }));
   svr.Get("/models", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
-    refuse_query(req, {});
-    json list = json::array();
-    for (const ModelSummary& m : service.models().summaries()) list.push_back(summary_json(m));
-    send_json(res, 200, {{"models", list}});
-  }));
+            refuse_query(req, {});
+            json list = json::array();
+            for (const ModelSummary& m : service.models().summaries()) list.push_back(summary_json(m));
+            send_json(res, 200, {{"models", list}});
+          }));
   svr.Post("/models/load", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
-    require_json(req);
-    json j;
-    try {
-      j = json::parse(req.body);
-    } catch (const json::exception& e) {
-      throw RequestError(400, std::string("malformed JSON: ") + e.what());
-    }
-    if (!j.is_object()) throw RequestError(400, "the request body must be a JSON object {name, path}");
-    for (const auto& item : j.items())
-      if (item.key() != "name" && item.key() != "path")
-        throw RequestError(400, "unknown field '" + item.key() + "' (allowed here: name, path)");
-    if (!j.contains("name") || !j["name"].is_string()) throw RequestError(400, "missing string field 'name'");
-    if (!j.contains("path") || !j["path"].is_string()) throw RequestError(400, "missing string field 'path'");
-    const std::string name = j["name"];
-    static const std::regex kName("[A-Za-z0-9_.-]{1,64}");
-    if (!std::regex_match(name, kName))
-      throw RequestError(400, "field 'name' must be 1-64 characters of A-Z a-z 0-9 _ . -");
-    const std::filesystem::path path = confine_to_models_dir(service.options().models_dir, j["path"]);
-    ModelSummary s;
-    try {
-      s = service.load(name, path);
-    } catch (const RequestError&) {
-      throw;
-    } catch (const std::exception& e) {
-      throw RequestError(400, "cannot load '" + j["path"].get<std::string>() + "': " + e.what());
-    }
-    send_json(res, 200, summary_json(s));
-  }));
+             require_json(req);
+             json j;
+             try {
+               j = json::parse(req.body);
+             } catch (const json::exception& e) {
+               throw RequestError(400, std::string("malformed JSON: ") + e.what());
+             }
+             if (!j.is_object())
+               throw RequestError(400, "the request body must be a JSON object {name, path}");
+             for (const auto& item : j.items())
+               if (item.key() != "name" && item.key() != "path")
+                 throw RequestError(400, "unknown field '" + item.key() + "' (allowed here: name, path)");
+             if (!j.contains("name") || !j["name"].is_string())
+               throw RequestError(400, "missing string field 'name'");
+             if (!j.contains("path") || !j["path"].is_string())
+               throw RequestError(400, "missing string field 'path'");
+             const std::string name = j["name"];
+             static const std::regex kName("[A-Za-z0-9_.-]{1,64}");
+             if (!std::regex_match(name, kName))
+               throw RequestError(400, "field 'name' must be 1-64 characters of A-Z a-z 0-9 _ . -");
+             const std::filesystem::path path =
+                 confine_to_models_dir(service.options().models_dir, j["path"]);
+             ModelSummary s;
+             try {
+               s = service.load(name, path);
+             } catch (const RequestError&) {
+               throw;
+             } catch (const std::exception& e) {
+               throw RequestError(400, "cannot load '" + j["path"].get<std::string>() + "': " + e.what());
+             }
+             send_json(res, 200, summary_json(s));
+           }));
   const auto render = [&service](const RenderRequest& request, httplib::Response& res) {
     const auto start = std::chrono::steady_clock::now();
     ModelSummary used;
@@ -205,32 +219,35 @@ void add_routes(httplib::Server& svr, Service& service) {
     for (const auto& [k, v] : body.headers) res.set_header(k, v);
     res.set_header("X-Model-Version", used.name + "@" + std::to_string(used.version));
     res.set_header("X-Device-Ms", std::to_string(view.device_seconds * 1e3));
-    res.set_header("X-Render-Ms",
-                   std::to_string(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()));
+    res.set_header(
+        "X-Render-Ms",
+        std::to_string(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()));
     res.set_content(std::move(body.body), body.content_type);
   };
   const RequestLimits limits{service.options().max_pixels};
   svr.Post("/render", guarded(metrics, [render, limits](const httplib::Request& req, httplib::Response& res) {
-    require_json(req);
-    render(parse_render_json(req.body, limits), res);
-  }));
+             require_json(req);
+             render(parse_render_json(req.body, limits), res);
+           }));
   svr.Get("/render", guarded(metrics, [render, limits](const httplib::Request& req, httplib::Response& res) {
-    render(parse_render_query(query(req), limits), res);
-  }));
-  svr.Get(R"(/scene/frames/(\d{1,9})\.png)", guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
-    refuse_query(req, {});
-    const std::vector<uint8_t> png = service.scene_frame_png(std::stoul(req.matches[1].str()));
-    res.set_content(reinterpret_cast<const char*>(png.data()), png.size(), "image/png");
-  }));
+            render(parse_render_query(query(req), limits), res);
+          }));
+  svr.Get(R"(/scene/frames/(\d{1,9})\.png)",
+          guarded(metrics, [&service](const httplib::Request& req, httplib::Response& res) {
+            refuse_query(req, {});
+            const std::vector<uint8_t> png = service.scene_frame_png(std::stoul(req.matches[1].str()));
+            res.set_content(reinterpret_cast<const char*>(png.data()), png.size(), "image/png");
+          }));
 
   // Known paths with a method they do not take: 405 naming the one they do.
   const std::pair<const char*, const char*> methods[] = {
-      {"/", "GET"},        {"/viewer.js", "GET"}, {"/palettes", "GET"},        {"/healthz", "GET"},
-      {"/metrics", "GET"}, {"/model", "GET"},     {"/models", "GET"},          {"/models/load", "POST"},
-      {"/render", "GET, POST"}};
+      {"/", "GET"},        {"/viewer.js", "GET"},    {"/palettes", "GET"},
+      {"/healthz", "GET"}, {"/metrics", "GET"},      {"/model", "GET"},
+      {"/models", "GET"},  {"/models/load", "POST"}, {"/render", "GET, POST"}};
   for (const auto& [path, allowed] : methods) {
-    const auto refuse =
-        guarded(metrics, [allowed = std::string(allowed)](const httplib::Request& req, httplib::Response& res) {
+    const auto refuse = guarded(
+        metrics, [allowed = std::string(allowed)](const httplib::Request& req, httplib::Response& res) {
           send_error(res, 405, req.method + " is not allowed on " + req.path + " (allowed: " + allowed + ")");
           res.set_header("Allow", allowed);
         });
@@ -290,7 +307,8 @@ int run_http_server(const ServeOptions& options) {
   } else if (!svr.bind_to_port(options.host, port)) {
     port = -1;
   }
-  if (port < 0) throw std::runtime_error("cannot listen on " + options.host + ":" + std::to_string(options.port));
+  if (port < 0)
+    throw std::runtime_error("cannot listen on " + options.host + ":" + std::to_string(options.port));
 
   std::atomic<bool> signalled{false};
   std::thread waiter([&] {
@@ -300,8 +318,9 @@ int run_http_server(const ServeOptions& options) {
     svr.stop();
   });
   const ModelSummary model = *service.models().summary("default");
-  std::cout << "serve: " << model.gaussians << " Gaussians (" << model.path << ") on " << service.device().name
-            << "\nserve: listening on http://" << options.host << ":" << port << std::endl;
+  std::cout << "serve: " << model.gaussians << " Gaussians (" << model.path << ") on "
+            << service.device().name << "\nserve: listening on http://" << options.host << ":" << port
+            << std::endl;
   const bool ok = svr.listen_after_bind();
   if (!signalled) pthread_kill(waiter.native_handle(), SIGTERM);  // wake the waiter
   waiter.join();

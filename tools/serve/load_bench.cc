@@ -23,7 +23,8 @@ using nlohmann::json;
 json look_at(const std::array<double, 3>& eye, const std::array<double, 3>& target) {
   auto sub = [](auto a, auto b) { return std::array<double, 3>{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };
   auto cross = [](auto a, auto b) {
-    return std::array<double, 3>{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    return std::array<double, 3>{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                                 a[0] * b[1] - a[1] * b[0]};
   };
   auto unit = [](auto a) {
     const double n = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
@@ -56,7 +57,8 @@ double percentile(std::vector<double> v, double p) {
   return v[std::clamp<size_t>(static_cast<size_t>(rank), 1, v.size()) - 1];
 }
 
-LoadBenchResult run_size(const LoadBenchOptions& o, ServerProcess& server, const json& model, uint32_t w, uint32_t h) {
+LoadBenchResult run_size(const LoadBenchOptions& o, ServerProcess& server, const json& model, uint32_t w,
+                         uint32_t h) {
   std::array<double, 3> centre{}, lo{}, hi{};
   for (int a = 0; a < 3; ++a) {
     lo[a] = model["bounds"]["min"][a];
@@ -101,7 +103,8 @@ LoadBenchResult run_size(const LoadBenchOptions& o, ServerProcess& server, const
         for (;;) {  // a 503 is the server's deliberate refusal: counted, then the same request again
           const auto t0 = std::chrono::steady_clock::now();
           const auto res = client.Post("/render", body, "application/json");
-          const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+          const double ms =
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
           std::unique_lock lock(mutex);
           ++r.sent;
           if (res && res->status == 503) {
@@ -118,7 +121,8 @@ LoadBenchResult run_size(const LoadBenchOptions& o, ServerProcess& server, const
           } else {
             ++r.errors;
             if (r.first_error.empty())
-              r.first_error = res ? std::to_string(res->status) + " " + res->body : httplib::to_string(res.error());
+              r.first_error =
+                  res ? std::to_string(res->status) + " " + res->body : httplib::to_string(res.error());
           }
           break;
         }

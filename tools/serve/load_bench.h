@@ -14,9 +14,9 @@ struct LoadBenchOptions {
   std::string model;
   std::vector<std::pair<uint32_t, uint32_t>> sizes = {{320, 256}, {640, 512}};
   int clients = 64;
-  int requests = 256;          // per size
-  double max_seconds = 300;    // per size: clients stop sending after this
-  size_t max_queue = 64;       // the server's --max-queue
+  int requests = 256;        // per size
+  double max_seconds = 300;  // per size: clients stop sending after this
+  size_t max_queue = 64;     // the server's --max-queue
 };
 
 struct LoadBenchResult {

@@ -25,8 +25,8 @@ struct ModelSummary {
   size_t gaussians = 0;
   uint32_t channels = 1, sh_degree = 0;
   std::array<double, 3> bounds_min{}, bounds_max{};  // of the means, in the pose frame
-  std::string frame;                                  // the frame poses are given in: scene | model
-  std::array<double, 3> frame_offset{};               // pose-frame coordinates + this = original world
+  std::string frame;                                 // the frame poses are given in: scene | model
+  std::array<double, 3> frame_offset{};              // pose-frame coordinates + this = original world
   uint64_t device_bytes = 0;
 };
 
@@ -53,6 +53,7 @@ class ModelStore {
 
 // `requested` (relative to `models_dir`, or absolute) resolved with every symlink followed; RequestError
 // 403 naming it when the result is not inside models_dir's own resolved path, 404 when it does not exist.
-std::filesystem::path confine_to_models_dir(const std::filesystem::path& models_dir, const std::string& requested);
+std::filesystem::path confine_to_models_dir(const std::filesystem::path& models_dir,
+                                            const std::string& requested);
 
 }  // namespace litgs::serve

@@ -59,7 +59,8 @@ std::string base64(const std::string& bytes) {
   out.reserve((bytes.size() + 2) / 3 * 4);
   size_t i = 0;
   for (; i + 2 < bytes.size(); i += 3) {
-    const uint32_t v = uint32_t(uint8_t(bytes[i])) << 16 | uint32_t(uint8_t(bytes[i + 1])) << 8 | uint8_t(bytes[i + 2]);
+    const uint32_t v =
+        uint32_t(uint8_t(bytes[i])) << 16 | uint32_t(uint8_t(bytes[i + 1])) << 8 | uint8_t(bytes[i + 2]);
     for (int k = 3; k >= 0; --k) out += kAlphabet[(v >> (6 * k)) & 63];
   }
   if (i < bytes.size()) {
@@ -80,7 +81,8 @@ EncodedBody encode_outputs(const RenderRequest& r, const RenderedView& v) {
     const std::vector<float>& planes;
     uint32_t channels;
   };
-  const Named all[] = {{"image", r.image, v.image, v.channels}, {"depth", r.depth, v.depth, 1},
+  const Named all[] = {{"image", r.image, v.image, v.channels},
+                       {"depth", r.depth, v.depth, 1},
                        {"alpha", r.alpha, v.alpha, 1}};
   EncodedBody out;
   out.headers = {{"X-Width", std::to_string(v.width)},
@@ -104,7 +106,8 @@ EncodedBody encode_outputs(const RenderRequest& r, const RenderedView& v) {
     const Encoded e = encode(n.request, n.planes, v.width, v.height, n.channels);
     j["outputs"][n.name] = {{"format", e.format}, {"channels", e.channels}, {"base64", base64(e.bytes)}};
     if (n.request.palette) j["outputs"][n.name]["range"] = {n.request.lo, n.request.hi};
-    if (n.name == std::string("depth") && e.format == "png16") j["outputs"][n.name]["scale"] = n.request.scale;
+    if (n.name == std::string("depth") && e.format == "png16")
+      j["outputs"][n.name]["scale"] = n.request.scale;
   }
   out.content_type = "application/json";
   out.body = j.dump();

@@ -21,7 +21,8 @@ using nlohmann::json;
 // A JSON object whose keys must all be in `allowed`; fields are looked up by name with their full path.
 class Fields {
  public:
-  Fields(const json& j, std::string path, std::initializer_list<const char*> allowed) : j_(j), path_(std::move(path)) {
+  Fields(const json& j, std::string path, std::initializer_list<const char*> allowed)
+      : j_(j), path_(std::move(path)) {
     if (!j.is_object()) bad(where() + " must be a JSON object");
     std::set<std::string> names(allowed.begin(), allowed.end());
     for (const auto& item : j.items())
@@ -53,7 +54,8 @@ class Fields {
   int64_t integer(const char* key, int64_t lo, int64_t hi) const {
     const json& v = need(key);
     if (!v.is_number_integer()) bad("field '" + field(key) + "' must be an integer");
-    const int64_t x = v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(INT64_MAX) ? INT64_MAX : v.get<int64_t>();
+    const int64_t x =
+        v.is_number_unsigned() && v.get<uint64_t>() > uint64_t(INT64_MAX) ? INT64_MAX : v.get<int64_t>();
     if (x < lo || x > hi)
       bad("field '" + field(key) + "' is " + std::to_string(x) + ", outside [" + std::to_string(lo) + ", " +
           std::to_string(hi) + "]");
@@ -69,7 +71,8 @@ class Fields {
     if (!v.is_array() || v.size() != count)
       bad("field '" + field(key) + "' must be an array of " + std::to_string(count) + " numbers");
     std::vector<double> out;
-    for (size_t i = 0; i < count; ++i) out.push_back(number_at(v[i], field(key) + "[" + std::to_string(i) + "]"));
+    for (size_t i = 0; i < count; ++i)
+      out.push_back(number_at(v[i], field(key) + "[" + std::to_string(i) + "]"));
     return out;
   }
 
@@ -122,17 +125,20 @@ void parse_intrinsics(const Fields& top, kernels::SplatCamera& camera) {
   camera.fy = in.number("fy");
   camera.cx = in.number("cx");
   camera.cy = in.number("cy");
-  if (!(camera.fx > 0) || !(camera.fy > 0)) bad("fields 'intrinsics.fx' and 'intrinsics.fy' must be positive");
+  if (!(camera.fx > 0) || !(camera.fy > 0))
+    bad("fields 'intrinsics.fx' and 'intrinsics.fy' must be positive");
 }
 
 Encoding parse_encoding(const Fields& f, const char* key, std::initializer_list<Encoding> allowed,
                         Encoding fallback) {
   if (!f.has(key)) return fallback;
   const std::string name = f.text(key);
-  const Encoding e = name == "png8" ? Encoding::kPng8 : name == "png16" ? Encoding::kPng16
-                     : name == "float32" ? Encoding::kFloat32
-                                         : throw RequestError(400, "field '" + f.field(key) + "' is '" + name +
-                                                                        "': png8, png16 or float32");
+  const Encoding e =
+      name == "png8"    ? Encoding::kPng8
+      : name == "png16" ? Encoding::kPng16
+      : name == "float32"
+          ? Encoding::kFloat32
+          : throw RequestError(400, "field '" + f.field(key) + "' is '" + name + "': png8, png16 or float32");
   for (Encoding a : allowed)
     if (a == e) return e;
   bad("field '" + f.field(key) + "': '" + name + "' is not offered for this output");
@@ -167,8 +173,8 @@ void parse_outputs(const Fields& top, RenderRequest& r) {
   if (outs.has("image")) {
     const Fields f(outs.need("image"), "outputs.image", {"format", "palette", "range"});
     r.image.wanted = true;
-    r.image.encoding = parse_encoding(f, "format", {Encoding::kPng8, Encoding::kPng16, Encoding::kFloat32},
-                                      Encoding::kPng8);
+    r.image.encoding =
+        parse_encoding(f, "format", {Encoding::kPng8, Encoding::kPng16, Encoding::kFloat32}, Encoding::kPng8);
     r.image.scale = r.image.encoding == Encoding::kPng16 ? 65535.0 : 255.0;
     parse_palette(f, r.image, std::vector<double>{0.0, 1.0});
   }
@@ -291,11 +297,14 @@ RenderRequest parse_render_query(const std::vector<std::pair<std::string, std::s
     } else {
       bad("unknown query parameter '" + name +
           "' (allowed: model pose q t fx fy cx cy fov_y_deg width height sh_degree outputs image_format "
-          "image_palette image_range depth_format depth_scale depth_palette depth_range alpha_format bundle)");
+          "image_palette image_range depth_format depth_scale depth_palette depth_range alpha_format "
+          "bundle)");
     }
   }
-  if (!pose_name.empty()) body["pose"] = json{{pose_name, pose}};
-  else if (!pose.empty()) bad("query parameters q and t need pose=T_cam_world or pose=T_world_cam");
+  if (!pose_name.empty())
+    body["pose"] = json{{pose_name, pose}};
+  else if (!pose.empty())
+    bad("query parameters q and t need pose=T_cam_world or pose=T_world_cam");
   if (!intrinsics.empty()) body["intrinsics"] = intrinsics;
   if (!outputs.empty()) body["outputs"] = outputs;
   return from_json(body, limits);

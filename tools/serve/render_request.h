@@ -19,8 +19,8 @@ enum class Encoding { kPng8, kPng16, kFloat32 };
 struct OutputRequest {
   bool wanted = false;
   Encoding encoding = Encoding::kPng8;
-  double scale = 1.0;                   // PNG value per unit (image: full scale; depth: per metre)
-  std::optional<io::Palette> palette;   // an 8-bit RGB PNG of the values over [lo, hi]
+  double scale = 1.0;                  // PNG value per unit (image: full scale; depth: per metre)
+  std::optional<io::Palette> palette;  // an 8-bit RGB PNG of the values over [lo, hi]
   double lo = 0, hi = 1;
 };
 
@@ -29,7 +29,7 @@ struct RenderRequest {
   kernels::SplatCamera camera;  // sh_degree is set once the model is known (sh_degree below)
   int sh_degree = -1;           // -1: the model's
   OutputRequest image, depth, alpha;
-  bool bundle = false;          // JSON bundle even for one output (always for several)
+  bool bundle = false;  // JSON bundle even for one output (always for several)
   size_t output_count() const { return size_t{image.wanted} + depth.wanted + alpha.wanted; }
 };
 

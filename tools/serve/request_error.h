@@ -7,7 +7,8 @@
 namespace litgs::serve {
 
 struct RequestError : std::runtime_error {
-  RequestError(int status_code, const std::string& message) : std::runtime_error(message), status(status_code) {}
+  RequestError(int status_code, const std::string& message)
+      : std::runtime_error(message), status(status_code) {}
   int status;
 };
 

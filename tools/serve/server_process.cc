@@ -11,7 +11,8 @@
 
 namespace litgs::serve {
 
-ServerProcess::ServerProcess(const std::string& binary, const std::vector<std::string>& args, double timeout_s) {
+ServerProcess::ServerProcess(const std::string& binary, const std::vector<std::string>& args,
+                             double timeout_s) {
   int fds[2];
   if (pipe(fds) != 0) throw std::runtime_error("pipe failed");
   std::vector<std::string> argv_text = {binary, "serve", "--host", "127.0.0.1", "--port", "0"};
@@ -59,7 +60,8 @@ ServerProcess::ServerProcess(const std::string& binary, const std::vector<std::s
   }
   const std::string text = output();
   stop(SIGKILL, 10);
-  throw std::runtime_error("litgs-engine serve did not start (exit " + std::to_string(status_) + "): " + text);
+  throw std::runtime_error("litgs-engine serve did not start (exit " + std::to_string(status_) +
+                           "): " + text);
 }
 
 ServerProcess::~ServerProcess() {

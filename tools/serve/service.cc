@@ -93,7 +93,8 @@ Result Service::on_device(Job&& job, double timeout_s, const char* what) {
   });
   if (!queued)
     throw RequestError(503, std::string("the device queue is full (") + std::to_string(worker_->depth()) +
-                                " waiting, --max-queue " + std::to_string(options_.max_queue) + "): retry later");
+                                " waiting, --max-queue " + std::to_string(options_.max_queue) +
+                                "): retry later");
   if (future.wait_for(std::chrono::duration<double>(timeout_s)) != std::future_status::ready) {
     pending->abandoned = true;
     throw RequestError(503, std::string(what) + " timed out after " + std::to_string(timeout_s) +
@@ -113,8 +114,8 @@ RenderedView Service::render(const RenderRequest& r, ModelSummary* used) {
     throw RequestError(400, "field 'sh_degree' is " + std::to_string(r.sh_degree) + " but model '" + r.model +
                                 "' has degree " + std::to_string(summary->sh_degree));
   if (r.image.palette && summary->channels != 1)
-    throw RequestError(400, "field 'outputs.image.palette' needs a one-channel model; '" + r.model + "' has " +
-                                std::to_string(summary->channels) + " channels");
+    throw RequestError(400, "field 'outputs.image.palette' needs a one-channel model; '" + r.model +
+                                "' has " + std::to_string(summary->channels) + " channels");
   kernels::SplatCamera camera = r.camera;
   camera.sh_degree = r.sh_degree < 0 ? summary->sh_degree : static_cast<uint32_t>(r.sh_degree);
   try {
@@ -134,7 +135,8 @@ RenderedView Service::render(const RenderRequest& r, ModelSummary* used) {
           throw RequestError(503, "render timed out waiting for the device (--request-timeout): retry later");
         const std::shared_ptr<DeviceModel> model = models_.get(name);
         std::unique_ptr<kernels::Rasterizer>& rasterizer = rasterizers_[model->summary.channels];
-        if (!rasterizer) rasterizer = std::make_unique<kernels::Rasterizer>(*context_, model->summary.channels);
+        if (!rasterizer)
+          rasterizer = std::make_unique<kernels::Rasterizer>(*context_, model->summary.channels);
         const auto t0 = std::chrono::steady_clock::now();
         rasterizer->forward(*model->gaussians, camera);
         kernels::RenderImages<float> images = rasterizer->download_images();

@@ -22,13 +22,13 @@
 namespace litgs::serve {
 
 struct ServeOptions {
-  std::string model;       // loaded as "default" at start
-  std::string scene;       // optional: poses in its frame, its cameras in GET /model
+  std::string model;  // loaded as "default" at start
+  std::string scene;  // optional: poses in its frame, its cameras in GET /model
   std::string host = "127.0.0.1";
-  int port = 8080;         // 0: any free port (printed)
-  size_t max_queue = 32;   // renders waiting for the device before 503
+  int port = 8080;        // 0: any free port (printed)
+  size_t max_queue = 32;  // renders waiting for the device before 503
   uint64_t max_pixels = 4'194'304;
-  std::string models_dir;  // POST /models/load reads only inside it (empty: loading refused)
+  std::string models_dir;         // POST /models/load reads only inside it (empty: loading refused)
   double request_timeout_s = 30;  // a render not finished by then is answered 503
   size_t max_body_bytes = 1 << 20;
   int read_timeout_s = 5;  // a client that sends nothing for this long is disconnected
