@@ -96,7 +96,6 @@ LoadBenchResult run_size(const LoadBenchOptions& o, ServerProcess& server, const
   for (int c = 0; c < o.clients; ++c)
     clients.emplace_back([&] {
       httplib::Client client("127.0.0.1", server.port());
-      client.set_keep_alive(true);
       client.set_read_timeout(120, 0);
       for (int i = next++; i < o.requests && std::chrono::steady_clock::now() < deadline; i = next++) {
         const std::string body = request_body(i);
@@ -143,8 +142,9 @@ LoadBenchResult run_size(const LoadBenchOptions& o, ServerProcess& server, const
 }  // namespace
 
 LoadBenchReport run_load_bench(const LoadBenchOptions& o) {
-  if (o.clients < 1 || o.requests < 1 || !(o.max_seconds > 0))
-    throw std::invalid_argument("bench serve: --clients, --requests and --max-seconds must be positive");
+  if (o.clients < 1 || o.requests < 1 || o.rounds < 1 || !(o.max_seconds > 0))
+    throw std::invalid_argument(
+        "bench serve: --clients, --requests, --rounds and --max-seconds must be positive");
   ServerProcess server(o.binary, {"--model", o.model, "--max-queue", std::to_string(o.max_queue)});
   LoadBenchReport report;
   report.rss_started = server.resident_bytes();
@@ -153,7 +153,11 @@ LoadBenchReport run_load_bench(const LoadBenchOptions& o) {
   if (!res || res->status != 200) throw std::runtime_error("bench serve: GET /model failed");
   const json model = json::parse(res->body);
   report.device = model.value("device", "");
-  for (const auto& [w, h] : o.sizes) report.results.push_back(run_size(o, server, model, w, h));
+  for (const auto& [w, h] : o.sizes)
+    for (int round = 1; round <= o.rounds; ++round) {
+      report.results.push_back(run_size(o, server, model, w, h));
+      report.results.back().round = round;
+    }
   const int status = server.stop(SIGTERM);
   if (status != 0) throw std::runtime_error("bench serve: the server exited with " + std::to_string(status));
   return report;
