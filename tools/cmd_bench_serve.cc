@@ -28,6 +28,8 @@ void add_bench_serve_command(CLI::App& bench) {
   cmd->add_option("--rounds", o->rounds, "Rounds per image size (memory after each)")->capture_default_str();
   cmd->add_option("--max-seconds", o->max_seconds, "Time bound per image size")->capture_default_str();
   cmd->add_option("--max-queue", o->max_queue, "The server's --max-queue")->capture_default_str();
+  cmd->add_option("--request-timeout", o->request_timeout_s, "The server's --request-timeout (s)")
+      ->capture_default_str();
   cmd->add_flag("--json", *json_out, "One JSON object instead of the table");
   cmd->callback([o, json_out] {
     o->binary = "/proc/self/exe";

@@ -3,6 +3,7 @@
 #include <httplib.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/socket.h>
 
 #include <Eigen/Geometry>
 #include <atomic>
@@ -301,6 +302,15 @@ int run_http_server(const ServeOptions& options) {
   configure(svr, service);
   add_routes(svr, service);
 
+  // httplib listens with a backlog of 5 (compiled into Debian's library): many clients connecting at once
+  // would overflow it and their connections be dropped. Keep the listening socket and listen again on it
+  // with the system's maximum (Linux updates the backlog of a listening socket).
+  int listen_fd = -1;
+  svr.set_socket_options([&listen_fd](socket_t sock) {
+    const int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    listen_fd = sock;
+  });
   int port = options.port;
   if (port == 0) {
     port = svr.bind_to_any_port(options.host);
@@ -309,6 +319,7 @@ int run_http_server(const ServeOptions& options) {
   }
   if (port < 0)
     throw std::runtime_error("cannot listen on " + options.host + ":" + std::to_string(options.port));
+  if (listen_fd >= 0) ::listen(listen_fd, SOMAXCONN);
 
   std::atomic<bool> signalled{false};
   std::thread waiter([&] {

@@ -96,7 +96,7 @@ LoadBenchResult run_size(const LoadBenchOptions& o, ServerProcess& server, const
   for (int c = 0; c < o.clients; ++c)
     clients.emplace_back([&] {
       httplib::Client client("127.0.0.1", server.port());
-      client.set_read_timeout(120, 0);
+      client.set_read_timeout(static_cast<time_t>(o.request_timeout_s) + 60, 0);
       for (int i = next++; i < o.requests && std::chrono::steady_clock::now() < deadline; i = next++) {
         const std::string body = request_body(i);
         for (;;) {  // a 503 is the server's deliberate refusal: counted, then the same request again
@@ -145,7 +145,8 @@ LoadBenchReport run_load_bench(const LoadBenchOptions& o) {
   if (o.clients < 1 || o.requests < 1 || o.rounds < 1 || !(o.max_seconds > 0))
     throw std::invalid_argument(
         "bench serve: --clients, --requests, --rounds and --max-seconds must be positive");
-  ServerProcess server(o.binary, {"--model", o.model, "--max-queue", std::to_string(o.max_queue)});
+  ServerProcess server(o.binary, {"--model", o.model, "--max-queue", std::to_string(o.max_queue),
+                                  "--request-timeout", std::to_string(o.request_timeout_s)});
   LoadBenchReport report;
   report.rss_started = server.resident_bytes();
   httplib::Client info("127.0.0.1", server.port());

@@ -16,10 +16,11 @@ struct LoadBenchOptions {
   std::string model;
   std::vector<std::pair<uint32_t, uint32_t>> sizes = {{320, 256}, {640, 512}};
   int clients = 64;
-  int requests = 192;        // per size and round
-  int rounds = 2;            // per size: memory that still grows in the second round would be a leak
-  double max_seconds = 300;  // per size: clients stop sending after this
-  size_t max_queue = 64;     // the server's --max-queue
+  int requests = 192;              // per size and round
+  double request_timeout_s = 120;  // the server's --request-timeout: 64 queued renders take long on a CPU
+  int rounds = 2;                  // per size: memory that still grows in the second round would be a leak
+  double max_seconds = 300;        // per size: clients stop sending after this
+  size_t max_queue = 64;           // the server's --max-queue
 };
 
 struct LoadBenchResult {
