@@ -48,6 +48,8 @@ Image single_channel(Image image, const std::filesystem::path& path);
 Image read_png(const std::filesystem::path& path);
 ImageInfo read_png_info(const std::filesystem::path& path);
 void write_png(const std::filesystem::path& path, const Image& image);
+// The bytes write_png would write (same libpng settings), in memory (for the render service).
+std::vector<uint8_t> encode_png(const Image& image);
 Image read_tiff(const std::filesystem::path& path);
 ImageInfo read_tiff_info(const std::filesystem::path& path);
 void write_tiff(const std::filesystem::path& path, const Image& image);

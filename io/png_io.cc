@@ -4,7 +4,9 @@
 #include <png.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 
 #include "io/atomic_file.h"
@@ -147,24 +149,54 @@ Image read_png(const std::filesystem::path& path) {
   return image;
 }
 
-void write_png(const std::filesystem::path& path, const Image& image) {
+namespace {
+
+// An image's pixels as PNG rows (big or little endian is libpng's business: png_set_swap).
+struct PngRows {
+  std::vector<unsigned char> bytes;
+  std::vector<unsigned char*> rows;
+};
+
+PngRows png_rows(const Image& image) {
   image.check();
   const size_t row_values = static_cast<size_t>(image.width) * image.channels;
   const size_t row_bytes = row_values * (image.bit_depth / 8);
-  std::vector<unsigned char> bytes(row_bytes * image.height);
+  PngRows r;
+  r.bytes.resize(row_bytes * image.height);
   if (image.bit_depth == 8) {
-    for (size_t i = 0; i < image.data.size(); ++i) bytes[i] = static_cast<unsigned char>(image.data[i]);
+    for (size_t i = 0; i < image.data.size(); ++i) r.bytes[i] = static_cast<unsigned char>(image.data[i]);
   } else {
-    std::memcpy(bytes.data(), image.data.data(), bytes.size());
+    std::memcpy(r.bytes.data(), image.data.data(), r.bytes.size());
   }
-  std::vector<unsigned char*> rows(image.height);
-  for (int y = 0; y < image.height; ++y) rows[y] = bytes.data() + y * row_bytes;
+  r.rows.resize(image.height);
+  for (int y = 0; y < image.height; ++y) r.rows[y] = r.bytes.data() + y * row_bytes;
+  return r;
+}
 
+}  // namespace
+
+std::vector<uint8_t> encode_png(const Image& image) {
+  PngRows rows = png_rows(image);
+  char* buffer = nullptr;
+  size_t size = 0;
+  std::FILE* fp = open_memstream(&buffer, &size);  // POSIX 2008: a FILE* that writes into a growing buffer
+  if (!fp) throw std::runtime_error("encode_png: open_memstream failed");
+  PngError err;
+  const bool ok = write_png_impl(fp, &image, rows.rows.data(), &err);
+  std::fclose(fp);
+  std::vector<uint8_t> out(buffer, buffer + (ok ? size : 0));
+  std::free(buffer);
+  if (!ok) throw std::runtime_error(std::string("encode_png: libpng: ") + err.message);
+  return out;
+}
+
+void write_png(const std::filesystem::path& path, const Image& image) {
+  PngRows rows = png_rows(image);
   AtomicFile file(path);
   std::FILE* fp = std::fopen(file.temp_path().c_str(), "wb");
   if (!fp) fail(path, 0, "cannot open the temporary file " + file.temp_path().string() + " for writing");
   PngError err;
-  const bool ok = write_png_impl(fp, &image, rows.data(), &err);
+  const bool ok = write_png_impl(fp, &image, rows.rows.data(), &err);
   const bool closed = std::fclose(fp) == 0;
   if (!ok) fail(path, 0, std::string("libpng: ") + err.message);
   if (!closed) fail(path, 0, "write failed (disk full?)");

@@ -1,13 +1,49 @@
 // `litgs-engine export colmap|tum --scene SCENE --out ...`: a scene directory into the formats other tools
-// read (COLMAP, 3DGS trainers, evo). CPU only: no Vulkan device is created.
+// read (COLMAP, 3DGS trainers, evo); `export splat --model M.ply --out M.splat`: a model for web splat
+// viewers. CPU only: no Vulkan device is created.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "io/export_scene.h"
+#include "io/gaussian_ply.h"
+#include "io/splat_export.h"
 #include "tools/commands.h"
 
 namespace litgs::tools {
+namespace {
+
+struct SplatOptions {
+  std::string model, out, palette;
+  std::vector<double> range;
+};
+
+void add_export_splat_command(CLI::App& exp) {
+  auto o = std::make_shared<SplatOptions>();
+  CLI::App* cmd = exp.add_subcommand(
+      "splat",
+      "A 3DGS PLY as the 32-byte .splat layout of web viewers (one-channel models: gray or a palette)");
+  cmd->add_option("--model", o->model, "3DGS PLY model")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--out", o->out, ".splat file to write")->required();
+  cmd->add_option("--palette", o->palette, "gray or ironbow: colour one-channel values over --range");
+  cmd->add_option("--range", o->range, "LO HI: the values the palette spans (default 0 1)")->expected(2);
+  cmd->callback([o] {
+    io::SplatColouring colouring;
+    if (!o->range.empty() && o->palette.empty()) throw std::invalid_argument("--range needs --palette");
+    if (!o->palette.empty()) colouring.palette = io::parse_palette(o->palette);
+    if (!o->range.empty()) colouring.lo = o->range[0], colouring.hi = o->range[1];
+    const kernels::GaussianModel model = io::read_gaussian_ply(o->model);
+    const size_t n = io::write_splat(o->out, model, colouring);
+    std::cout << "export splat: " << n << " Gaussians (" << model.channels << " channel"
+              << (model.channels == 1 ? "" : "s") << ", SH degree 0 kept of " << model.sh_degree << ") into "
+              << o->out << "\n";
+  });
+}
+
+}  // namespace
 
 void add_export_command(CLI::App& app) {
   CLI::App* exp = app.add_subcommand("export", "Write a scene directory in another tool's format");
@@ -39,6 +75,7 @@ void add_export_command(CLI::App& app) {
     const size_t n = io::export_tum(*t);
     std::cout << "export tum: " << n << " poses into " << t->out.string() << "\n";
   });
+  add_export_splat_command(*exp);
 }
 
 }  // namespace litgs::tools

@@ -29,6 +29,7 @@
 #include "kernels/splat/rasterizer.h"
 #include "kernels/splat/reference.h"
 #include "tools/commands.h"
+#include "tools/render_view.h"
 
 namespace litgs::tools {
 namespace {
@@ -83,16 +84,6 @@ double level_and_counts(const RenderOptions& o, const kernels::SplatCamera& came
   return 1.0;
 }
 
-glm::dmat3 rotation_from_quat(double w, double x, double y, double z) {
-  const double n = std::sqrt(w * w + x * x + y * y + z * z);
-  if (!(n > 1e-12) || !std::isfinite(n))
-    throw std::invalid_argument("camera rotation quaternion is zero or not finite");
-  w /= n, x /= n, y /= n, z /= n;
-  return glm::dmat3(1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y),  //
-                    2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x),  //
-                    2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y));
-}
-
 // {"width": W, "height": H, "fx": .., "fy": .., "cx": .., "cy": ..,
 //  "q_cam_world": [qw, qx, qy, qz], "t_cam_world": [tx, ty, tz]}  (p_cam = R p_world + t, as COLMAP)
 kernels::SplatCamera camera_from_json(const std::string& path) {
@@ -120,30 +111,6 @@ kernels::SplatCamera camera_from_json(const std::string& path) {
   }
 }
 
-io::Image to_image(const std::vector<float>& planes, uint32_t w, uint32_t h, uint32_t channels, int bit_depth,
-                   double scale) {
-  io::Image img;
-  img.width = static_cast<int>(w);
-  img.height = static_cast<int>(h);
-  img.channels = static_cast<int>(channels);
-  img.bit_depth = bit_depth;
-  img.data.resize(size_t{w} * h * channels);
-  const double max_value = bit_depth == 16 ? 65535.0 : 255.0;
-  for (uint32_t c = 0; c < channels; ++c)
-    for (size_t p = 0; p < size_t{w} * h; ++p) {
-      const double v = planes[c * size_t{w} * h + p] * scale;
-      img.data[p * channels + c] =
-          static_cast<uint16_t>(std::lround(std::clamp(std::isfinite(v) ? v : 0.0, 0.0, max_value)));
-    }
-  return img;
-}
-
-std::string vector_text(const Eigen::Vector3d& v) {
-  std::ostringstream s;
-  s << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
-  return s.str();
-}
-
 // The camera of the scene's view at time `text` (seconds), as training builds it.
 kernels::SplatCamera scene_camera(const RenderOptions& o, const io::Scene& scene) {
   if (!o.camera_json.empty() || !o.pose.empty())
@@ -168,10 +135,6 @@ kernels::SplatCamera scene_camera(const RenderOptions& o, const io::Scene& scene
 }
 
 void run_render(const RenderOptions& o) {
-  if (o.pose_frame != "auto" && o.pose_frame != "scene" && o.pose_frame != "original" &&
-      o.pose_frame != "model")
-    throw std::invalid_argument("--pose-frame must be auto, scene, original or model, not '" + o.pose_frame +
-                                "'");
   if (!o.time.empty() && o.scene.empty())
     throw std::invalid_argument("--time needs --scene (the scene's cameras)");
   check_level_options(o);
@@ -201,33 +164,12 @@ void run_render(const RenderOptions& o) {
     camera.height = o.height;
   }
   if (o.bit_depth != 8 && o.bit_depth != 16) throw std::invalid_argument("--bit-depth must be 8 or 16");
-  kernels::GaussianModel model = io::read_gaussian_ply(o.model);
+  std::optional<Eigen::Vector3d> scene_offset;
+  if (scene) scene_offset = scene->config.world_offset_m;
+  FramedModel framed = load_framed_model(o.model, o.pose_frame, scene_offset, o.scene);
+  const kernels::GaussianModel& model = framed.model;
   camera.sh_degree = o.sh_degree < 0 ? model.sh_degree : static_cast<uint32_t>(o.sh_degree);
   camera.check();
-
-  // The frame of the poses, and the model moved into it.
-  const host::ModelFrame model_frame = host::read_model_frame(o.model);
-  std::optional<Eigen::Vector3d> scene_offset = model_frame.scene_world_offset_m;
-  if (scene) {
-    if (scene_offset && *scene_offset != scene->config.world_offset_m)
-      std::cerr << "render: note: the model was trained on a scene with world_offset_m "
-                << vector_text(*scene_offset) << "; poses are taken in " << o.scene
-                << "'s frame (world_offset_m " << vector_text(scene->config.world_offset_m) << ")\n";
-    scene_offset = scene->config.world_offset_m;
-  }
-  const std::string frame = o.pose_frame == "auto" ? (scene_offset ? "scene" : "model") : o.pose_frame;
-  Eigen::Vector3d frame_offset = Eigen::Vector3d::Zero();  // pose-frame coordinates + this = original world
-  if (frame == "scene") {
-    if (!scene_offset)
-      throw std::invalid_argument(
-          o.model +
-          " does not state the scene it was trained on (no "
-          "litgs_scene_world_offset_m header line): give --scene DIR for --pose-frame scene");
-    frame_offset = *scene_offset;
-  } else if (frame == "model") {
-    frame_offset = model_frame.world_offset_m;
-  }
-  model = host::shift_means(std::move(model), model_frame.world_offset_m - frame_offset);
 
   std::vector<float> image, depth, alpha;
   uint64_t intersections = 0, culled = 0, walks_cut = 0;
@@ -257,10 +199,10 @@ void run_render(const RenderOptions& o) {
     io::write_image(o.depth_out, to_image(depth, camera.width, camera.height, 1, 16, o.depth_scale));
   if (!o.alpha_out.empty())
     io::write_image(o.alpha_out, to_image(alpha, camera.width, camera.height, 1, 8, 255.0));
-  const std::string frame_text = frame == "scene"
-                                     ? "scene frame (world_offset_m " + vector_text(frame_offset) + ")"
-                                 : frame == "original" ? "original world frame"
-                                                       : "model's frame";
+  const std::string frame_text = framed.frame == "scene"
+                                     ? "scene frame (world_offset_m " + vector_text(framed.frame_offset) + ")"
+                                 : framed.frame == "original" ? "original world frame"
+                                                              : "model's frame";
   std::cout << "render: " << model.size() << " Gaussians, " << intersections << " tile intersections, "
             << camera.width << "x" << camera.height << (o.reference ? " (CPU reference)" : "")
             << ", poses in the " << frame_text << " -> " << o.out << "\n";

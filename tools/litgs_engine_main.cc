@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   litgs::tools::add_bench_command(app);
   litgs::tools::add_import_command(app);
   litgs::tools::add_render_command(app);
+  litgs::tools::add_serve_command(app);
   litgs::tools::add_synth_command(app);
   litgs::tools::add_train_command(app);
   litgs::tools::add_export_command(app);
