@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 namespace litgs::tools {
 
@@ -58,9 +59,13 @@ void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli
 }
 
 host::frontend::FrontendProgress progress_printer() {
-  return [](const std::string& stage, size_t done, size_t total) {
+  // Redraws only when the bar grows (or the stage changes), so a log of it stays short.
+  auto last = std::make_shared<std::pair<std::string, int>>("", -1);
+  return [last](const std::string& stage, size_t done, size_t total) {
     const int width = 30;
     const int filled = total ? static_cast<int>(width * done / total) : width;
+    if (stage == last->first && filled == last->second && done != total) return;
+    *last = {stage, filled};
     std::cerr << '\r' << std::left << std::setw(10) << stage << " [" << std::string(filled, '#')
               << std::string(width - filled, ' ') << "] " << done << '/' << total << std::flush;
     if (done == total) std::cerr << '\n';
@@ -74,7 +79,8 @@ void print_summary(std::ostream& out, const std::string& title, const host::fron
   out << title << " (" << host::frontend::feature_name(o.features.type)
       << (o.preprocess.clahe ? " + CLAHE" : "") << ", pairs " << host::frontend::pairs_name(o.pairs)
       << ", prior epipolar "
-      << (o.prior_epipolar ? std::to_string(o.verify.prior_epipolar_px) + " px" : std::string("off"))
+      << (o.prior_epipolar ? (std::ostringstream() << o.verify.prior_epipolar_px << " px").str()
+                           : std::string("off"))
       << ")\n";
   out << std::setprecision(1) << "  images          " << m.images << " (" << m.frozen << " frozen, "
       << m.uniform << " uniform)\n"
@@ -85,8 +91,11 @@ void print_summary(std::ostream& out, const std::string& title, const host::fron
       << "  tracks          " << m.tracks << " (" << m.track_conflicts << " conflicting matches dropped)\n"
       << "  points          " << m.points << "\n"
       << std::setprecision(2) << "  track length    " << m.mean_track_length << " (mean)\n"
-      << std::setprecision(3) << "  reprojection    " << m.mean_error_px << " px (mean)\n"
-      << std::setprecision(2) << "  seconds         preprocess " << m.seconds.preprocess << ", features "
+      << std::setprecision(3) << "  reprojection    " << m.mean_error_px << " px (mean)\n";
+  if (m.true_plane_median_m >= 0)
+    out << std::setprecision(4) << "  true planes     " << m.true_plane_median_m << " m median, "
+        << m.true_plane_mean_m << " m mean distance of the points to the nearest\n";
+  out << std::setprecision(2) << "  seconds         preprocess " << m.seconds.preprocess << ", features "
       << m.seconds.features << ", pair selection " << m.seconds.pair_selection << ", matching "
       << m.seconds.matching << ", tracks+triangulation " << m.seconds.triangulation << ", total "
       << m.seconds.total << "\n";

@@ -316,6 +316,21 @@ FrontendResult run_frontend(const std::filesystem::path& dir, const FrontendOpti
     r.data.points.push_back(std::move(point));
   }
   summarize(r, s);
+  if (scene.gt && !scene.gt->planes.empty() && !r.data.points.empty()) {
+    std::vector<double> distances;
+    for (const auto& p : r.data.points) {
+      double best = INFINITY;
+      for (const auto& plane : scene.gt->planes)
+        best = std::min(best, std::abs(plane.n.dot(p.xyz) + plane.d));
+      distances.push_back(best);
+    }
+    double sum = 0;
+    for (double d : distances) sum += d;
+    m.true_plane_mean_m = sum / static_cast<double>(distances.size());
+    std::nth_element(distances.begin(), distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2),
+                     distances.end());
+    m.true_plane_median_m = distances[distances.size() / 2];
+  }
   m.seconds.total = since(t_start);
   return r;
 }
@@ -373,6 +388,7 @@ std::string frontend_json(const FrontendResult& r) {
               {"points", m.points},
               {"mean_track_length", m.mean_track_length},
               {"mean_reprojection_error_px", m.mean_error_px},
+              {"true_plane_distance_m", {{"median", m.true_plane_median_m}, {"mean", m.true_plane_mean_m}}},
               {"rejected_tracks",
                {{"no_angle", m.rejected_no_angle},
                 {"depth", m.rejected_depth},

@@ -54,6 +54,9 @@ struct FrontendSummary {
   size_t tracks = 0, track_conflicts = 0, points = 0;
   size_t rejected_no_angle = 0, rejected_depth = 0, rejected_error = 0, rejected_few_views = 0;
   double mean_track_length = 0, mean_error_px = 0;
+  // Scenes with gt/planes.txt: each point's distance to the nearest true plane, median and mean (metres);
+  // -1 without true planes or points.
+  double true_plane_median_m = -1, true_plane_mean_m = -1;
   StageSeconds seconds;
   std::vector<std::string> notes;
 };

@@ -31,7 +31,7 @@ Stretch percentile_stretch(const Histogram& histogram, double low_percentile, do
     uint64_t seen = 0;
     for (size_t v = 0; v < histogram.size(); ++v) {
       seen += histogram[v];
-      if (static_cast<double>(seen) >= target) return static_cast<double>(v);
+      if (seen > 0 && static_cast<double>(seen) >= target) return static_cast<double>(v);  // 0: the minimum
     }
     return static_cast<double>(histogram.size() - 1);
   };

@@ -20,7 +20,7 @@ std::vector<std::array<uint32_t, 2>> match_mutual(const ImageFeatures& a, const 
                                                   const MatchOptions& options);
 
 // The same among allowed candidates only: allowed[i] lists the keypoints of b that a's keypoint i may match
-// (sorted; e.g. those near its prior epipolar line), and b's keypoint j may match the i whose lists hold j.
+// (e.g. those near its prior epipolar line), and b's keypoint j may match the i whose lists hold j.
 // Nearest, second nearest and the mutual check are taken within these lists.
 std::vector<std::array<uint32_t, 2>> match_mutual_among(const ImageFeatures& a, const ImageFeatures& b,
                                                         const std::vector<std::vector<uint32_t>>& allowed,

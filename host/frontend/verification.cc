@@ -1,6 +1,7 @@
 #include "host/frontend/verification.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <stdexcept>
@@ -87,25 +88,52 @@ std::vector<std::vector<uint32_t>> prior_candidates(const std::vector<Eigen::Vec
     const Eigen::Vector3d l = E.transpose() * nb[j];
     line_in_a[j] = f * l / std::max(std::hypot(l.x(), l.y()), 1e-300);
   }
-  // b's keypoints as float arrays, so that the first test (distance to a's line in b) vectorizes.
-  std::vector<float> xb(ub.size()), yb(ub.size());
+  // b's keypoints in a grid of kCell-pixel cells: each line visits only the cells its band crosses.
+  constexpr double kCell = 16;
+  Eigen::Vector2d lo_corner = Eigen::Vector2d::Constant(INFINITY), hi_corner = -lo_corner;
+  for (const auto& x : ub)
+    if (x.allFinite()) {
+      lo_corner = lo_corner.cwiseMin(x);
+      hi_corner = hi_corner.cwiseMax(x);
+    }
+  if (!lo_corner.allFinite()) return out;
+  const Eigen::Vector2d extent = hi_corner - lo_corner;
+  const auto cols = static_cast<int>(std::clamp(extent.x() / kCell + 1, 1.0, 4096.0));
+  const auto rows = static_cast<int>(std::clamp(extent.y() / kCell + 1, 1.0, 4096.0));
+  std::vector<std::vector<uint32_t>> cells(static_cast<size_t>(cols) * rows);
+  auto cell_of = [&](double v, int n) {
+    return std::clamp(static_cast<int>(std::floor(v / kCell)), 0, n - 1);
+  };
   for (size_t j = 0; j < ub.size(); ++j) {
-    xb[j] = static_cast<float>(ub[j].x());
-    yb[j] = static_cast<float>(ub[j].y());
+    if (!ub[j].allFinite()) continue;
+    const Eigen::Vector2d p = ub[j] - lo_corner;
+    cells[static_cast<size_t>(cell_of(p.y(), rows)) * cols + cell_of(p.x(), cols)].push_back(
+        static_cast<uint32_t>(j));
   }
-  std::vector<uint8_t> near(ub.size());
-  const float bound = static_cast<float>(bound_px) + 1e-3f;  // float slack; the exact test follows
   for (size_t i = 0; i < ua.size(); ++i) {
     na[i] = normalized(ua[i]);
     const Eigen::Vector3d l = E * na[i];
     const Eigen::Vector3d line = f * l / std::max(std::hypot(l.x(), l.y()), 1e-300);
-    // line . ((x - cx) / fx, (y - cy) / fy, 1) as A x + B y + C.
-    const auto A = static_cast<float>(line.x() / K.fx), B = static_cast<float>(line.y() / K.fy);
-    const auto C = static_cast<float>(line.z() - line.x() * K.cx / K.fx - line.y() * K.cy / K.fy);
-    for (size_t j = 0; j < ub.size(); ++j) near[j] = std::abs(A * xb[j] + B * yb[j] + C) <= bound;
-    for (size_t j = 0; j < ub.size(); ++j)
-      if (near[j] && std::abs(line.dot(nb[j])) <= bound_px && std::abs(line_in_a[j].dot(na[i])) <= bound_px)
-        out[i].push_back(static_cast<uint32_t>(j));
+    auto visit = [&](int cx, int cy) {
+      for (uint32_t j : cells[static_cast<size_t>(cy) * cols + cx])
+        if (std::abs(line.dot(nb[j])) <= bound_px && std::abs(line_in_a[j].dot(na[i])) <= bound_px)
+          out[i].push_back(j);
+    };
+    // The band as A x + B y + C in pixels relative to the grid's corner: |A x + B y + C| <= bound_px.
+    const double A = line.x() / K.fx, B = line.y() / K.fy;
+    const double C = line.z() - A * (K.cx - lo_corner.x()) - B * (K.cy - lo_corner.y());
+    if (!std::isfinite(A) || !std::isfinite(B) || !std::isfinite(C) || (A == 0 && B == 0)) continue;
+    const bool flat = std::abs(B) >= std::abs(A);  // walk along x (flat lines) or along y (steep ones)
+    const int n_walk = flat ? cols : rows, n_across = flat ? rows : cols;
+    const double along = flat ? B : A, other = flat ? A : B;
+    const double half = bound_px / std::abs(along);  // the band's half width across the walk direction
+    for (int w = 0; w < n_walk; ++w) {
+      // The band's extent across, over this column (row) of cells.
+      const double v0 = -(other * w * kCell + C) / along, v1 = -(other * (w + 1) * kCell + C) / along;
+      const double lo = std::min(v0, v1) - half, hi = std::max(v0, v1) + half;
+      if (hi < 0 || lo > n_across * kCell) continue;  // every keypoint lies in [0, n_across * kCell)
+      for (int a = cell_of(lo, n_across); a <= cell_of(hi, n_across); ++a) flat ? visit(w, a) : visit(a, w);
+    }
   }
   return out;
 }
@@ -138,7 +166,8 @@ Verification verify_pair(const std::vector<Eigen::Vector2d>& ua, const std::vect
   cv::Mat mask;
   cv::Mat E;
   try {
-    E = cv::findEssentialMat(pa, pb, Kcv, cv::USAC_MAGSAC, o.confidence, o.max_error_px, mask);
+    E = cv::findEssentialMat(pa, pb, Kcv, cv::USAC_MAGSAC, o.confidence, o.max_error_px, o.max_iterations,
+                             mask);
   } catch (const cv::Exception&) {
     return v;  // degenerate sample sets (e.g. all matches on one point): nothing verified
   }

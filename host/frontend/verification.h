@@ -19,8 +19,8 @@ std::vector<Eigen::Vector2d> undistort_keypoints(const io::CameraIntrinsics& cam
 
 struct VerifyOptions {
   double max_error_px = 1.5;  // MAGSAC's threshold (pixels of the undistorted image)
-  double confidence = 0.9999;
-  int max_iterations = 5000;
+  double confidence = 0.999;  // OpenCV's defaults
+  int max_iterations = 1000;
   // Matches farther than this from the prior's epipolar line (both ways, undistorted pixels) are rejected.
   // It must cover the priors' error: a few pixels for Metashape/COLMAP poses, more for a drifting odometry.
   double prior_epipolar_px = 8;
@@ -55,8 +55,8 @@ Verification verify_pair(const std::vector<Eigen::Vector2d>& ua, const std::vect
 double prior_distance_px(const Eigen::Vector2d& xa, const Eigen::Vector2d& xb, const PinholeK& K,
                          const RelativePose& prior);
 
-// For each keypoint of a, the keypoints of b within `bound_px` of it by prior_distance_px (sorted): the
-// candidates prior-guided matching compares descriptors for.
+// For each keypoint of a, the keypoints of b within `bound_px` of it by prior_distance_px: the candidates
+// prior-guided matching compares descriptors for (b's keypoints are bucketed so a line visits few).
 std::vector<std::vector<uint32_t>> prior_candidates(const std::vector<Eigen::Vector2d>& ua,
                                                     const std::vector<Eigen::Vector2d>& ub, const PinholeK& K,
                                                     const RelativePose& prior, double bound_px);

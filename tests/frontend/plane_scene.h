@@ -29,8 +29,9 @@ inline double plane_texture(double x, double y) {
   double value = 0, weight = 0, cell = 0.4, w = 1;
   for (int octave = 0; octave < 4; ++octave, cell *= 0.5, w *= 0.7) {
     const double u = x / cell, v = y / cell;
-    const auto i = static_cast<int64_t>(std::floor(u)), j = static_cast<int64_t>(std::floor(v));
-    double fu = u - i, fv = v - j;
+    const double u0 = std::floor(u), v0 = std::floor(v);
+    const auto i = static_cast<int64_t>(u0), j = static_cast<int64_t>(v0);
+    double fu = u - u0, fv = v - v0;
     fu = fu * fu * (3 - 2 * fu);
     fv = fv * fv * (3 - 2 * fv);
     const double a = hash(i, j, octave), b = hash(i + 1, j, octave), c = hash(i, j + 1, octave),

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <random>
 
 #include "host/frontend/features.h"
@@ -167,7 +168,7 @@ TEST(FrontendIntensity, PercentileStretchAndConstantImages) {
   std::vector<Histogram> frames(5, empty_histogram());
   for (size_t i = 0; i < 5; ++i) frames[i][1000 + 100 * i] = 10;
   const auto windowed = sequence_stretch(frames, 0, 100, 1);
-  for (size_t i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(windowed[i].low, 1000.0 + 100.0 * i);
+  for (size_t i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(windowed[i].low, 1000.0 + 100.0 * static_cast<double>(i));
   const auto shared = sequence_stretch(frames, 0, 100, 0);
   for (size_t i = 0; i < 5; ++i) EXPECT_DOUBLE_EQ(shared[i].low, 1000.0);
 }
@@ -216,6 +217,37 @@ TEST(FrontendVerification, PriorDistanceIsZeroOnTheEpipolarLine) {
   const Eigen::Vector2d pb(K.fx * xb.x() / xb.z() + K.cx, K.fy * xb.y() / xb.z() + K.cy);
   EXPECT_LT(prior_distance_px(pa, pb, K, prior), 1e-9);
   EXPECT_GT(prior_distance_px(pa, pb + Eigen::Vector2d(0, 10), K, prior), 5);
+}
+
+TEST(FrontendVerification, PriorCandidatesAreExactlyThoseWithinTheBound) {
+  // The bucketed search must find what testing every pair finds, for flat and steep epipolar lines and
+  // keypoints outside the image (undistortion can push them there).
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-20, 660), v(-20, 530);
+  const PinholeK K{600, 610, 320, 256};
+  for (const Eigen::Vector3d& t : {Eigen::Vector3d(1, 0.1, 0.05), Eigen::Vector3d(0.05, 1, 0.2),
+                                   Eigen::Vector3d(0.2, -0.1, 1), Eigen::Vector3d(0, 0, 0)}) {
+    RelativePose prior;
+    prior.R_ba = Eigen::AngleAxisd(0.05, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix();
+    prior.t_ba = t;
+    std::vector<Eigen::Vector2d> a, b;
+    for (int i = 0; i < 600; ++i) {
+      a.emplace_back(u(rng), v(rng));
+      b.emplace_back(u(rng), v(rng));
+    }
+    const auto found = prior_candidates(a, b, K, prior, 8);
+    size_t total = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+      std::vector<uint32_t> expected;
+      for (uint32_t j = 0; j < b.size(); ++j)
+        if (prior_distance_px(a[i], b[j], K, prior) <= 8) expected.push_back(j);
+      std::vector<uint32_t> got = found[i];
+      std::sort(got.begin(), got.end());
+      EXPECT_EQ(got, expected) << "keypoint " << i << " t " << t.transpose();
+      total += expected.size();
+    }
+    EXPECT_GT(total, 100u);  // the bound is met often enough for the comparison to mean something
+  }
 }
 
 TEST(FrontendPairs, SelectionModes) {
