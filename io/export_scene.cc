@@ -8,6 +8,7 @@
 #include "io/colmap.h"
 #include "io/error.h"
 #include "io/import_colmap.h"
+#include "io/sfm_files.h"
 #include "io/tum.h"
 
 namespace litgs::io {
@@ -28,6 +29,48 @@ void copy_atomic(const fs::path& from, const fs::path& to) {
   fs::copy_file(from, file.temp_path(), fs::copy_options::overwrite_existing, ec);
   if (ec) fail(from, 0, "cannot copy to " + to.string() + ": " + ec.message());
   file.commit();
+}
+
+// points3D with their tracks from the front end's sfm/, and every keypoint of each exported image as a
+// point2D (COLMAP's pixel convention: + 0.5); keeps every k-th point to stay within max_points.
+void add_sfm_points(const SfmData& sfm, const Scene& scene, const fs::path& sfm_dir,
+                    const std::vector<int64_t>& image_of_frame, const Eigen::Vector3d& offset,
+                    size_t max_points, ColmapModel& model, ColmapExportReport& report) {
+  if (sfm.images.size() != scene.frames.size())
+    fail(sfm_dir / "images.txt", 0,
+         "lists " + std::to_string(sfm.images.size()) + " images, the scene has " +
+             std::to_string(scene.frames.size()) + " frames: run `litgs-engine match` again");
+  for (size_t i = 0; i < sfm.images.size(); ++i) {
+    if (sfm.images[i].frame != scene.frames[i].image.generic_string())
+      fail(sfm_dir / "images.txt", static_cast<int64_t>(i) + 2,
+           "image " + std::to_string(i) + " is " + sfm.images[i].frame + ", the scene's frame is " +
+               scene.frames[i].image.generic_string() + ": run `litgs-engine match` again");
+    if (image_of_frame[i] < 0) continue;
+    for (const SfmKeypoint& k : sfm.images[i].keypoints)
+      model.images[static_cast<size_t>(image_of_frame[i])].points2d.push_back(
+          {Eigen::Vector2d(k.x + 0.5, k.y + 0.5), -1});
+  }
+  const size_t step = std::max<size_t>(1, (sfm.points.size() + max_points - 1) / max_points);
+  if (step > 1) report.notes.push_back("kept every " + std::to_string(step) + "th point");
+  for (size_t i = 0; i < sfm.points.size(); i += step) {
+    ColmapPoint3D p;
+    p.id = model.points.size() + 1;
+    p.xyz = sfm.points[i].xyz + offset;
+    p.rgb = {128, 128, 128};
+    p.error_px = sfm.points[i].error_px;
+    for (const SfmObservation& obs : sfm.points[i].observations) {
+      if (image_of_frame[obs.image] < 0) continue;
+      ColmapImage& im = model.images[static_cast<size_t>(image_of_frame[obs.image])];
+      im.points2d[obs.keypoint].point3d_id = static_cast<int64_t>(p.id);
+      p.track.push_back({im.id, obs.keypoint});
+    }
+    if (p.track.size() >= 2) {
+      model.points.push_back(std::move(p));
+    } else {
+      for (const auto& t : p.track) model.images[t.image_id - 1].points2d[t.point2d_idx].point3d_id = -1;
+    }
+  }
+  report.notes.push_back("points3D and their 2D observations from sfm/ (litgs-engine match)");
 }
 
 }  // namespace
@@ -63,6 +106,7 @@ ColmapExportReport export_colmap(const ColmapExportOptions& o) {
   const auto poses = camera_poses_at_frames(scene);
   const fs::path images_dir = o.out / "images";
   fs::create_directories(images_dir);
+  std::vector<int64_t> image_of_frame(scene.frames.size(), -1);  // index into model.images
   for (size_t i = 0; i < scene.frames.size(); ++i) {
     if (!poses[i]) {
       ++report.skipped_without_pose;
@@ -77,13 +121,17 @@ ColmapExportReport export_colmap(const ColmapExportOptions& o) {
     im.camera_id = 1;
     im.name = scene.frames[i].image.filename().string();
     copy_atomic(o.scene / scene.frames[i].image, images_dir / im.name);
+    image_of_frame[i] = static_cast<int64_t>(model.images.size());
     model.images.push_back(std::move(im));
   }
   if (report.skipped_without_pose)
     report.notes.push_back(std::to_string(report.skipped_without_pose) +
                            " frames outside the trajectory (or next to unknown rotations) left out");
 
-  if (o.max_points > 0) {
+  const fs::path sfm_dir = o.scene / "sfm";
+  if (o.max_points > 0 && has_sfm(sfm_dir)) {
+    add_sfm_points(read_sfm(sfm_dir), scene, sfm_dir, image_of_frame, offset, o.max_points, model, report);
+  } else if (o.max_points > 0) {
     std::vector<Eigen::Vector3d> points;
     if (!scene.anchors.empty()) {
       for (const auto& a : scene.anchors) points.push_back(a.p_world);

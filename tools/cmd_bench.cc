@@ -12,6 +12,7 @@ void add_bench_command(CLI::App& app) {
   add_bench_render_command(*bench);
   add_bench_loss_command(*bench);
   add_bench_serve_command(*bench);
+  add_bench_frontend_command(*bench);
 }
 
 }  // namespace litgs::tools

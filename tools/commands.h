@@ -8,16 +8,18 @@ class App;
 namespace litgs::tools {
 
 void add_info_command(CLI::App& app);
-void add_bench_command(CLI::App& app);  // bench sort | render | loss | serve
+void add_bench_command(CLI::App& app);  // bench sort | render | loss | serve | frontend
 void add_bench_sort_command(CLI::App& bench);
 void add_bench_render_command(CLI::App& bench);
 void add_bench_loss_command(CLI::App& bench);
 void add_bench_serve_command(CLI::App& bench);
+void add_bench_frontend_command(CLI::App& bench);
 void add_import_command(CLI::App& app);  // import metashape | colmap | livo2 | bag
 void add_export_command(CLI::App& app);  // export colmap | tum | splat
 void add_render_command(CLI::App& app);
 void add_serve_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_train_command(CLI::App& app);
+void add_match_command(CLI::App& app);
 
 }  // namespace litgs::tools

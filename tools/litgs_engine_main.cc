@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   litgs::tools::add_synth_command(app);
   litgs::tools::add_train_command(app);
   litgs::tools::add_export_command(app);
+  litgs::tools::add_match_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

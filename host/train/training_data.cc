@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "host/frontend/frozen_frames.h"
+#include "host/frontend/intensity.h"
 #include "io/scene.h"
 
 namespace litgs::host {
@@ -155,42 +157,23 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
 
   // Raw frames, and the intensity mapping shared by all of them.
   std::vector<std::vector<float>> raw(scene.frames.size());
-  std::vector<uint64_t> histogram(65536, 0);
+  frontend::Histogram histogram = frontend::empty_histogram();
   for (size_t i = 0; i < scene.frames.size(); ++i) {
     const io::Image img = io::load_frame(dir, scene, i);
     raw[i].resize(static_cast<size_t>(img.width) * img.height);
-    for (size_t p = 0; p < raw[i].size(); ++p) {
-      const uint16_t v = img.data[p * img.channels];
-      raw[i][p] = v;
-      ++histogram[v];
-    }
+    for (size_t p = 0; p < raw[i].size(); ++p) raw[i][p] = img.data[p * img.channels];
+    frontend::add_to_histogram(histogram, img.data, static_cast<size_t>(img.channels));
   }
   TrainingData out;
   out.options = o;
   const bool percentile = o.mapping == IntensityMapping::kPercentile ||
                           (o.mapping == IntensityMapping::kAuto && k.bit_depth == 16);
-  if (percentile) {
-    uint64_t total = 0;
-    for (uint64_t c : histogram) total += c;
-    auto value_at = [&](double pct) {
-      const double target = pct / 100.0 * static_cast<double>(total);
-      uint64_t seen = 0;
-      for (size_t v = 0; v < histogram.size(); ++v) {
-        seen += histogram[v];
-        if (static_cast<double>(seen) >= target) return static_cast<double>(v);
-      }
-      return 65535.0;
-    };
-    out.stretch_low = value_at(o.low_percentile);
-    out.stretch_high = value_at(o.high_percentile);
-    if (!(out.stretch_high > out.stretch_low)) out.stretch_high = out.stretch_low + 1;
-  } else {
-    out.stretch_low = 0;
-    out.stretch_high = k.bit_depth == 16 ? 65535.0 : 255.0;
-  }
-  const double range = out.stretch_high - out.stretch_low;
+  frontend::Stretch stretch{0, k.bit_depth == 16 ? 65535.0 : 255.0};
+  if (percentile) stretch = frontend::percentile_stretch(histogram, o.low_percentile, o.high_percentile);
+  out.stretch_low = stretch.low;
+  out.stretch_high = stretch.high;
   for (auto& frame : raw)
-    for (float& v : frame) v = static_cast<float>(std::clamp((v - out.stretch_low) / range, 0.0, 1.0));
+    for (float& v : frame) v = stretch.unit(v);
 
   // Training resolution and pinhole camera (pixel centres at +0.5, the rasterizer's convention).
   const Pinhole pinhole = training_pinhole(k, o.downscale);
@@ -204,19 +187,14 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
   const int sub = std::max(1, static_cast<int>(std::ceil(std::max(sx, sy))));
 
   std::vector<Eigen::Vector3d> centres;
-  const std::vector<float>* previous = nullptr;
+  frontend::FrozenFrameDetector frozen(o.frozen_threshold);
   bool skipped_before = false;
   for (size_t i = 0; i < scene.frames.size(); ++i) {
-    if (previous) {
-      double diff = 0;
-      for (size_t p = 0; p < raw[i].size(); ++p) diff += std::abs(raw[i][p] - (*previous)[p]);
-      if (diff / static_cast<double>(raw[i].size()) < o.frozen_threshold) {
-        ++out.frozen_skipped;
-        skipped_before = true;
-        continue;
-      }
+    if (frozen.is_frozen(raw[i])) {
+      ++out.frozen_skipped;
+      skipped_before = true;
+      continue;
     }
-    previous = &raw[i];
     TrainingView view;
     view.after_frozen = std::exchange(skipped_before, false);
     view.name = scene.frames[i].image.filename().string();

@@ -1,0 +1,43 @@
+// Keypoints and descriptors (ORB, SIFT or AKAZE through OpenCV) with a per-image budget spread over the
+// image by grid bucketing, so that low-texture thermal frames still get keypoints everywhere.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "host/frontend/preprocess.h"
+#include "io/sfm_files.h"
+
+namespace litgs::host::frontend {
+
+enum class FeatureType { kOrb, kSift, kAkaze };
+std::string feature_name(FeatureType type);
+FeatureType parse_feature_type(const std::string& name);  // "orb" | "sift" | "akaze"; invalid_argument
+
+struct FeatureOptions {
+  FeatureType type = FeatureType::kSift;
+  int max_keypoints = 3000;  // per image
+  // Grid bucketing: each of grid_cols x grid_rows cells keeps its strongest max_keypoints / cells first, the
+  // rest of the budget goes to the strongest left anywhere. 0 cells: strongest overall.
+  int grid_cols = 8, grid_rows = 8;
+  void check() const;  // std::invalid_argument naming the field
+};
+
+struct ImageFeatures {
+  std::vector<io::SfmKeypoint> keypoints;
+  std::vector<uint8_t> descriptors;  // keypoints.size() rows of descriptor_bytes
+  int descriptor_bytes = 0;
+  bool float_descriptors = false;  // rows of float (SIFT) or bit strings (ORB, AKAZE)
+};
+
+// Detects and describes; an empty or uniform image gives no keypoints (not an error).
+ImageFeatures detect_features(const Gray8& image, const FeatureOptions& options);
+
+// Indices of at most `budget` of the keypoints at (x, y) with `response`: per cell of the grid the
+// strongest budget / cells first, then the strongest of the rest. Ties keep the lower index. Sorted.
+std::vector<size_t> bucket_keypoints(const std::vector<float>& x, const std::vector<float>& y,
+                                     const std::vector<float>& response, int width, int height, int budget,
+                                     int grid_cols, int grid_rows);
+
+}  // namespace litgs::host::frontend

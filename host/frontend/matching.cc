@@ -1,0 +1,97 @@
+#include "host/frontend/matching.h"
+
+#include <limits>
+#include <opencv2/core/hal/hal.hpp>
+#include <opencv2/features2d.hpp>
+#include <stdexcept>
+
+namespace litgs::host::frontend {
+namespace {
+
+cv::Mat descriptor_mat(const ImageFeatures& f) {
+  const int rows = static_cast<int>(f.keypoints.size());
+  if (f.float_descriptors)
+    return cv::Mat(rows, f.descriptor_bytes / 4, CV_32F, const_cast<uint8_t*>(f.descriptors.data()));
+  return cv::Mat(rows, f.descriptor_bytes, CV_8U, const_cast<uint8_t*>(f.descriptors.data()));
+}
+
+}  // namespace
+
+void MatchOptions::check() const {
+  if (!(ratio > 0 && ratio <= 1)) throw std::invalid_argument("match ratio must be in (0, 1]");
+}
+
+std::vector<std::array<uint32_t, 2>> match_mutual(const ImageFeatures& a, const ImageFeatures& b,
+                                                  const MatchOptions& o) {
+  o.check();
+  std::vector<std::array<uint32_t, 2>> out;
+  if (a.keypoints.empty() || b.keypoints.empty()) return out;
+  if (a.float_descriptors != b.float_descriptors || a.descriptor_bytes != b.descriptor_bytes)
+    throw std::invalid_argument("match_mutual: the two images have different descriptor kinds");
+  cv::BFMatcher matcher(a.float_descriptors ? cv::NORM_L2 : cv::NORM_HAMMING);
+  const cv::Mat da = descriptor_mat(a), db = descriptor_mat(b);
+  std::vector<std::vector<cv::DMatch>> ab, ba;
+  matcher.knnMatch(da, db, ab, 2);
+  matcher.knnMatch(db, da, ba, 1);
+  for (const auto& m : ab) {
+    if (m.empty()) continue;
+    const cv::DMatch& best = m[0];
+    if (m.size() > 1 && !(best.distance < o.ratio * m[1].distance)) continue;
+    const auto& back = ba[static_cast<size_t>(best.trainIdx)];
+    if (back.empty() || back[0].trainIdx != best.queryIdx) continue;
+    out.push_back({static_cast<uint32_t>(best.queryIdx), static_cast<uint32_t>(best.trainIdx)});
+  }
+  return out;
+}
+
+std::vector<std::array<uint32_t, 2>> match_mutual_among(const ImageFeatures& a, const ImageFeatures& b,
+                                                        const std::vector<std::vector<uint32_t>>& allowed,
+                                                        const MatchOptions& o) {
+  o.check();
+  std::vector<std::array<uint32_t, 2>> out;
+  if (a.keypoints.empty() || b.keypoints.empty()) return out;
+  if (a.float_descriptors != b.float_descriptors || a.descriptor_bytes != b.descriptor_bytes)
+    throw std::invalid_argument("match_mutual_among: the two images have different descriptor kinds");
+  if (allowed.size() != a.keypoints.size())
+    throw std::invalid_argument("match_mutual_among: one candidate list per keypoint of a is needed");
+  const size_t bytes = static_cast<size_t>(a.descriptor_bytes);
+  // Distances as the matcher's norm: L2 for float rows, Hamming for bit strings.
+  auto distance = [&](uint32_t i, uint32_t j) -> double {
+    const uint8_t* da = a.descriptors.data() + i * bytes;
+    const uint8_t* db = b.descriptors.data() + j * bytes;
+    if (a.float_descriptors)
+      return std::sqrt(static_cast<double>(cv::hal::normL2Sqr_(reinterpret_cast<const float*>(da),
+                                                               reinterpret_cast<const float*>(db),
+                                                               static_cast<int>(bytes / 4))));
+    return cv::hal::normHamming(da, db, static_cast<int>(bytes));
+  };
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<double> best_of_b(b.keypoints.size(), kInf);
+  std::vector<int64_t> best_i_of_b(b.keypoints.size(), -1);
+  std::vector<int64_t> best_j(a.keypoints.size(), -1);
+  std::vector<char> passes_ratio(a.keypoints.size(), 0);
+  for (uint32_t i = 0; i < allowed.size(); ++i) {
+    double first = kInf, second = kInf;
+    for (uint32_t j : allowed[i]) {
+      const double d = distance(i, j);
+      if (d < first) {
+        second = first;
+        first = d;
+        best_j[i] = j;
+      } else if (d < second) {
+        second = d;
+      }
+      if (d < best_of_b[j]) {
+        best_of_b[j] = d;
+        best_i_of_b[j] = i;
+      }
+    }
+    passes_ratio[i] = best_j[i] >= 0 && (second == kInf || first < o.ratio * second);
+  }
+  for (uint32_t i = 0; i < allowed.size(); ++i)
+    if (passes_ratio[i] && best_i_of_b[static_cast<size_t>(best_j[i])] == i)
+      out.push_back({i, static_cast<uint32_t>(best_j[i])});
+  return out;
+}
+
+}  // namespace litgs::host::frontend

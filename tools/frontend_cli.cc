@@ -1,0 +1,105 @@
+#include "tools/frontend_cli.h"
+
+#include <CLI/CLI.hpp>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+namespace litgs::tools {
+
+host::frontend::FrontendOptions FrontendCli::resolved() const {
+  host::frontend::FrontendOptions o = options;
+  o.features.type = host::frontend::parse_feature_type(features);
+  o.pairs = host::frontend::parse_pairs(pairs);
+  o.preprocess.clahe = !no_clahe;
+  o.prior_epipolar = !no_prior_epipolar;
+  if (poses != "estimated" && poses != "truth")
+    throw std::invalid_argument("--poses " + poses + ": expected estimated or truth");
+  o.true_poses = poses == "truth";
+  o.check();
+  return o;
+}
+
+void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli) {
+  host::frontend::FrontendOptions& o = cli->options;
+  cmd.add_option("--features", cli->features, "orb | sift | akaze")->capture_default_str();
+  cmd.add_flag("--no-clahe", cli->no_clahe, "No CLAHE before detection (default: on)");
+  cmd.add_option("--pairs", cli->pairs,
+                 "covisible[:N] (sequential:N first, then frusta that overlap at the scene depth) | "
+                 "sequential:N | exhaustive")
+      ->capture_default_str();
+  cmd.add_option("--max-keypoints", o.features.max_keypoints, "Keypoint budget per image")
+      ->capture_default_str();
+  cmd.add_option("--threads", o.threads, "Worker threads (0: all cores)")->capture_default_str();
+  cmd.add_option("--grid", o.features.grid_cols, "Grid bucketing: N x N cells (0: off)")
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.features.grid_rows = o.features.grid_cols; });
+  cmd.add_option("--clahe-clip", o.preprocess.clahe_clip_limit, "CLAHE clip limit")->capture_default_str();
+  cmd.add_option("--clahe-tiles", o.preprocess.clahe_tiles, "CLAHE tile grid N x N")->capture_default_str();
+  cmd.add_option("--stretch-window", o.preprocess.stretch_window,
+                 "16-bit stretch over the N frames around each frame (0: the whole sequence)")
+      ->capture_default_str();
+  cmd.add_option("--ratio", o.match.ratio, "Ratio test bound")->capture_default_str();
+  cmd.add_option("--magsac-px", o.verify.max_error_px, "MAGSAC threshold, pixels")->capture_default_str();
+  cmd.add_option("--prior-epipolar-px", o.verify.prior_epipolar_px,
+                 "Reject matches this far from the prior poses' epipolar lines (pixels)")
+      ->capture_default_str();
+  cmd.add_flag("--no-prior-epipolar", cli->no_prior_epipolar, "Do not use the prior poses' epipolar bound");
+  cmd.add_option("--min-inliers", o.verify.min_inliers, "Verified matches a pair needs")
+      ->capture_default_str();
+  cmd.add_option("--max-error-px", o.triangulation.max_error_px,
+                 "Triangulation: a view agrees with a point within this reprojection error")
+      ->capture_default_str();
+  cmd.add_option("--poses", cli->poses, "Priors: estimated (poses.txt) | truth (gt/poses.txt)")
+      ->capture_default_str();
+  cmd.add_option("--min-views", o.triangulation.min_views, "Views that must agree with a point")
+      ->capture_default_str();
+  cmd.add_option("--min-angle", o.triangulation.min_angle_deg, "Triangulation angle, degrees")
+      ->capture_default_str();
+}
+
+host::frontend::FrontendProgress progress_printer() {
+  // Redraws only when the bar grows (or the stage changes), so a log of it stays short.
+  auto last = std::make_shared<std::pair<std::string, int>>("", -1);
+  return [last](const std::string& stage, size_t done, size_t total) {
+    const int width = 30;
+    const int filled = total ? static_cast<int>(width * done / total) : width;
+    if (stage == last->first && filled == last->second && done != total) return;
+    *last = {stage, filled};
+    std::cerr << '\r' << std::left << std::setw(10) << stage << " [" << std::string(filled, '#')
+              << std::string(width - filled, ' ') << "] " << done << '/' << total << std::flush;
+    if (done == total) std::cerr << '\n';
+  };
+}
+
+void print_summary(std::ostream& out, const std::string& title, const host::frontend::FrontendResult& r) {
+  const host::frontend::FrontendSummary& m = r.summary;
+  const auto& o = r.options;
+  out << std::fixed;
+  out << title << " (" << host::frontend::feature_name(o.features.type)
+      << (o.preprocess.clahe ? " + CLAHE" : "") << ", pairs " << host::frontend::pairs_name(o.pairs)
+      << ", prior epipolar "
+      << (o.prior_epipolar ? (std::ostringstream() << o.verify.prior_epipolar_px << " px").str()
+                           : std::string("off"))
+      << ")\n";
+  out << std::setprecision(1) << "  images          " << m.images << " (" << m.frozen << " frozen, "
+      << m.uniform << " uniform)\n"
+      << "  keypoints/image " << m.keypoints_per_image << "\n"
+      << "  pairs           " << m.pairs_tried << " tried, " << m.pairs_verified << " verified\n"
+      << std::setprecision(3) << "  inlier ratio    " << m.inlier_ratio << " (" << m.verified_matches
+      << " verified / " << m.mutual_matches << " mutual matches)\n"
+      << "  tracks          " << m.tracks << " (" << m.track_conflicts << " conflicting matches dropped)\n"
+      << "  points          " << m.points << "\n"
+      << std::setprecision(2) << "  track length    " << m.mean_track_length << " (mean)\n"
+      << std::setprecision(3) << "  reprojection    " << m.mean_error_px << " px (mean)\n";
+  if (m.true_plane_median_m >= 0)
+    out << std::setprecision(4) << "  true planes     " << m.true_plane_median_m << " m median, "
+        << m.true_plane_mean_m << " m mean distance of the points to the nearest\n";
+  out << std::setprecision(2) << "  seconds         preprocess " << m.seconds.preprocess << ", features "
+      << m.seconds.features << ", pair selection " << m.seconds.pair_selection << ", matching "
+      << m.seconds.matching << ", tracks+triangulation " << m.seconds.triangulation << ", total "
+      << m.seconds.total << "\n";
+  for (const auto& note : m.notes) out << "  note: " << note << "\n";
+}
+
+}  // namespace litgs::tools
