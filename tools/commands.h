@@ -1,8 +1,13 @@
 // The subcommands of litgs-engine. Each registers itself on the CLI11 app and runs when chosen.
 #pragma once
 
+#include <string>
+
 namespace CLI {
 class App;
+}
+namespace litgs::host {
+struct LidarMapReport;
 }
 
 namespace litgs::tools {
@@ -12,10 +17,14 @@ void add_bench_command(CLI::App& app);  // bench sort | render | loss
 void add_bench_sort_command(CLI::App& bench);
 void add_bench_render_command(CLI::App& bench);
 void add_bench_loss_command(CLI::App& bench);
+void add_bench_planes_command(CLI::App& bench);
 void add_import_command(CLI::App& app);  // import metashape | colmap | livo2 | bag
 void add_export_command(CLI::App& app);  // export colmap | tum
 void add_render_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_train_command(CLI::App& app);
+void add_map_command(CLI::App& app);
+void add_refine_command(CLI::App& app);
+void print_lidar_map_report(const host::LidarMapReport& report, const std::string& where);  // cmd_map.cc
 
 }  // namespace litgs::tools
