@@ -11,7 +11,6 @@ void add_bench_command(CLI::App& app) {
   add_bench_sort_command(*bench);
   add_bench_render_command(*bench);
   add_bench_loss_command(*bench);
-  add_bench_planes_command(*bench);
 }
 
 }  // namespace litgs::tools

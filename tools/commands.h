@@ -17,7 +17,6 @@ void add_bench_command(CLI::App& app);  // bench sort | render | loss
 void add_bench_sort_command(CLI::App& bench);
 void add_bench_render_command(CLI::App& bench);
 void add_bench_loss_command(CLI::App& bench);
-void add_bench_planes_command(CLI::App& bench);
 void add_import_command(CLI::App& app);  // import metashape | colmap | livo2 | bag
 void add_export_command(CLI::App& app);  // export colmap | tum
 void add_render_command(CLI::App& app);

@@ -53,11 +53,14 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<do
 AnchorAssociationReport associate_anchors(std::vector<TrackPoint>& points,
                                           const std::vector<AnchorPoint>& anchors,
                                           const std::vector<CameraPose>& poses, const PinholeCamera& camera,
-                                          const PlanarMap* map, const AnchorAssociationOptions& o) {
+                                          const PlanarMap* map, const AnchorAssociationOptions& o,
+                                          size_t round) {
   AnchorAssociationReport report;
   for (auto& p : points) p.anchor = -1;
+  const double radius =
+      std::max(o.min_radius_px, o.radius_px * std::pow(o.shrink, static_cast<double>(round)));
   // Per frame, the observations by pixel cell for the radius search.
-  const double cell = std::max(o.radius_px, 1.0);
+  const double cell = std::max(radius, 1.0);
   auto cell_key = [cell](const Eigen::Vector2d& uv) {
     return (static_cast<int64_t>(std::floor(uv.y() / cell)) << 32) ^
            static_cast<int64_t>(static_cast<uint32_t>(static_cast<int32_t>(std::floor(uv.x() / cell))));
@@ -69,6 +72,7 @@ AnchorAssociationReport associate_anchors(std::vector<TrackPoint>& points,
         grid[ob.frame].emplace(cell_key(ob.uv), k);
 
   std::vector<std::map<size_t, size_t>> votes(anchors.size());  // anchor -> track -> agreeing frames
+  std::vector<std::map<size_t, double>> dist(anchors.size());   // anchor -> track -> summed pixel distance
   std::vector<std::vector<uint32_t>> visible(anchors.size());   // anchor -> frames that see it
   for (size_t f = 0; f < poses.size(); ++f) {
     std::optional<ViewPlaneMaps> depth;
@@ -88,36 +92,34 @@ AnchorAssociationReport associate_anchors(std::vector<TrackPoint>& points,
         }
       }
       visible[a].push_back(static_cast<uint32_t>(f));
-      // Tracks seen in this frame near the anchor's projection: the nearest one votes.
-      size_t best = points.size();
-      double best_d = o.radius_px;
+      // Every track seen in this frame near the anchor's projection votes.
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const auto range = grid[f].equal_range(cell_key(uv + Eigen::Vector2d(dx * cell, dy * cell)));
           for (auto it = range.first; it != range.second; ++it)
             for (const auto& ob : points[it->second].obs)
-              if (ob.frame == f && ob.active && (ob.uv - uv).norm() <= best_d) {
-                best_d = (ob.uv - uv).norm();
-                best = it->second;
+              if (ob.frame == f && ob.active && (ob.uv - uv).norm() <= radius) {
+                ++votes[a][it->second];
+                dist[a][it->second] += (ob.uv - uv).norm();
               }
         }
-      if (best < points.size()) ++votes[a][best];
     }
   }
   // Each track to its strongest agreeing anchor, each anchor to one track.
-  std::vector<std::tuple<size_t, size_t, size_t>> pairs;  // votes, anchor, track
+  std::vector<std::tuple<size_t, double, size_t, size_t>> pairs;  // votes, -mean distance, anchor, track
   for (size_t a = 0; a < anchors.size(); ++a) {
     if (!votes[a].empty()) ++report.anchors_in_view;
     for (const auto& [track, n] : votes[a]) {
       size_t shared = 0;  // frames that see the anchor and observe the track
       for (const auto& ob : points[track].obs)
         shared += ob.active && std::binary_search(visible[a].begin(), visible[a].end(), ob.frame);
-      if (n >= o.min_agreeing && 2 * n >= shared) pairs.emplace_back(n, a, track);
+      if (n >= o.min_agreeing && 2 * n >= shared)
+        pairs.emplace_back(n, -dist[a][track] / static_cast<double>(n), a, track);
     }
   }
   std::sort(pairs.rbegin(), pairs.rend());
   std::vector<bool> anchor_used(anchors.size(), false);
-  for (const auto& [n, a, track] : pairs) {
+  for (const auto& [n, neg_dist, a, track] : pairs) {
     if (anchor_used[a] || points[track].anchor >= 0) continue;
     anchor_used[a] = true;
     points[track].anchor = static_cast<int>(a);

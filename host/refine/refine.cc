@@ -165,7 +165,7 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
     // Both associations follow the poses as they improve.
     if (anchors)
       report.anchor_association = associate_anchors(in.points, in.anchors, poses, in.camera,
-                                                    planes ? in.map : nullptr, o.anchor_association);
+                                                    planes ? in.map : nullptr, o.anchor_association, r);
     if (associator) rr.planes = associator->associate(in.points, poses, r, o.plane_association);
     if (r == 0) report.before = residual_stats(in.points, poses, in.camera);
     rr.before = residual_stats(in.points, poses, in.camera);
