@@ -71,8 +71,11 @@ void RosBagWriter::cloud(const std::string& topic, double t_s, const PointCloud&
   m.height = 1;
   m.width = static_cast<uint32_t>(cloud.size());
   const bool intensity = !cloud.intensity.empty();
-  const char* names[4] = {"x", "y", "z", "intensity"};
-  for (uint32_t k = 0; k < (intensity ? 4u : 3u); ++k) {
+  const ScalarField* time = cloud.field("time");
+  std::vector<std::string> names = {"x", "y", "z"};
+  if (intensity) names.push_back("intensity");
+  if (time) names.push_back("time");
+  for (uint32_t k = 0; k < names.size(); ++k) {
     sensor_msgs::PointField f;
     f.name = names[k];
     f.offset = 4 * k;
@@ -80,14 +83,17 @@ void RosBagWriter::cloud(const std::string& topic, double t_s, const PointCloud&
     f.count = 1;
     m.fields.push_back(f);
   }
-  m.point_step = intensity ? 16 : 12;
+  m.point_step = static_cast<uint32_t>(4 * names.size());
   m.row_step = m.point_step * m.width;
   m.is_dense = true;
   m.data.resize(m.row_step);
   for (size_t i = 0; i < cloud.size(); ++i) {
-    float v[4] = {static_cast<float>(cloud.positions[i].x()), static_cast<float>(cloud.positions[i].y()),
-                  static_cast<float>(cloud.positions[i].z()), intensity ? cloud.intensity[i] : 0.f};
-    std::memcpy(m.data.data() + i * m.point_step, v, m.point_step);
+    std::vector<float> v = {static_cast<float>(cloud.positions[i].x()),
+                            static_cast<float>(cloud.positions[i].y()),
+                            static_cast<float>(cloud.positions[i].z())};
+    if (intensity) v.push_back(cloud.intensity[i]);
+    if (time) v.push_back(static_cast<float>(time->values[i]));
+    std::memcpy(m.data.data() + i * m.point_step, v.data(), m.point_step);
   }
   impl_->bag.write(topic, m.header.stamp, m);
 }

@@ -36,7 +36,7 @@ struct RosBagTopics {
 // (seconds); a zero stamp falls back to the bag's receive time.
 struct RosBagHandlers {
   std::function<void(double t_s, Image image)> thermal;     // channels and depth as the encoding says
-  std::function<void(double t_s, PointCloud cloud)> lidar;  // x y z [intensity]; non-finite points dropped
+  std::function<void(double t_s, PointCloud cloud)> lidar;  // x y z [intensity] [time]; non-finite dropped
   std::function<void(const ImuSample& sample)> imu;
   std::function<void(const TumPose& pose)> odom;  // pose.pose of the message: T_world_child
 };
@@ -59,8 +59,8 @@ RosBagCounts read_ros_bag(const std::filesystem::path& bag, const RosBagTopics& 
 enum class RosBagCompression { kNone, kBz2, kLz4 };
 
 // Writes a bag with rosbag_storage (for tests and fuzz seeds). Images: 1 channel -> mono8/mono16, 3 -> rgb8/
-// rgb16; clouds: x y z float32 [intensity float32]. IoError on library errors, or when the build has none
-// (ros_bag_writer_available()).
+// rgb16; clouds: x y z float32 [intensity float32] [time float32 (extra "time")]. IoError on library errors,
+// or when the build has none (ros_bag_writer_available()).
 class RosBagWriter {
  public:
   explicit RosBagWriter(const std::filesystem::path& bag,

@@ -480,7 +480,9 @@ double read_field(const uint8_t* p, uint8_t datatype) {
 }
 
 // sensor_msgs/PointCloud2: header, height, width, fields[] {name, offset, datatype, count}, is_bigendian,
-// point_step, row_step, data, is_dense. x y z (float32/float64) and an optional intensity (any type).
+// point_step, row_step, data, is_dense. x y z (float32/float64), an optional intensity (any type) and an
+// optional per-point time, kept as the extra field "time" in seconds after the stamp: Velodyne's "time"
+// (float seconds) or Ouster's "t" (integer nanoseconds).
 PointCloud decode_point_cloud2(Wire& w, Stamp& stamp) {
   stamp = w.header();
   const uint32_t height = w.u32("height"), width = w.u32("width");
@@ -506,12 +508,12 @@ PointCloud decode_point_cloud2(Wire& w, Stamp& stamp) {
   w.finish();
   if (big) throw MessageError(w.where() + ": big-endian point clouds are not supported");
 
-  const Field* f[4] = {nullptr, nullptr, nullptr, nullptr};
-  static const char* names[4] = {"x", "y", "z", "intensity"};
+  const Field* f[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+  static const char* names[6] = {"x", "y", "z", "intensity", "time", "t"};
   for (const auto& field : fields)
-    for (int k = 0; k < 4; ++k)
+    for (int k = 0; k < 6; ++k)
       if (field.name == names[k]) f[k] = &field;
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < 6; ++k) {
     if (!f[k]) {
       if (k < 3) throw MessageError(w.where() + ": point cloud has no field '" + names[k] + "'");
       continue;
@@ -535,6 +537,9 @@ PointCloud decode_point_cloud2(Wire& w, Stamp& stamp) {
   PointCloud c;
   // point_step >= 4 (x is inside it), so width * height <= size / 4: bounded by the message.
   c.positions.reserve(static_cast<size_t>(width) * height);
+  const Field* time = f[4] ? f[4] : f[5];
+  const double time_scale = f[4] ? 1.0 : 1e-9;  // "t" counts nanoseconds
+  if (time) c.extra.push_back({"time", {}});
   for (uint32_t r = 0; r < height; ++r)
     for (uint32_t i = 0; i < width; ++i) {
       const uint8_t* p = data + static_cast<size_t>(r) * row_step + static_cast<size_t>(i) * point_step;
@@ -544,6 +549,11 @@ PointCloud decode_point_cloud2(Wire& w, Stamp& stamp) {
       if (!x.allFinite()) continue;
       c.positions.push_back(x);
       if (f[3]) c.intensity.push_back(static_cast<float>(read_field(p + f[3]->offset, f[3]->datatype)));
+      if (time) {
+        const double dt = read_field(p + time->offset, time->datatype) * time_scale;
+        if (!std::isfinite(dt)) throw MessageError(w.where() + ": a point's time is not finite");
+        c.extra[0].values.push_back(dt);
+      }
     }
   return c;
 }

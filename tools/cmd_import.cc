@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "host/lidar_map/map_builder.h"
 #include "io/import_bag.h"
 #include "io/import_colmap.h"
 #include "io/import_livo2.h"
@@ -98,12 +99,22 @@ void add_import_bag(CLI::App* import) {
   c->add_flag("!--no-scans", o->scans, "Do not write the LiDAR scans");
   c->add_option("--image-format", o->image_extension, "Extension of the written frames: .png or .tiff")
       ->capture_default_str();
-  c->callback([o, frame] {
+  auto map = std::make_shared<bool>(true);
+  auto voxel = std::make_shared<double>(host::LidarMapOptions{}.voxel_m);
+  c->add_flag("!--no-map", *map,
+              "Do not build lidar/map.pcd from the scans (litgs-engine map does it later)");
+  c->add_option("--map-voxel", *voxel, "Voxel edge of the map in metres")->capture_default_str();
+  c->callback([o, frame, map, voxel] {
     o->poses_frame = *frame == "camera" ? io::PoseFrame::kCamera : io::PoseFrame::kImu;
     const io::BagImportReport r = io::import_bag(*o);
     std::cout << "import bag: " << r.frames << " frames, " << r.scans << " scans, " << r.imu
               << " IMU samples, " << r.poses << " poses into " << o->out.string() << "\n";
     for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
+    if (*map && r.scans > 0) {
+      host::LidarMapOptions mo;
+      mo.voxel_m = *voxel;
+      print_lidar_map_report(host::write_scene_lidar_map(o->out, mo), (o->out / "lidar/map.pcd").string());
+    }
   });
 }
 

@@ -1,8 +1,13 @@
 // The subcommands of litgs-engine. Each registers itself on the CLI11 app and runs when chosen.
 #pragma once
 
+#include <string>
+
 namespace CLI {
 class App;
+}
+namespace litgs::host {
+struct LidarMapReport;
 }
 
 namespace litgs::tools {
@@ -21,5 +26,8 @@ void add_serve_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_match_command(CLI::App& app);
+void add_map_command(CLI::App& app);
+void add_refine_command(CLI::App& app);
+void print_lidar_map_report(const host::LidarMapReport& report, const std::string& where);  // cmd_map.cc
 
 }  // namespace litgs::tools

@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
   litgs::tools::add_train_command(app);
   litgs::tools::add_export_command(app);
   litgs::tools::add_match_command(app);
+  litgs::tools::add_map_command(app);
+  litgs::tools::add_refine_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

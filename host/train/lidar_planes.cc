@@ -43,6 +43,7 @@ PlanarMap fit_planes(const std::vector<Eigen::Vector3d>& points, const PlaneFitO
   map.normals.assign(points.size(), Eigen::Vector3f::Zero());
   map.centres.assign(points.size(), Eigen::Vector3f::Zero());
   map.planar.assign(points.size(), 0);
+  map.flatness.assign(points.size(), std::numeric_limits<float>::quiet_NaN());
   if (points.size() < o.neighbours) return map;
   Adaptor adaptor{points};
   Tree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
@@ -63,7 +64,9 @@ PlanarMap fit_planes(const std::vector<Eigen::Vector3d>& points, const PlaneFitO
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
     const Eigen::Vector3d ev = eig.eigenvalues();  // ascending
-    if (!(ev[1] > 0) || ev[0] / ev[1] > o.max_flatness) continue;
+    if (!(ev[1] > 0)) continue;
+    map.flatness[i] = static_cast<float>(ev[0] / ev[1]);
+    if (ev[0] / ev[1] > o.max_flatness) continue;
     map.normals[i] = eig.eigenvectors().col(0).cast<float>().normalized();
     map.centres[i] = mean.cast<float>();
     map.planar[i] = 1;

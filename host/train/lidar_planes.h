@@ -27,6 +27,9 @@ struct PlanarMap {
   std::vector<Eigen::Vector3f>
       centres;                  // the local plane's point (centroid of the fit); zero where not planar
   std::vector<uint8_t> planar;  // 1 where the fit is valid
+  // Smallest / middle eigenvalue of each neighbourhood (0 on a perfect plane); NaN where no fit was made
+  // (too few or too distant neighbours).
+  std::vector<float> flatness;
   // The surface each point stands for in a view: a disc of this radius (metres; on its plane where planar,
   // facing the camera elsewhere), so that a nearer surface hides the points behind it between its own
   // sparse points. Empty or 0: the point covers only the pixel it falls in.

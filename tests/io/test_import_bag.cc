@@ -151,6 +151,28 @@ TEST_F(ImportBagTest, BadBagsAreNamed) {
 // 32-bit arithmetic, which passed the old "offset + size > point_step" check and read 4 GiB past each point.
 // The bag is written by rosbag_storage and the one serialized PointField is patched in place (same length,
 // so the bag's records stay consistent).
+TEST_F(ImportBagTest, PerPointTimeFieldIsKeptForDeskewing) {
+  PointCloud c;
+  c.positions = {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}};
+  c.extra.push_back({"time", {0.0, 0.025, 0.0999}});
+  {
+    RosBagWriter w(dir_ / "timed.bag");
+    w.cloud("/velodyne_points", 100.0, c);
+    w.close();
+  }
+  RosBagTopics topics;
+  topics.thermal = topics.imu = "";
+  std::vector<double> times;
+  RosBagHandlers h;
+  h.lidar = [&](double, PointCloud cloud) {
+    ASSERT_NE(cloud.field("time"), nullptr);
+    times = cloud.field("time")->values;
+  };
+  read_ros_bag(dir_ / "timed.bag", topics, h);
+  ASSERT_EQ(times.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) EXPECT_NEAR(times[i], c.extra[0].values[i], 1e-7);  // float32 on the wire
+}
+
 TEST_F(ImportBagTest, PointCloudFieldOffsetThatWouldWrapIsAnError) {
   PointCloud c;
   c.positions = {{1, 2, 3}, {4, 5, 6}};

@@ -1,0 +1,66 @@
+// The LiDAR map of a scene that has only scans: every scan point deskewed by its own time, placed in the
+// world with the trajectory and the extrinsics, averaged per voxel, then given a local plane fit (normal and
+// planarity). Behind `litgs-engine map` and `import bag` (docs/lidar-map.md).
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "host/train/lidar_planes.h"
+#include "io/point_cloud.h"
+#include "io/scene.h"
+
+namespace litgs::host {
+
+struct LidarMapOptions {
+  double voxel_m = 0.1;      // edge of the averaging voxel
+  double min_range_m = 0.5;  // returns nearer than this (the rig itself) are dropped
+  double max_range_m = 100;  // and farther than this (sparse, noisy)
+  bool deskew = true;        // use the scans' per-point "time" field where they have one
+  int deskew_samples = 8;    // poses sampled across one scan's time span, interpolated between
+  PlaneFitOptions planes;    // the per-point plane fit on the voxel centroids
+  void check() const;        // throws std::invalid_argument naming the bad field
+};
+
+struct LidarMapReport {
+  size_t scans = 0;               // scans used
+  size_t scans_without_pose = 0;  // outside the trajectory: skipped
+  size_t scans_deskewed = 0;      // with a per-point time field
+  size_t input_points = 0;        // in range, over the scans used
+  size_t map_points = 0, planar_points = 0;
+  double seconds = 0;
+  double peak_rss_mb = 0;  // the process's peak resident memory (VmHWM) when the map was done
+  std::vector<std::string> notes;
+};
+
+// T_world_lidar at a LiDAR-clock time, or nullopt outside the trajectory.
+using LidarPoseAt = std::function<std::optional<Eigen::Matrix4d>(double t_lidar_s)>;
+
+// The scene's LiDAR pose: poses.txt (camera or IMU frame, on the camera clock) interpolated at
+// t_lidar - time_offset_cam_lidar_s, times T_cam_lidar or T_imu_lidar.
+LidarPoseAt scene_lidar_pose(const io::Scene& scene);
+
+// The map from scans given one at a time (sensor frame; an extra field "time" holds each point's seconds
+// after the scan's stamp). Output: world positions, mean intensity where every scan has one, unit normals
+// where planar (zero elsewhere), and the extra field "planarity" = 1 - smallest/middle eigenvalue of the
+// neighbourhood (0 where no fit). Points sorted by voxel: same input, same map.
+io::PointCloud build_lidar_map(const std::vector<double>& scan_times_s,
+                               const std::function<io::PointCloud(size_t)>& scan,
+                               const LidarPoseAt& T_world_lidar, const LidarMapOptions& options,
+                               LidarMapReport& report);
+
+// Reads the scene's scans and trajectory, builds the map and writes it: to `out` when given (scene.yaml
+// untouched), else to lidar/map.pcd with scene.yaml's lidar_map set to true. An existing lidar/map.pcd is
+// kept unless `replace`. std::invalid_argument naming the problem (no scans, no scan within the trajectory,
+// a map already there); io::IoError on file errors.
+LidarMapReport write_scene_lidar_map(const std::filesystem::path& scene_dir, const LidarMapOptions& options,
+                                     const std::filesystem::path& out = {}, bool replace = false);
+
+// The process's peak resident set size in MB (Linux /proc/self/status VmHWM; 0 where unknown).
+double peak_rss_mb();
+
+}  // namespace litgs::host

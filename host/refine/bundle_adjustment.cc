@@ -1,0 +1,206 @@
+#include "host/refine/bundle_adjustment.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace litgs::host::refine {
+namespace {
+
+// Pixel residual of a world point seen by a camera with T_world_cam = (q, p).
+struct Reprojection {
+  Eigen::Vector2d uv;
+  PinholeCamera c;
+  template <class T>
+  bool operator()(const T* q_, const T* p_, const T* X_, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(q_);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_), X(X_);
+    const Eigen::Matrix<T, 3, 1> x = q.conjugate() * (X - p);
+    // A point behind the camera gives a large finite residual, not a division by ~0.
+    const T z = x.z() > T(1e-3) ? x.z() : T(1e-3);
+    r[0] = T(c.fx) * x.x() / z + T(c.cx) - T(uv.x());
+    r[1] = T(c.fy) * x.y() / z + T(c.cy) - T(uv.y());
+    return true;
+  }
+};
+
+struct PointToPlane {
+  PlaneRef plane;
+  double inv_sigma;
+  template <class T>
+  bool operator()(const T* X_, T* r) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> X(X_);
+    r[0] = T(inv_sigma) * plane.n.cast<T>().dot(X - plane.l.cast<T>());
+    return true;
+  }
+};
+
+// Relative motion T_i^-1 T_j against the measured one, whitened; rotation as 2 * vec(dq) (radians, small).
+struct RelativePose {
+  Eigen::Quaterniond dq;
+  Eigen::Vector3d dp;
+  double inv_sigma_t, inv_sigma_r;
+  template <class T>
+  bool operator()(const T* qi_, const T* pi_, const T* qj_, const T* pj_, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> qi(qi_), qj(qj_);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pi(pi_), pj(pj_);
+    const Eigen::Matrix<T, 3, 1> t = qi.conjugate() * (pj - pi);
+    const Eigen::Quaternion<T> e = dq.cast<T>().conjugate() * (qi.conjugate() * qj);
+    for (int k = 0; k < 3; ++k) r[k] = T(inv_sigma_t) * (t[k] - T(dp[k]));
+    for (int k = 0; k < 3; ++k) r[3 + k] = T(2 * inv_sigma_r) * e.vec()[k] * (e.w() < T(0) ? T(-1) : T(1));
+    return true;
+  }
+};
+
+struct AbsolutePose {
+  Eigen::Quaterniond q0;
+  Eigen::Vector3d p0;
+  double inv_sigma_t, inv_sigma_r;
+  template <class T>
+  bool operator()(const T* q_, const T* p_, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(q_);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_);
+    const Eigen::Quaternion<T> e = q0.cast<T>().conjugate() * q;
+    for (int k = 0; k < 3; ++k) r[k] = T(inv_sigma_t) * (p[k] - T(p0[k]));
+    for (int k = 0; k < 3; ++k) r[3 + k] = T(2 * inv_sigma_r) * e.vec()[k] * (e.w() < T(0) ? T(-1) : T(1));
+    return true;
+  }
+};
+
+struct AnchorPrior {
+  Eigen::Vector3d a;
+  Eigen::Matrix3d sqrt_info;
+  template <class T>
+  bool operator()(const T* X_, T* r) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> X(X_);
+    const Eigen::Matrix<T, 3, 1> e = sqrt_info.cast<T>() * (X - a.cast<T>());
+    for (int k = 0; k < 3; ++k) r[k] = e[k];
+    return true;
+  }
+};
+
+}  // namespace
+
+double reprojection_error_px(const CameraPose& pose, const PinholeCamera& c, const Eigen::Vector3d& X,
+                             const Eigen::Vector2d& uv) {
+  const Eigen::Vector3d x = pose.q.conjugate() * (X - pose.p);
+  if (!(x.z() > 1e-3)) return std::numeric_limits<double>::infinity();
+  return (Eigen::Vector2d(c.fx * x.x() / x.z() + c.cx, c.fy * x.y() / x.z() + c.cy) - uv).norm();
+}
+
+BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<CameraPose>& poses = *b.poses;
+  const std::vector<CameraPose>& priors = *b.priors;
+  const size_t n = poses.size();
+  auto variable = [&](size_t f) { return b.variable.empty() || b.variable[f]; };
+  BaSolveSummary s;
+  ceres::Problem::Options po;
+  po.manifold_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  std::vector<bool> in_problem(n, false);
+  auto add_pose = [&](size_t f) {
+    if (in_problem[f]) return;
+    in_problem[f] = true;
+    problem.AddParameterBlock(poses[f].q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
+    problem.AddParameterBlock(poses[f].p.data(), 3);
+    if (!variable(f)) {
+      problem.SetParameterBlockConstant(poses[f].q.coeffs().data());
+      problem.SetParameterBlockConstant(poses[f].p.data());
+    } else {
+      ++s.variable_frames;
+    }
+  };
+  const BaWeights& w = b.weights;
+  for (auto& p : *b.points) {
+    if (!p.active || p.active_observations() < 2) continue;
+    bool sees_variable = false;
+    for (const auto& ob : p.obs) sees_variable |= ob.active && variable(ob.frame);
+    if (!sees_variable) continue;
+    ++s.points;
+    double weight_sum = 0;
+    size_t count = 0;
+    for (const auto& ob : p.obs) {
+      if (!ob.active) continue;
+      add_pose(ob.frame);
+      auto* cost =
+          new ceres::AutoDiffCostFunction<Reprojection, 2, 4, 3, 3>(new Reprojection{ob.uv, b.camera});
+      problem.AddResidualBlock(
+          cost,
+          new ceres::ScaledLoss(new ceres::CauchyLoss(w.pixel_loss_px), ob.weight, ceres::TAKE_OWNERSHIP),
+          poses[ob.frame].q.coeffs().data(), poses[ob.frame].p.data(), p.X.data());
+      ++s.reprojection_residuals;
+      weight_sum += ob.weight;
+      ++count;
+    }
+    if (b.use_planes && p.has_plane) {
+      auto* cost =
+          new ceres::AutoDiffCostFunction<PointToPlane, 1, 3>(new PointToPlane{p.plane, 1 / w.plane_sigma_m});
+      problem.AddResidualBlock(
+          cost,
+          new ceres::ScaledLoss(new ceres::HuberLoss(1.0), weight_sum / static_cast<double>(count),
+                                ceres::TAKE_OWNERSHIP),
+          p.X.data());
+      ++s.plane_residuals;
+    }
+    if (b.use_anchor_priors && b.anchors && p.anchor >= 0) {
+      const size_t a = static_cast<size_t>(p.anchor);
+      auto* cost = new ceres::AutoDiffCostFunction<AnchorPrior, 3, 3>(
+          new AnchorPrior{(*b.anchors)[a].p, b.anchor_sqrt_information[a]});
+      problem.AddResidualBlock(cost, new ceres::HuberLoss(w.anchor_loss), p.X.data());
+      ++s.anchor_residuals;
+    }
+  }
+  // Odometry priors between consecutive frames with at least one variable.
+  for (size_t f = 0; f + 1 < n; ++f) {
+    if (!variable(f) && !variable(f + 1)) continue;
+    add_pose(f);
+    add_pose(f + 1);
+    const Eigen::Quaterniond dq = priors[f].q.conjugate() * priors[f + 1].q;
+    const Eigen::Vector3d dp = priors[f].q.conjugate() * (priors[f + 1].p - priors[f].p);
+    const double dist = dp.norm();
+    auto* cost = new ceres::AutoDiffCostFunction<RelativePose, 6, 4, 3, 4, 3>(
+        new RelativePose{dq, dp, 1 / (w.rel_sigma_t_m + w.rel_sigma_t_per_m * dist),
+                         1 / (w.rel_sigma_r_rad + w.rel_sigma_r_per_m * dist)});
+    problem.AddResidualBlock(cost, nullptr, poses[f].q.coeffs().data(), poses[f].p.data(),
+                             poses[f + 1].q.coeffs().data(), poses[f + 1].p.data());
+    ++s.prior_residuals;
+  }
+  if (n > 0 && variable(0)) {
+    add_pose(0);
+    auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(
+        new AbsolutePose{priors[0].q, priors[0].p, 1 / w.gauge_sigma_t_m, 1 / w.gauge_sigma_r_rad});
+    problem.AddResidualBlock(cost, nullptr, poses[0].q.coeffs().data(), poses[0].p.data());
+    ++s.prior_residuals;
+  }
+  if (problem.NumResidualBlocks() == 0) {
+    s.termination = "EMPTY";
+    s.usable = true;
+    return s;
+  }
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ||
+                                  ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE)
+                              ? ceres::SPARSE_SCHUR
+                              : ceres::DENSE_SCHUR;
+  so.max_num_iterations = b.max_iterations;
+  so.num_threads = std::max(1, b.threads);
+  so.minimizer_progress_to_stdout = false;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+  s.initial_cost = summary.initial_cost;
+  s.final_cost = summary.final_cost;
+  s.iterations = static_cast<int>(summary.iterations.size());
+  s.usable = summary.IsSolutionUsable();
+  s.termination = ceres::TerminationTypeToString(summary.termination_type);
+  s.brief = summary.BriefReport();
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (auto& pose : poses) pose.q.normalize();
+  return s;
+}
+
+}  // namespace litgs::host::refine

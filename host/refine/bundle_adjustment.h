@@ -1,0 +1,64 @@
+// One Ceres solve of the LiDAR-plane-constrained bundle adjustment (docs/refinement.md). Variables: the
+// camera poses (unit quaternion on Ceres' quaternion manifold, position) of the frames marked variable,
+// and the points seen by them. Residuals, each with a robust loss:
+// - reprojection, in pixels (Cauchy, scale pixel_loss_px), scaled by the observation's weight;
+// - the signed point-to-plane distance n . (X - l) / plane_sigma_m of a point associated with a LiDAR
+//   plane (Huber at 1 sigma; a signed residual, differentiable at zero), scaled by the point's weight;
+// - relative-pose priors between consecutive frames from the odometry (the priors' relative motion; sigma
+//   grows with the distance travelled), which keep metric scale, and a weak prior on the first frame's
+//   pose (gauge sigmas), which holds the gauge when neither planes nor anchors do;
+// - anchor position priors L^-1 (X - a) with the anchor's (guarded) covariance Sigma = L L^T.
+// Ceres stays inside bundle_adjustment.cc.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "host/refine/ba_types.h"
+
+namespace litgs::host::refine {
+
+struct BaWeights {
+  double pixel_loss_px = 2;          // Cauchy scale of the reprojection residual
+  double plane_sigma_m = 0.02;       // point-to-plane: residual = distance / sigma
+  double anchor_loss = 3;            // Huber scale of the whitened anchor residual
+  double rel_sigma_t_m = 0.01;       // relative-pose prior: translation sigma ...
+  double rel_sigma_t_per_m = 0.02;   // ... plus this per metre travelled between the frames
+  double rel_sigma_r_rad = 0.003;    // rotation sigma ...
+  double rel_sigma_r_per_m = 0.002;  // ... plus this per metre travelled
+  double gauge_sigma_t_m = 1.0;      // the first frame's pose prior: weak, planes and anchors override it
+  double gauge_sigma_r_rad = 0.1;
+};
+
+struct BaProblem {
+  PinholeCamera camera;
+  std::vector<CameraPose>* poses = nullptr;              // refined in place
+  const std::vector<CameraPose>* priors = nullptr;       // the odometry's poses, same frames
+  std::vector<TrackPoint>* points = nullptr;             // refined in place
+  const std::vector<AnchorPoint>* anchors = nullptr;     // null: no anchor priors
+  std::vector<Eigen::Matrix3d> anchor_sqrt_information;  // L^-1 per anchor (when anchors)
+  std::vector<bool> variable;                            // per frame; empty: all
+  bool use_planes = true, use_anchor_priors = true;
+  BaWeights weights;
+  int threads = 1;
+  int max_iterations = 50;
+};
+
+struct BaSolveSummary {
+  double initial_cost = 0, final_cost = 0;
+  int iterations = 0;
+  size_t reprojection_residuals = 0, plane_residuals = 0, prior_residuals = 0, anchor_residuals = 0;
+  size_t points = 0, variable_frames = 0;
+  bool usable = false;      // Ceres' verdict on the solution
+  std::string termination;  // CONVERGENCE, NO_CONVERGENCE, ...
+  std::string brief;        // Ceres' BriefReport()
+  double seconds = 0;
+};
+
+BaSolveSummary solve_bundle_adjustment(BaProblem& problem);
+
+// The reprojection error of x seen from `pose` at `uv`, pixels (infinity when behind the camera).
+double reprojection_error_px(const CameraPose& pose, const PinholeCamera& camera, const Eigen::Vector3d& x,
+                             const Eigen::Vector2d& uv);
+
+}  // namespace litgs::host::refine

@@ -1,0 +1,243 @@
+#include "host/refine/refine.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace litgs::host::refine {
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// median + k * 1.4826 * MAD, at least floor.
+double robust_bound(const std::vector<double>& v, double k, double floor) {
+  const double m = median(v);
+  std::vector<double> dev;
+  for (double x : v) dev.push_back(std::abs(x - m));
+  return std::max(floor, m + k * 1.4826 * median(dev));
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// A frame whose observations all repeat the previous frame's exactly (a camera's non-uniformity
+// correction freezes the image): its observations say nothing about its own pose.
+size_t drop_frozen_frames(std::vector<TrackPoint>& points, size_t frames) {
+  std::vector<size_t> shared(frames, 0), moved(frames, 0);
+  for (const auto& p : points)
+    for (size_t i = 1; i < p.obs.size(); ++i)
+      if (p.obs[i].frame == p.obs[i - 1].frame + 1 && p.obs[i].frame < frames) {
+        ++shared[p.obs[i].frame];
+        moved[p.obs[i].frame] += (p.obs[i].uv - p.obs[i - 1].uv).norm() > 1e-6;
+      }
+  std::vector<bool> frozen(frames, false);
+  size_t count = 0;
+  for (size_t f = 1; f < frames; ++f)
+    if (shared[f] >= 5 && moved[f] == 0) {
+      frozen[f] = true;
+      ++count;
+    }
+  for (auto& p : points)
+    for (auto& ob : p.obs)
+      if (ob.frame < frames && frozen[ob.frame]) ob.active = false;
+  return count;
+}
+
+void deactivate_weak_points(std::vector<TrackPoint>& points, size_t* dropped) {
+  for (auto& p : points)
+    if (p.active && (p.active_observations() < 2 || !p.X.allFinite())) {
+      p.active = false;
+      if (dropped) ++*dropped;
+    }
+}
+
+bool all_finite(const std::vector<CameraPose>& poses, const std::vector<TrackPoint>& points) {
+  for (const auto& c : poses)
+    if (!c.p.allFinite() || !c.q.coeffs().allFinite()) return false;
+  for (const auto& p : points)
+    if (p.active && !p.X.allFinite()) return false;
+  return true;
+}
+
+}  // namespace
+
+size_t TrackPoint::active_observations() const {
+  size_t n = 0;
+  for (const auto& o : obs) n += o.active;
+  return n;
+}
+
+void RefineOptions::check() const {
+  if (rounds < 1) throw std::invalid_argument("refine: rounds must be >= 1");
+  if (window == 1) throw std::invalid_argument("refine: window must be 0 (off) or >= 2 frames");
+  if (!(reject_k > 0)) throw std::invalid_argument("refine: reject_k must be > 0");
+  if (threads < 1) throw std::invalid_argument("refine: threads must be >= 1");
+  if (max_iterations < 1) throw std::invalid_argument("refine: max_iterations must be >= 1");
+  weights.check();
+}
+
+ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::vector<CameraPose>& poses,
+                             const PinholeCamera& camera) {
+  ResidualStats s;
+  std::vector<double> e;
+  double sum2 = 0, plane2 = 0;
+  for (const auto& p : points) {
+    if (!p.active) continue;
+    for (const auto& ob : p.obs)
+      if (ob.active) {
+        e.push_back(reprojection_error_px(poses[ob.frame], camera, p.X, ob.uv));
+        sum2 += e.back() * e.back();
+      }
+    if (p.has_plane) {
+      const double d = p.plane.n.dot(p.X - p.plane.l);
+      plane2 += d * d;
+      ++s.plane_points;
+    }
+  }
+  s.observations = e.size();
+  if (!e.empty()) {
+    s.reprojection_rms_px = std::sqrt(sum2 / static_cast<double>(e.size()));
+    s.reprojection_median_px = median(e);
+  }
+  if (s.plane_points) s.plane_rms_m = std::sqrt(plane2 / static_cast<double>(s.plane_points));
+  return s;
+}
+
+RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const RefineOptions& o) {
+  o.check();
+  const auto start = std::chrono::steady_clock::now();
+  RefineReport report;
+  const size_t n = in.priors.size();
+  if (poses.size() != n) throw std::invalid_argument("refine: poses and priors differ in count");
+  report.frames = n;
+  report.anchors = in.anchors.size();
+  for (auto& p : in.points)
+    for (auto& ob : p.obs)
+      if (ob.frame >= n)
+        throw std::invalid_argument("refine: an observation names frame " + std::to_string(ob.frame) +
+                                    " of " + std::to_string(n));
+  report.points = in.points.size();
+  for (const auto& p : in.points) report.observations += p.obs.size();
+  report.frozen_frames = drop_frozen_frames(in.points, n);
+  for (const auto& p : in.points) report.untriangulated_points += !p.active;
+  deactivate_weak_points(in.points, &report.untriangulated_points);
+
+  const bool planes = o.use_planes && in.map && in.map->planar_count() > 0;
+  const bool anchors = o.use_anchors && !in.anchors.empty();
+  if (o.use_planes && !planes) report.notes.push_back("no LiDAR planes: the plane term is off");
+  if (o.use_anchors && !anchors) report.notes.push_back("no anchors: the anchor weights and priors are off");
+  std::vector<double> anchor_w;
+  std::vector<Eigen::Matrix3d> sqrt_info;
+  if (anchors) {
+    const AnchorWeights aw = anchor_weights(in.anchors, o.weights);
+    anchor_w = aw.weights;
+    report.guarded_anchor_covariances = aw.guarded;
+    report.anchor_weight_median_raw = aw.median_raw;
+    for (const auto& a : in.anchors) {
+      const Eigen::Matrix3d c = guarded_covariance(a.cov, o.weights.min_sigma_m * o.weights.min_sigma_m);
+      sqrt_info.push_back(Eigen::Matrix3d(c.llt().matrixL()).inverse());
+    }
+  } else {
+    for (auto& p : in.points) p.anchor = -1;
+  }
+  report.alphas = motion_alphas(motion_scores(in.priors), o.weights);
+  std::unique_ptr<PlaneAssociator> associator;
+  if (planes) associator = std::make_unique<PlaneAssociator>(*in.map, in.camera);
+
+  size_t active_points = 0;
+  for (const auto& p : in.points) active_points += p.active;
+  if (active_points == 0) {
+    report.status =
+        "stopped: no point has two observations and a finite position (" +
+        std::to_string(report.untriangulated_points) +
+        " tracks could not be triangulated: no baseline, e.g. pure rotation); poses kept as the priors";
+    report.stopped_early = true;
+  }
+  for (size_t r = 0; r < o.rounds && !report.stopped_early; ++r) {
+    const auto round_start = std::chrono::steady_clock::now();
+    RoundReport rr;
+    // Both associations follow the poses as they improve.
+    if (anchors)
+      report.anchor_association = associate_anchors(in.points, in.anchors, poses, in.camera,
+                                                    planes ? in.map : nullptr, o.anchor_association, r);
+    if (associator) rr.planes = associator->associate(in.points, poses, r, o.plane_association);
+    if (r == 0) report.before = residual_stats(in.points, poses, in.camera);
+    rr.before = residual_stats(in.points, poses, in.camera);
+    assign_observation_weights(in.points, report.alphas, anchor_w, o.weights);
+    const std::vector<CameraPose> poses_backup = poses;
+    const std::vector<TrackPoint> points_backup = in.points;
+    BaProblem problem;
+    problem.camera = in.camera;
+    problem.poses = &poses;
+    problem.priors = &in.priors;
+    problem.points = &in.points;
+    problem.anchors = anchors ? &in.anchors : nullptr;
+    problem.anchor_sqrt_information = sqrt_info;
+    problem.use_planes = planes;
+    problem.use_anchor_priors = anchors;
+    problem.weights = o.ba;
+    problem.threads = o.threads;
+    problem.max_iterations = o.max_iterations;
+    if (r == 0 && o.window >= 2 && n > o.window) {
+      rr.local = true;
+      for (size_t first = 0; first < n; first += o.window / 2) {
+        problem.variable.assign(n, false);
+        for (size_t f = first; f < std::min(n, first + o.window); ++f) problem.variable[f] = true;
+        solve_bundle_adjustment(problem);
+        ++rr.local_solves;
+        if (first + o.window >= n) break;
+      }
+      problem.variable.clear();
+    }
+    rr.global = solve_bundle_adjustment(problem);
+    if (!rr.global.usable || !all_finite(poses, in.points)) {
+      poses = poses_backup;
+      in.points = points_backup;
+      report.status = "stopped in round " + std::to_string(r + 1) + ": Ceres returned " +
+                      rr.global.termination + " (" + rr.global.brief +
+                      "); the previous round's poses and points are kept";
+      report.stopped_early = true;
+    }
+    rr.after = residual_stats(in.points, poses, in.camera);
+    if (r + 1 < o.rounds && !report.stopped_early) {
+      // Rejection between rounds: observations and plane links beyond the robust bound.
+      std::vector<double> e, d;
+      for (const auto& p : in.points) {
+        if (!p.active) continue;
+        for (const auto& ob : p.obs)
+          if (ob.active) e.push_back(reprojection_error_px(poses[ob.frame], in.camera, p.X, ob.uv));
+        if (p.has_plane) d.push_back(std::abs(p.plane.n.dot(p.X - p.plane.l)));
+      }
+      rr.reject_bound_px = robust_bound(e, o.reject_k, o.reject_floor_px);
+      rr.reject_bound_m = robust_bound(d, o.reject_k, o.reject_floor_m);
+      for (auto& p : in.points) {
+        if (!p.active) continue;
+        for (auto& ob : p.obs)
+          if (ob.active &&
+              !(reprojection_error_px(poses[ob.frame], in.camera, p.X, ob.uv) <= rr.reject_bound_px)) {
+            ob.active = false;
+            ++rr.rejected_observations;
+          }
+        if (p.has_plane && !(std::abs(p.plane.n.dot(p.X - p.plane.l)) <= rr.reject_bound_m)) {
+          p.has_plane = false;
+          p.plane_rejected = true;
+          ++rr.rejected_planes;
+        }
+      }
+      deactivate_weak_points(in.points, &rr.dropped_points);
+    }
+    rr.seconds = seconds_since(round_start);
+    report.rounds.push_back(rr);
+  }
+  report.after = residual_stats(in.points, poses, in.camera);
+  report.seconds = seconds_since(start);
+  return report;
+}
+
+}  // namespace litgs::host::refine

@@ -1,0 +1,80 @@
+// The refinement: associations, weights and Ceres solves in rounds (docs/refinement.md). Round 0 runs
+// sliding windows (local) before its global solve; every round re-associates points with LiDAR planes (a
+// shrinking radius) and recomputes the weights; between rounds, residuals above median + k * 1.4826 * MAD
+// (with a floor) are rejected and counted. No Ceres or PCL here.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "host/refine/association.h"
+#include "host/refine/bundle_adjustment.h"
+#include "host/refine/weights.h"
+
+namespace litgs::host::refine {
+
+struct RefineOptions {
+  size_t rounds = 3;
+  bool use_anchors = true, use_planes = true;
+  size_t window = 20;            // frames per local window (step: half of it); 0: no local pass
+  double reject_k = 3;           // rejection bound: median + k * 1.4826 * MAD ...
+  double reject_floor_px = 1.5;  // ... but never below this (reprojection, pixels)
+  double reject_floor_m = 0.03;  // ... or this (point-to-plane, metres)
+  int threads = 1;
+  int max_iterations = 50;  // per Ceres solve
+  WeightOptions weights;
+  AnchorAssociationOptions anchor_association;
+  PlaneAssociationOptions plane_association;
+  BaWeights ba;
+  void check() const;  // std::invalid_argument naming the bad field
+};
+
+struct RefineInput {
+  PinholeCamera camera;
+  std::vector<CameraPose> priors;  // the odometry, one per frame, by time
+  std::vector<TrackPoint> points;  // observations undistorted; X the initial triangulation
+  std::vector<AnchorPoint> anchors;
+  const PlanarMap* map = nullptr;  // the LiDAR map's plane fits; null: none
+};
+
+struct ResidualStats {
+  size_t observations = 0;  // active
+  double reprojection_rms_px = 0, reprojection_median_px = 0;
+  size_t plane_points = 0;
+  double plane_rms_m = 0;
+};
+
+struct RoundReport {
+  bool local = false;  // sliding windows ran before the global solve
+  size_t local_solves = 0;
+  ResidualStats before, after;
+  PlaneAssociationReport planes;
+  size_t rejected_observations = 0, rejected_planes = 0, dropped_points = 0;  // after this round
+  double reject_bound_px = 0, reject_bound_m = 0;
+  BaSolveSummary global;
+  double seconds = 0;
+};
+
+struct RefineReport {
+  std::string status = "converged";  // or the reason it stopped early
+  bool stopped_early = false;
+  size_t frames = 0, points = 0, observations = 0, anchors = 0;
+  size_t frozen_frames = 0;          // frames whose observations repeat the previous frame's: dropped
+  size_t untriangulated_points = 0;  // inactive from the start (non-finite or fewer than 2 observations)
+  AnchorAssociationReport anchor_association;
+  size_t guarded_anchor_covariances = 0;
+  double anchor_weight_median_raw = 0;  // m^-3
+  std::vector<double> alphas;           // per frame
+  ResidualStats before, after;
+  std::vector<RoundReport> rounds;
+  double seconds = 0;
+  std::vector<std::string> notes;
+};
+
+// Refines `poses` (initialized by the caller, usually to the priors) and the points in place.
+RefineReport refine(RefineInput& input, std::vector<CameraPose>& poses, const RefineOptions& options);
+
+ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::vector<CameraPose>& poses,
+                             const PinholeCamera& camera);
+
+}  // namespace litgs::host::refine

@@ -1,0 +1,268 @@
+#include "host/refine/scene_refine.h"
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "host/refine/ate.h"
+#include "host/synth/presets.h"
+#include "io/atomic_file.h"
+#include "io/pcd.h"
+#include "io/scene.h"
+#include "io/scene_text.h"
+
+namespace litgs::host::refine {
+namespace fs = std::filesystem;
+namespace {
+
+Eigen::Matrix4d to_matrix(const CameraPose& c) {
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = c.q.toRotationMatrix();
+  T.topRightCorner<3, 1>() = c.p;
+  return T;
+}
+
+CameraPose from_matrix(double t, const Eigen::Matrix4d& T) {
+  CameraPose c;
+  c.t_s = t;
+  c.q = Eigen::Quaterniond(Eigen::Matrix3d(T.topLeftCorner<3, 3>())).normalized();
+  c.p = T.topRightCorner<3, 1>();
+  return c;
+}
+
+// T_body_cam of the scene's pose frame (identity for camera poses).
+Eigen::Matrix4d body_from_camera(const io::SceneConfig& c) {
+  if (c.poses_frame == io::PoseFrame::kCamera) return Eigen::Matrix4d::Identity();
+  return c.T_imu_lidar * c.T_cam_lidar.inverse();
+}
+
+// Camera poses at the frame times; std::invalid_argument naming the file when a frame lies outside it.
+std::vector<CameraPose> camera_poses_at(const std::vector<io::TumPose>& poses,
+                                        const std::vector<io::SceneFrame>& frames,
+                                        const io::SceneConfig& config, const std::string& what) {
+  std::vector<CameraPose> out;
+  for (const auto& f : frames) {
+    const auto T = io::tum_pose_at(poses, f.t_s, 1e-6);
+    if (!T)
+      throw std::invalid_argument(what + " has no pose at frame time " + std::to_string(f.t_s) +
+                                  " (outside the trajectory, or an unknown rotation)");
+    out.push_back(from_matrix(f.t_s, *T * body_from_camera(config)));
+  }
+  return out;
+}
+
+std::vector<io::TumPose> to_tum(const std::vector<CameraPose>& poses, const io::SceneConfig& config) {
+  const Eigen::Matrix4d T_cam_body = body_from_camera(config).inverse();
+  std::vector<io::TumPose> out;
+  for (const auto& c : poses) {
+    const CameraPose b = from_matrix(c.t_s, to_matrix(c) * T_cam_body);
+    io::TumPose p;
+    p.t_s = c.t_s;
+    p.p_world = b.p;
+    p.q_world_body = b.q;
+    out.push_back(p);
+  }
+  return out;
+}
+
+// "synthetic: litgs-engine synth --preset NAME --seed S ..." -> the preset's world.
+synth::World synthetic_world(const io::SceneConfig& config, const fs::path& dir) {
+  std::istringstream in(config.source);
+  std::string word, preset;
+  uint64_t seed = 1;
+  while (in >> word) {
+    if (word == "--preset") in >> preset;
+    if (word == "--seed") in >> seed;
+  }
+  if (config.source.rfind("synthetic:", 0) != 0 || preset.empty())
+    throw std::invalid_argument(
+        (dir / "scene.yaml").string() +
+        ": --tracks synthetic needs a scene made by litgs-engine synth (its source line names "
+        "the preset); this one says \"" +
+        config.source + "\"");
+  synth::World world = synth::make_preset(preset, seed).world;
+  world.build_index();
+  return world;
+}
+
+std::set<size_t> read_frozen(const fs::path& path) {
+  std::set<size_t> frozen;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    double t = 0;
+    size_t index = 0;
+    if (s >> t >> index) frozen.insert(index);
+  }
+  return frozen;
+}
+
+nlohmann::json stats_json(const ResidualStats& s) {
+  return {{"observations", s.observations},
+          {"reprojection_rms_px", s.reprojection_rms_px},
+          {"reprojection_median_px", s.reprojection_median_px},
+          {"plane_points", s.plane_points},
+          {"plane_rms_m", s.plane_rms_m}};
+}
+
+nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions& o) {
+  const RefineReport& r = sr.refine;
+  nlohmann::json rounds = nlohmann::json::array();
+  for (const auto& rr : r.rounds)
+    rounds.push_back({{"local_windows", rr.local_solves},
+                      {"before", stats_json(rr.before)},
+                      {"after", stats_json(rr.after)},
+                      {"planes",
+                       {{"by_depth_image", rr.planes.by_depth_image},
+                        {"by_nearest_point", rr.planes.by_nearest_point},
+                        {"unassociated", rr.planes.unassociated},
+                        {"radius_m", rr.planes.radius_m}}},
+                      {"rejected_observations", rr.rejected_observations},
+                      {"rejected_planes", rr.rejected_planes},
+                      {"dropped_points", rr.dropped_points},
+                      {"reject_bound_px", rr.reject_bound_px},
+                      {"reject_bound_m", rr.reject_bound_m},
+                      {"ceres",
+                       {{"initial_cost", rr.global.initial_cost},
+                        {"final_cost", rr.global.final_cost},
+                        {"iterations", rr.global.iterations},
+                        {"termination", rr.global.termination},
+                        {"usable", rr.global.usable},
+                        {"reprojection_residuals", rr.global.reprojection_residuals},
+                        {"plane_residuals", rr.global.plane_residuals},
+                        {"prior_residuals", rr.global.prior_residuals},
+                        {"anchor_residuals", rr.global.anchor_residuals},
+                        {"brief", rr.global.brief},
+                        {"seconds", rr.global.seconds}}},
+                      {"seconds", rr.seconds}});
+  double alpha_mean = 0;
+  for (double a : r.alphas) alpha_mean += a / static_cast<double>(std::max<size_t>(1, r.alphas.size()));
+  nlohmann::json j = {{"status", r.status},
+                      {"stopped_early", r.stopped_early},
+                      {"frames", r.frames},
+                      {"points", r.points},
+                      {"observations", r.observations},
+                      {"untriangulated_points", r.untriangulated_points},
+                      {"frozen_frames", r.frozen_frames},
+                      {"anchors", r.anchors},
+                      {"anchored_tracks", r.anchor_association.anchored_tracks},
+                      {"anchors_in_view", r.anchor_association.anchors_in_view},
+                      {"guarded_anchor_covariances", r.guarded_anchor_covariances},
+                      {"anchor_weight_median_m-3", r.anchor_weight_median_raw},
+                      {"alpha_mean", alpha_mean},
+                      {"before", stats_json(r.before)},
+                      {"after", stats_json(r.after)},
+                      {"rounds", rounds},
+                      {"seconds", r.seconds},
+                      {"notes", r.notes},
+                      {"tracks", o.tracks},
+                      {"options",
+                       {{"rounds", o.refine.rounds},
+                        {"anchors", o.refine.use_anchors},
+                        {"planes", o.refine.use_planes},
+                        {"alpha_min", o.refine.weights.alpha_min},
+                        {"alpha_max", o.refine.weights.alpha_max},
+                        {"window", o.refine.window},
+                        {"threads", o.refine.threads}}}};
+  if (sr.has_truth) {
+    j["ate_before_m"] = sr.ate_before_m;
+    j["ate_after_m"] = sr.ate_after_m;
+    j["plane_rms_true_m"] = sr.plane_rms_true_m;
+  }
+  return j;
+}
+
+}  // namespace
+
+SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o) {
+  o.refine.check();
+  io::SceneReadOptions ro;
+  ro.check_images = false;
+  const io::Scene scene = io::read_scene(dir, ro);
+  const io::CameraIntrinsics& k = scene.config.camera;
+  for (double d : k.distortion)
+    if (d != 0 && o.tracks != "synthetic")
+      throw std::invalid_argument("refine: the camera has distortion; tracks must come undistorted");
+  RefineInput in;
+  in.camera = {k.fx, k.fy, k.cx, k.cy, k.width, k.height};
+  const fs::path prior_path = dir / "poses_prior.txt";
+  const bool kept = fs::exists(prior_path);
+  const std::vector<io::TumPose> prior_tum = kept ? io::read_tum(prior_path) : scene.poses;
+  in.priors =
+      camera_poses_at(prior_tum, scene.frames, scene.config, kept ? prior_path.string() : "poses.txt");
+  for (const auto& a : scene.anchors) in.anchors.push_back({a.p_world, a.cov_m2});
+
+  SceneRefineReport report;
+  std::vector<CameraPose> truth;
+  if (scene.gt && scene.gt->poses.size() >= 3) {
+    truth = camera_poses_at(scene.gt->poses, scene.frames, scene.config, "gt/poses.txt");
+    report.has_truth = true;
+  }
+  if (o.tracks == "synthetic") {
+    if (truth.empty()) throw std::invalid_argument("refine --tracks synthetic needs gt/poses.txt");
+    const synth::World world = synthetic_world(scene.config, dir);
+    std::vector<Eigen::Vector3d> anchors_true;
+    if (fs::exists(dir / "gt/anchors.txt"))
+      for (const auto& a : io::read_anchors(dir / "gt/anchors.txt")) anchors_true.push_back(a.p_world);
+    SyntheticTrackOptions so = o.synthetic;
+    if (fs::exists(dir / "gt/frozen.txt")) so.frozen_frames = read_frozen(dir / "gt/frozen.txt");
+    in.points = synthetic_tracks(world, truth, in.priors, in.camera, anchors_true, so);
+  } else {
+    throw std::invalid_argument("refine: unknown track source '" + o.tracks + "' (synthetic)");
+  }
+  PlanarMap planar;
+  if (scene.map && o.refine.use_planes) {
+    planar = fit_planes(scene.map->positions, {});
+    in.map = &planar;
+  }
+  std::vector<CameraPose> poses = in.priors;
+  report.refine = refine(in, poses, o.refine);
+
+  if (report.has_truth) {
+    report.ate_before_m =
+        absolute_trajectory_error(to_tum(in.priors, {}), to_tum(truth, {}), AteAlignment::kSE3).rmse_m;
+    report.ate_after_m =
+        absolute_trajectory_error(to_tum(poses, {}), to_tum(truth, {}), AteAlignment::kSE3).rmse_m;
+    if (!scene.gt->planes.empty()) {
+      double sum2 = 0;
+      size_t count = 0;
+      for (const auto& p : in.points) {
+        if (!p.active || !p.has_plane) continue;
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& g : scene.gt->planes)
+          if (std::abs(g.n.dot(p.plane.n)) > 0.9) best = std::min(best, std::abs(g.n.dot(p.X) + g.d));
+        if (std::isfinite(best)) {
+          sum2 += best * best;
+          ++count;
+        }
+      }
+      if (count) report.plane_rms_true_m = std::sqrt(sum2 / static_cast<double>(count));
+    }
+  }
+  // Outputs: the input kept first, so that nothing is lost if a later write fails.
+  if (!kept) io::write_tum(prior_path, scene.poses);
+  io::PointCloud cloud;
+  io::ScalarField anchor{"anchor", {}}, on_plane{"on_plane", {}}, observations{"observations", {}};
+  for (const auto& p : in.points) {
+    if (!p.active) continue;
+    cloud.positions.push_back(p.X);
+    anchor.values.push_back(p.anchor);
+    on_plane.values.push_back(p.has_plane);
+    observations.values.push_back(static_cast<double>(p.active_observations()));
+  }
+  cloud.extra = {anchor, on_plane, observations};
+  fs::create_directories(dir / "refine");
+  io::PcdWriteOptions pw;
+  pw.double_positions = true;
+  io::write_pcd(dir / "refine/points.pcd", cloud, pw);
+  report.points_written = cloud.size();
+  io::write_tum(dir / "poses.txt", to_tum(poses, scene.config));
+  io::write_file_atomic(dir / "refine.json",
+                        [&](std::ostream& out) { out << report_json(report, o).dump(2) << "\n"; });
+  return report;
+}
+
+}  // namespace litgs::host::refine

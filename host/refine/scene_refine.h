@@ -1,0 +1,33 @@
+// `litgs-engine refine SCENE`: the refinement on a scene directory (docs/refinement.md). Reads the scene,
+// the prior poses (poses_prior.txt when a previous run kept it, else poses.txt), the LiDAR map's plane fits
+// and the anchors; gets tracks from a source; writes the refined poses.txt (keeping the input as
+// poses_prior.txt), refine/points.pcd (refined points with their anchor and plane status) and refine.json.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "host/refine/refine.h"
+#include "host/refine/synthetic_tracks.h"
+
+namespace litgs::host::refine {
+
+struct SceneRefineOptions {
+  RefineOptions refine;
+  // Where the tracks come from. "synthetic": from a synthetic scene's ground truth (synthetic_tracks.h),
+  // the stand-in until the thermal front end writes its tracks.
+  std::string tracks = "synthetic";
+  SyntheticTrackOptions synthetic;
+};
+
+struct SceneRefineReport {
+  RefineReport refine;
+  bool has_truth = false;
+  double ate_before_m = 0, ate_after_m = 0;  // SE(3)-aligned, against gt/poses.txt at the frame times
+  double plane_rms_true_m = -1;  // refined points on true planes (gt/map.pcd plane ids): RMS distance
+  size_t points_written = 0;
+};
+
+SceneRefineReport refine_scene(const std::filesystem::path& scene_dir, const SceneRefineOptions& options);
+
+}  // namespace litgs::host::refine

@@ -1,0 +1,56 @@
+// `litgs-engine refine SCENE [--no-anchors] [--no-planes] [--alpha-min A --alpha-max B] [--rounds N]
+// [--threads T]`: LiDAR-plane-constrained bundle adjustment of the scene's poses (docs/refinement.md).
+#include <CLI/CLI.hpp>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include "host/refine/scene_refine.h"
+#include "tools/commands.h"
+
+namespace litgs::tools {
+
+void add_refine_command(CLI::App& app) {
+  CLI::App* c =
+      app.add_subcommand("refine", "Refine the scene's poses: anchors, LiDAR planes, bundle adjustment");
+  auto scene = std::make_shared<std::filesystem::path>();
+  auto o = std::make_shared<host::refine::SceneRefineOptions>();
+  auto anchors = std::make_shared<bool>(true);
+  auto planes = std::make_shared<bool>(true);
+  c->add_option("scene", *scene, "Scene directory")->required()->check(CLI::ExistingDirectory);
+  c->add_flag("!--no-anchors", *anchors, "No anchor weights or anchor priors");
+  c->add_flag("!--no-planes", *planes, "No LiDAR point-to-plane term");
+  c->add_option("--alpha-min", o->refine.weights.alpha_min,
+                "Anchors' share of a frame's weight, slowest frames")
+      ->capture_default_str();
+  c->add_option("--alpha-max", o->refine.weights.alpha_max, "... and fastest frames")->capture_default_str();
+  c->add_option("--rounds", o->refine.rounds, "Rounds (association, solve, rejection)")
+      ->capture_default_str();
+  c->add_option("--threads", o->refine.threads, "Ceres threads")->capture_default_str();
+  c->add_option("--window", o->refine.window, "Frames per local window in round 1 (0: none)")
+      ->capture_default_str();
+  c->add_option(
+       "--tracks", o->tracks,
+       "Track source: synthetic (from a synth scene's ground truth, until the front end writes tracks)")
+      ->capture_default_str();
+  c->add_option("--outliers", o->synthetic.outlier_fraction, "Synthetic tracks: fraction of wrong matches")
+      ->capture_default_str();
+  c->add_option("--pixel-noise", o->synthetic.pixel_noise_px, "Synthetic tracks: pixel noise (px)")
+      ->capture_default_str();
+  c->callback([scene, o, anchors, planes] {
+    o->refine.use_anchors = *anchors;
+    o->refine.use_planes = *planes;
+    const host::refine::SceneRefineReport r = host::refine::refine_scene(*scene, *o);
+    const auto& rr = r.refine;
+    std::cout << std::fixed << std::setprecision(3) << "refine: " << rr.status << "; " << rr.frames
+              << " frames, " << r.points_written << " points (" << rr.anchor_association.anchored_tracks
+              << " anchored), " << rr.rounds.size() << " rounds in " << rr.seconds << " s; reprojection RMS "
+              << rr.before.reprojection_rms_px << " -> " << rr.after.reprojection_rms_px << " px, plane RMS "
+              << rr.before.plane_rms_m << " -> " << rr.after.plane_rms_m << " m";
+    if (r.has_truth) std::cout << "; ATE " << r.ate_before_m << " -> " << r.ate_after_m << " m";
+    std::cout << "\n";
+    for (const auto& note : rr.notes) std::cout << "  note: " << note << "\n";
+  });
+}
+
+}  // namespace litgs::tools
