@@ -17,5 +17,8 @@ void add_export_command(CLI::App& app);  // export colmap | tum
 void add_render_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_train_command(CLI::App& app);
+void add_eval_command(CLI::App& app);
+void add_run_command(CLI::App& app);  // and its report: tools/cmd_run.cc
+void add_report_command(CLI::App& app);
 
 }  // namespace litgs::tools
