@@ -46,9 +46,10 @@ void add_run_command(CLI::App& app) {
   auto o = std::make_shared<RunCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "run", "Import, train, evaluate and report in one resumable pipeline (DIR/<stage>/, DIR/run.json)");
-  cmd->add_option("input", o->input,
-                  "Scene directory, ROS bag (.bag, with --calib), FAST-LIVO2 Log folder, Metashape XML, COLMAP "
-                  "model folder, or synth:PRESET");
+  cmd->add_option(
+      "input", o->input,
+      "Scene directory, ROS bag (.bag, with --calib), FAST-LIVO2 Log folder, Metashape XML, COLMAP "
+      "model folder, or synth:PRESET");
   cmd->add_option("--out", o->out, "Run folder: DIR/<stage>/, DIR/run.json, DIR/report.html");
   cmd->add_option("--from", o->from, "Run this stage and those after it again, even if up to date");
   cmd->add_option("--until", o->until, "Stop after this stage");
@@ -67,11 +68,14 @@ void add_report_command(CLI::App& app) {
   };
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("report", "Write the self-contained HTML report of a run folder");
-  cmd->add_option("--run", o->run, "Run folder (train/ and eval/ done)")->required()->check(CLI::ExistingDirectory);
+  cmd->add_option("--run", o->run, "Run folder (train/ and eval/ done)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   cmd->add_option("--out", o->out, "HTML file (default: RUN/report.html)");
   cmd->add_option("--max-views", o->max_views, "Held-out views shown as pictures")->capture_default_str();
   cmd->callback([o] {
-    const std::filesystem::path out = o->out.empty() ? std::filesystem::path(o->run) / "report.html" : std::filesystem::path(o->out);
+    const std::filesystem::path out =
+        o->out.empty() ? std::filesystem::path(o->run) / "report.html" : std::filesystem::path(o->out);
     const std::string html = host::run::report_html(o->run, o->max_views);
     io::write_file_atomic(out, [&](std::ostream& s) { s << html; });
     std::cout << "report: " << out.string() << " (" << html.size() / 1024 << " KiB)\n";

@@ -96,7 +96,7 @@ class Runner {
         continue;
       }
       try {
-        run_stage(stage, i >= from, tag, entry);
+        run_stage(stage, !o_.from.empty() && i >= from, tag, entry);
       } catch (const StageFailed&) {
         finish(start, "failed");
         throw;
@@ -168,7 +168,7 @@ class Runner {
     std::vector<std::string> command = plan.command;
     if (resume) command.insert(command.end(), plan.resume_args.begin(), plan.resume_args.end());
     out_ << tag << ": " << stage.what << (resume ? " (resuming from its checkpoint)" : "")
-         << (forced && !o_.from.empty() ? " (forced by --from)" : "") << "\n"
+         << (forced ? " (forced by --from)" : "") << "\n"
          << std::flush;
     ChildResult child;
     if (!command.empty()) {

@@ -90,16 +90,22 @@ RunConfig read_run_config(const std::filesystem::path& path) {
     sections.insert(section);
     known.insert(std::string(section) + "." + key);
   });
+  std::set<std::string> seen_sections;
   for (const auto& s : root) {
     const std::string section = s.first.as<std::string>();
     const int line = s.first.Mark().line + 1;
+    if (!seen_sections.insert(section).second)
+      throw io::IoError(path, line, "section '" + section + "' given twice");
     if (!sections.count(section))
       throw io::IoError(path, line,
                         "unknown section '" + section + "' (sections: import, train, eval, report)");
     if (s.second.IsNull()) continue;
     if (!s.second.IsMap()) throw io::IoError(path, line, "section '" + section + "' must hold keys");
+    std::set<std::string> seen;
     for (const auto& k : s.second) {
       const std::string key = k.first.as<std::string>();
+      if (!seen.insert(key).second)
+        throw io::IoError(path, k.first.Mark().line + 1, "key '" + section + "." + key + "' given twice");
       if (!known.count(section + "." + key))
         throw io::IoError(path, k.first.Mark().line + 1,
                           "unknown key '" + section + "." + key + "' (run --print-config lists every key)");

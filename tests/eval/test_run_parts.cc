@@ -75,6 +75,8 @@ TEST_F(RunParts, UnknownKeysAndBadValuesAreErrorsNamingThem) {
   EXPECT_NE(e.find("eval.geometry: expected true or false"), std::string::npos) << e;
   e = error_of(write("e.yaml", "train: [1, 2\n"));
   EXPECT_NE(e.find("YAML error"), std::string::npos) << e;
+  e = error_of(write("g.yaml", "train:\n  iterations: 5\n  iterations: 7\n"));
+  EXPECT_NE(e.find("'train.iterations' given twice"), std::string::npos) << e;
   e = error_of(write("f.yaml", "train:\n  extra_args: --resume\n"));
   EXPECT_NE(e.find("expected a list"), std::string::npos) << e;
 }

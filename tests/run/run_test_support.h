@@ -11,10 +11,13 @@
 
 namespace litgs::testing {
 
-// The tests' run.yaml: a 16-frame 64x48 facade, 40 iterations from 3,000 random Gaussians, small EMD draws.
-inline std::string small_run_yaml(const std::string& train_extra = "") {
+// The tests' run.yaml: a 16-frame 64x48 facade, `iterations` from 3,000 random Gaussians, small EMD draws;
+// `train_extra`: more lines of the train section.
+inline std::string small_run_yaml(const std::string& train_extra = "", int iterations = 40) {
   return "import:\n  synth_frames: 16\n  synth_width: 64\n  synth_height: 48\n"
-         "train:\n  iterations: 40\n  init: random\n  max_gaussians: 3000\n  eval_every: 20\n"
+         "train:\n  iterations: " +
+         std::to_string(iterations) +
+         "\n  init: random\n  max_gaussians: 3000\n  eval_every: 20\n"
          "  checkpoint_every: 20\n  progress_every: 10\n  holdout_every: 4\n"
          "  extra_args: [\"--random-count\", \"3000\"]\n" +
          train_extra + "eval:\n  emd_samples: 200\n  emd_rounds: 2\n";
