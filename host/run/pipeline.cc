@@ -1,10 +1,12 @@
 #include "host/run/pipeline.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <fstream>
 #include <map>
+#include <sstream>
 
 #include "host/run/child_process.h"
 #include "host/run/content_hash.h"
@@ -208,12 +210,15 @@ class Runner {
     out_ << tag << line;
   }
 
+  // The child's last line that says something: CLI11's "Run with --help" hint is skipped.
   static std::string last_line(const std::string& text) {
-    size_t end = text.find_last_not_of("\n\r ");
-    if (end == std::string::npos) return "";
-    const size_t begin = text.find_last_of("\n\r", end);
-    return text.substr(begin == std::string::npos ? 0 : begin + 1,
-                       end - (begin == std::string::npos ? 0 : begin + 1) + 1);
+    std::istringstream in(text);
+    std::string line, last;
+    while (std::getline(in, line)) {
+      while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+      if (!line.empty() && line.rfind("Run with --help", 0) != 0) last = line;
+    }
+    return last;
   }
 
   void finish(std::chrono::steady_clock::time_point start, const std::string& status) {
@@ -230,17 +235,26 @@ class Runner {
       std::snprintf(line, sizeof line, "  %-8s %-24s", s["name"].get<std::string>().c_str(),
                     s["status"].get<std::string>().c_str());
       out_ << line;
-      if (s.contains("seconds"))
-        out_ << " " << std::to_string(s["seconds"].get<double>()).substr(0, 7) << " s, peak "
-             << megabytes(s.value("peak_host_bytes", uint64_t{0}));
+      if (s.contains("seconds")) {
+        std::snprintf(line, sizeof line, " %8.1f s, peak host memory %s", s["seconds"].get<double>(),
+                      megabytes(s.value("peak_host_bytes", uint64_t{0})).c_str());
+        out_ << line;
+      }
       out_ << "\n";
     }
     const json& results = ctx_.results;
     if (results.contains("eval")) {
       const json& m = results["eval"]["metrics"];
-      out_ << "run: held-out PSNR " << m["psnr_db"] << " dB, SSIM " << m["ssim"];
-      if (m.contains("emd_m")) out_ << ", EMD " << m["emd_m"] << " m (floor " << m["emd_floor_m"] << " m)";
-      out_ << ", render " << m["render_ms_per_frame"] << " ms/frame\n";
+      const auto value = [&](const char* key) {
+        return m.value(key, json()).is_number() ? m[key].get<double>() : NAN;
+      };
+      char line[256];
+      std::snprintf(line, sizeof line,
+                    "run: held-out PSNR %.2f dB, SSIM %.4f, EMD %.4f m (sampling floor %.4f m), "
+                    "render %.1f ms/frame, %.0f Gaussians\n",
+                    value("psnr_db"), value("ssim"), value("emd_m"), value("emd_floor_m"),
+                    value("render_ms_per_frame"), value("gaussians"));
+      out_ << line;
     }
     if (results.contains("report"))
       out_ << "run: report: " << results["report"]["report"].get<std::string>() << "\n";

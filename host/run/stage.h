@@ -45,6 +45,9 @@ struct Stage {
   std::function<nlohmann::json(const StageContext&)> result;
 };
 
+// A number as a command-line argument, without losing digits (std::to_string keeps 6 decimals).
+std::string number_arg(double value);
+
 // The stages in the order they run (stage_table.cc).
 const std::vector<Stage>& stage_table();
 

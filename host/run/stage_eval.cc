@@ -29,7 +29,7 @@ StagePlan plan(const StageContext& c) {
                "--views-out",
                (dir / "views").string(),
                "--downscale",
-               std::to_string(t.downscale),
+               number_arg(t.downscale),
                "--holdout-every",
                std::to_string(t.holdout_every),
                "--intensity",

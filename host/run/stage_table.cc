@@ -1,6 +1,14 @@
+#include <cstdio>
+
 #include "host/run/stage.h"
 
 namespace litgs::host::run {
+
+std::string number_arg(double value) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", value);
+  return buf;
+}
 
 const std::vector<Stage>& stage_table() {
   static const std::vector<Stage> table = {

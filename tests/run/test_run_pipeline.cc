@@ -84,7 +84,10 @@ TEST(RunBadInput, FailingStageStopsNamesItAndKeepsEarlierOutputs) {
   const CommandResult r = run_engine(run_args("synth:facade", dir, config));
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("stage 'train' failed"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("bogus"), std::string::npos) << r.output;  // why: the child's own message
+  // Why: the child's own message, in the output and in run.json.
+  EXPECT_NE(r.output.find("stage 'train' failed: exit status 105: --strategy: bogus not in {adc,mcmc}"),
+            std::string::npos)
+      << r.output;
   EXPECT_TRUE(fs::exists(dir / "import" / "manifest.json"));
   EXPECT_TRUE(fs::exists(dir / "import" / "scene" / "scene.yaml"));
   EXPECT_FALSE(fs::exists(dir / "train" / "manifest.json"));
@@ -162,6 +165,30 @@ TEST(RunBadInput, InterruptedStageIsNotTakenAsDone) {
   EXPECT_EQ(stage_status(dir, "train"), "up to date");
   EXPECT_EQ(stage_status(dir, "eval"), "done");
   EXPECT_TRUE(read_json_file(eval_json).is_object());
+}
+
+}  // namespace
+}  // namespace litgs::testing
+
+namespace litgs::testing {
+namespace {
+
+// eval on its own, on the end-to-end test's run folder (its fixture).
+TEST(RunEval, JsonStatesLpipsAndRefusesASceneWithoutHeldOutViews) {
+  const fs::path dir = kRoot / "e2e";
+  ASSERT_TRUE(fs::exists(dir / "train" / "point_cloud.ply")) << "RunPipeline.SyntheticEndToEnd* makes it";
+  const std::string model = (dir / "train" / "point_cloud.ply").string(),
+                    scene = (dir / "import" / "scene").string();
+  CommandResult r = run_engine("eval --model " + model + " --scene " + scene +
+                               " --holdout-every 4 --emd-samples 50 --json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+  EXPECT_NE(j["lpips"].get<std::string>().find("not available"), std::string::npos);
+  EXPECT_EQ(j["emd"]["samples"], 50);
+  EXPECT_LE(j["emd"]["mean_m"].get<double>(), 1e3);
+  r = run_engine("eval --model " + model + " --scene " + scene + " --holdout-every 0");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("no held-out views to evaluate"), std::string::npos) << r.output;
 }
 
 }  // namespace
