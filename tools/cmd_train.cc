@@ -3,10 +3,14 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "engine/context.h"
@@ -14,8 +18,10 @@
 #include "host/train/lidar_planes.h"
 #include "host/train/trainer.h"
 #include "host/train/training_data.h"
+#include "host/train/true_planes.h"
 #include "io/scene.h"
 #include "tools/commands.h"
+#include "tools/data_flags.h"
 
 namespace litgs::tools {
 namespace {
@@ -28,8 +34,8 @@ struct TrainCliOptions {
   // LiDAR-map initialization: a point on a LiDAR plane becomes a disc this thin relative to its radius
   // (host::surfel_covariances); 1: spheres, as 3DGS.
   double init_flatness = 0.1;
-  std::string intensity = "auto";   // auto | percentile | linear
-  std::string poses = "estimated";  // estimated (poses.txt) | truth (gt/poses.txt)
+  DataFlags data_flags;  // --intensity, --poses
+  std::string trace;     // JSON lines appended at every progress report (the report's curves)
   host::TrainingDataOptions data;
   host::TrainOptions train;
 };
@@ -62,15 +68,7 @@ std::string format_eta(double s) {
 }
 
 void run_train(TrainCliOptions o) {
-  if (o.intensity == "percentile")
-    o.data.mapping = host::IntensityMapping::kPercentile;
-  else if (o.intensity == "linear")
-    o.data.mapping = host::IntensityMapping::kLinear;
-  else if (o.intensity != "auto")
-    throw std::invalid_argument("--intensity must be auto, percentile or linear, not '" + o.intensity + "'");
-  if (o.poses != "estimated" && o.poses != "truth")
-    throw std::invalid_argument("--poses must be estimated or truth, not '" + o.poses + "'");
-  o.data.true_poses = o.poses == "truth";
+  apply_data_flags(o.data_flags, o.data);
   o.train.check();
   const host::TrainingData data = host::load_training_data(o.scene, o.data);
 
@@ -89,28 +87,8 @@ void run_train(TrainCliOptions o) {
     o.train.lambda_geo = 0;
   }
 
-  // Ground truth planes (synthetic scenes): the true map's points with their plane's normal; points on no
-  // plane (poles) take part as occluders only. Each point stands for a disc of the map's spacing, so that
-  // the truth, too, is the surface a pixel sees rather than a point behind it.
-  std::unique_ptr<host::PlanarMap> gt_planes;
-  if (scene.gt && scene.gt->map && !scene.gt->planes.empty()) {
-    const io::PointCloud& m = *scene.gt->map;
-    const io::ScalarField* id = m.field("plane_id");
-    if (id) {
-      gt_planes = std::make_unique<host::PlanarMap>();
-      for (size_t i = 0; i < m.size(); ++i) {
-        const double pid = id->values[i];
-        const bool on_plane = pid >= 0 && pid < static_cast<double>(scene.gt->planes.size());
-        gt_planes->points.push_back(m.positions[i].cast<float>());
-        gt_planes->centres.push_back(m.positions[i].cast<float>());  // a true point lies on its plane
-        gt_planes->normals.push_back(
-            on_plane ? Eigen::Vector3f(scene.gt->planes[static_cast<size_t>(pid)].n.cast<float>())
-                     : Eigen::Vector3f(Eigen::Vector3f::Zero()));
-        gt_planes->planar.push_back(on_plane ? 1 : 0);
-      }
-      host::assign_surfel_radii(*gt_planes);
-    }
-  }
+  // Ground truth planes (synthetic scenes): evaluation's depth residual.
+  const std::unique_ptr<host::PlanarMap> gt_planes = host::true_planar_map(scene);
 
   host::InitOptions init;
   init.sh_degree = o.train.sh_degree;
@@ -169,10 +147,36 @@ void run_train(TrainCliOptions o) {
                   p.gaussians, p.iterations_per_s, format_eta(eta).c_str());
     std::cout << (tty ? "\r" : "") << line << anomaly_text(p.counters) << (tty ? "" : "\n") << std::flush;
   };
+  // --trace: one JSON object per progress report, appended and flushed, so that what an interrupted run
+  // reported survives it. session_s counts from this call's start (a resume starts a new session).
+  std::ofstream trace;
+  if (!o.trace.empty()) {
+    const std::filesystem::path parent = std::filesystem::path(o.trace).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+    trace.open(o.trace, std::ios::app);
+    if (!trace) throw std::runtime_error(o.trace + ": cannot open the trace file for appending");
+  }
+  const auto session_start = std::chrono::steady_clock::now();
+  auto report = [&](const host::TrainProgress& p) {
+    progress(p);
+    if (!trace.is_open()) return;
+    const double session_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - session_start).count();
+    const auto number = [](double v) {
+      return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+    };
+    trace << nlohmann::json{{"iteration", p.iteration},     {"session_s", session_s},
+                            {"loss", number(p.loss)},       {"photometric_loss", number(p.photometric_loss)},
+                            {"psnr_db", number(p.psnr_db)}, {"geometric_rms_m", number(p.geometric_rms_m)},
+                            {"gaussians", p.gaussians}}
+                 .dump()
+          << "\n"
+          << std::flush;
+  };
   // Resume notes and warnings on their own line, not inside a progress line being redrawn.
   auto notice = [&](const std::string& line) { std::cerr << "train: " << line << "\n"; };
   const host::TrainReport r =
-      host::train(context, data, model, planes.get(), o.train, o.out, progress, gt_planes.get(), notice);
+      host::train(context, data, model, planes.get(), o.train, o.out, report, gt_planes.get(), notice);
   if (tty) std::cout << "\n";
   std::cout << "train: " << r.iterations << " iterations in " << r.wall_s << " s (" << r.ms_per_iteration
             << " ms/iteration), " << r.gaussians << " Gaussians; held-out PSNR " << r.final_eval.psnr_db
@@ -198,8 +202,7 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--out", o->out, "Output directory (point_cloud.ply, metrics.json, checkpoints/)")
       ->required();
   cmd->add_option("--iterations", o->train.iterations, "Training iterations")->capture_default_str();
-  cmd->add_option("--downscale", o->data.downscale, "Divide image size and intrinsics by this")
-      ->capture_default_str();
+  add_data_flags(cmd, o->data, o->data_flags);
   cmd->add_option("--lambda-geo", o->train.lambda_geo, "Weight of the LiDAR point-to-plane loss")
       ->capture_default_str();
   cmd->add_option("--geo-robust-scale", o->train.geo_robust_scale_m,
@@ -240,14 +243,9 @@ void add_train_command(CLI::App& app) {
   cmd->add_flag("--deterministic", o->train.deterministic, "Bit-identical gradients (slower)");
   cmd->add_option("--sh-degree", o->train.sh_degree, "Final SH degree")->capture_default_str();
   cmd->add_option("--seed", o->train.seed, "Seed of view order and densification")->capture_default_str();
-  cmd->add_option("--holdout-every", o->data.holdout_every, "Hold out every Nth frame (0: none)")
-      ->capture_default_str();
-  cmd->add_option("--intensity", o->intensity, "auto | percentile | linear")->capture_default_str();
   cmd->add_option("--plane-prune-k", o->train.plane_prune_k,
                   "Prune Gaussians beyond median + k * 1.4826 * MAD of their LiDAR-plane distances (at least "
                   "10 cm; 0: off)")
-      ->capture_default_str();
-  cmd->add_option("--poses", o->poses, "estimated (poses.txt) or truth (gt/poses.txt of synthetic scenes)")
       ->capture_default_str();
   cmd->add_option("--densify-from", o->train.densify_from, "First densification iteration")
       ->capture_default_str();
@@ -260,6 +258,8 @@ void add_train_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--opacity-reset-every", o->train.opacity_reset_every, "Opacity reset cadence")
       ->capture_default_str();
+  cmd->add_option("--trace", o->trace,
+                  "Append each progress report (iteration, seconds, loss, Gaussians) as a JSON line to FILE");
   cmd->add_option("--progress-every", o->train.progress_every, "Progress cadence")->capture_default_str();
   cmd->add_option("--level-model", o->train.level_model,
                   "Radiometric level per frame, learnt with the map: none, affine (gain and offset per "

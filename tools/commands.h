@@ -29,5 +29,8 @@ void add_match_command(CLI::App& app);
 void add_map_command(CLI::App& app);
 void add_refine_command(CLI::App& app);
 void print_lidar_map_report(const host::LidarMapReport& report, const std::string& where);  // cmd_map.cc
+void add_eval_command(CLI::App& app);
+void add_run_command(CLI::App& app);  // and its report: tools/cmd_run.cc
+void add_report_command(CLI::App& app);
 
 }  // namespace litgs::tools

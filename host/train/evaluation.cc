@@ -6,6 +6,27 @@
 
 namespace litgs::host {
 
+PlaneResidualSum depth_plane_residuals(const PlanarMap& truth_map, const kernels::SplatCamera& cam,
+                                       std::span<const float> depth, std::span<const float> alpha) {
+  // Point-to-plane residual of the rendered depth along each pixel's ray, where a true plane is seen and the
+  // render is opaque enough to have a depth.
+  const ViewPlaneMaps truth = project_planes(truth_map, cam);
+  PlaneResidualSum sum;
+  const uint32_t W = cam.width, H = cam.height;
+  for (uint32_t y = 0; y < H; ++y)
+    for (uint32_t x = 0; x < W; ++x) {
+      const size_t p = size_t{y} * W + x;
+      if (truth.points[4 * p + 3] != 1.0f || alpha[p] < 0.5f) continue;
+      const double rx = (x + 0.5 - cam.cx) / cam.fx, ry = (y + 0.5 - cam.cy) / cam.fy, D = depth[p];
+      const double r = truth.normals[4 * p] * (truth.points[4 * p] - D * rx) +
+                       truth.normals[4 * p + 1] * (truth.points[4 * p + 1] - D * ry) +
+                       truth.normals[4 * p + 2] * (truth.points[4 * p + 2] - D);
+      sum.sum_sq_m2 += r * r;
+      ++sum.count;
+    }
+  return sum;
+}
+
 Evaluator::Evaluator(const TrainingData& data, const TrainOptions& o, const PlanarMap* gt_planes,
                      kernels::Rasterizer& rasterizer)
     : data_(&data), options_(&o), gt_planes_(gt_planes), rasterizer_(&rasterizer) {
@@ -54,20 +75,9 @@ EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32
       e.mae_counts += counts * mean_abs_diff(img.image, target);
     }
     if (gt_planes_) {
-      // Point-to-plane residual of the rendered depth along each pixel's ray, where a true plane is seen and
-      // the render is opaque enough to have a depth.
-      const ViewPlaneMaps truth = project_planes(*gt_planes_, cam);
-      for (uint32_t y = 0; y < H; ++y)
-        for (uint32_t x = 0; x < W; ++x) {
-          const size_t p = size_t{y} * W + x;
-          if (truth.points[4 * p + 3] != 1.0f || img.alpha[p] < 0.5f) continue;
-          const double rx = (x + 0.5 - cam.cx) / cam.fx, ry = (y + 0.5 - cam.cy) / cam.fy, D = img.depth[p];
-          const double r = truth.normals[4 * p] * (truth.points[4 * p] - D * rx) +
-                           truth.normals[4 * p + 1] * (truth.points[4 * p + 1] - D * ry) +
-                           truth.normals[4 * p + 2] * (truth.points[4 * p + 2] - D);
-          plane_sq += r * r;
-          ++plane_n;
-        }
+      const PlaneResidualSum r = depth_plane_residuals(*gt_planes_, cam, img.depth, img.alpha);
+      plane_sq += r.sum_sq_m2;
+      plane_n += r.count;
     }
     if (renders) renders->push_back(img);
   }

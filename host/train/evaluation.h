@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "host/train/level_plan.h"
@@ -13,6 +14,15 @@
 #include "kernels/splat/rasterizer.h"
 
 namespace litgs::host {
+
+// The rendered depth's point-to-plane residuals against true planes in one view (camera frame), over the
+// pixels where a true plane is seen and the render's alpha is at least 0.5: their sum of squares and count.
+struct PlaneResidualSum {
+  double sum_sq_m2 = 0;
+  size_t count = 0;
+};
+PlaneResidualSum depth_plane_residuals(const PlanarMap& truth_map, const kernels::SplatCamera& camera,
+                                       std::span<const float> depth, std::span<const float> alpha);
 
 class Evaluator {
  public:

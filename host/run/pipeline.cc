@@ -1,0 +1,276 @@
+#include "host/run/pipeline.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "host/run/child_process.h"
+#include "host/run/content_hash.h"
+#include "host/run/stage.h"
+#include "io/atomic_file.h"
+
+namespace litgs::host::run {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+size_t stage_index(const std::string& name, size_t fallback) {
+  if (name.empty()) return fallback;
+  const auto& table = stage_table();
+  for (size_t i = 0; i < table.size(); ++i)
+    if (table[i].name == name) return i;
+  std::string names;
+  for (const Stage& s : table) names += (names.empty() ? "" : ", ") + s.name;
+  throw std::invalid_argument("no stage named '" + name + "' (stages: " + names + ")");
+}
+
+json read_json(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) return nullptr;
+  try {
+    return json::parse(in);
+  } catch (const json::exception&) {
+    return nullptr;  // unreadable: as if absent (the stage runs again)
+  }
+}
+
+void write_json(const fs::path& path, const json& j) {
+  io::write_file_atomic(path, [&](std::ostream& s) { s << j.dump(2) << "\n"; });
+}
+
+std::string megabytes(uint64_t bytes) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.0f MB", static_cast<double>(bytes) / 1e6);
+  return buf;
+}
+
+std::string now_text() {
+  const std::time_t t = std::time(nullptr);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+class Runner {
+ public:
+  Runner(const RunOptions& o, std::ostream& out) : o_(o), out_(out) {}
+
+  json run() {
+    const auto& table = stage_table();
+    const size_t from = stage_index(o_.from, 0), until = stage_index(o_.until, table.size() - 1);
+    if (from > until) throw std::invalid_argument("--from " + o_.from + " comes after --until " + o_.until);
+    ctx_.input = o_.input;
+    ctx_.kind = detect_input_kind(o_.input);
+    if (ctx_.kind == InputKind::kUnknown)
+      throw std::invalid_argument("INPUT '" + o_.input + "': unknown kind of input: " + input_kind_help());
+    ctx_.out_dir = fs::absolute(o_.out_dir);
+    ctx_.engine = o_.engine;
+    ctx_.config = o_.config;
+    fs::create_directories(ctx_.out_dir);
+    // The run's options beside its results: `run INPUT --out DIR --config DIR/run.yaml` repeats it.
+    io::write_file_atomic(ctx_.out_dir / "run.yaml",
+                          [&](std::ostream& s) { s << run_config_yaml(o_.config); });
+    record_ = {{"input", o_.input},
+               {"kind", kind_name(ctx_.kind)},
+               {"out", ctx_.out_dir.string()},
+               {"config", to_json(o_.config)},
+               {"started", now_text()},
+               {"status", "running"},
+               {"stages", json::array()}};
+    const auto start = std::chrono::steady_clock::now();
+    for (size_t i = 0; i < table.size(); ++i) {
+      const Stage& stage = table[i];
+      json& entry = record_["stages"].emplace_back(json{{"name", stage.name}});
+      const std::string tag =
+          "run: [" + std::to_string(i + 1) + "/" + std::to_string(table.size()) + "] " + stage.name;
+      if (i > until) {
+        entry["status"] = "not run (after --until)";
+        continue;
+      }
+      if (!stage.built) {
+        entry["status"] = "skipped: not built yet";
+        out_ << tag << ": skipped: not built yet (" << stage.what << ")\n";
+        continue;
+      }
+      try {
+        run_stage(stage, !o_.from.empty() && i >= from, tag, entry);
+      } catch (const StageFailed&) {
+        finish(start, "failed");
+        throw;
+      } catch (const std::exception& e) {
+        entry["status"] = "failed";
+        entry["reason"] = e.what();
+        finish(start, "failed");
+        throw StageFailed(stage.name, e.what());
+      }
+      write_json(ctx_.out_dir / "run.json", record_);
+    }
+    finish(start, "done");
+    summary();
+    return record_;
+  }
+
+ private:
+  std::string hash_of(const fs::path& p) {
+    const std::string key = fs::absolute(p).string();
+    auto it = hashes_.find(key);
+    if (it == hashes_.end()) it = hashes_.emplace(key, hash_path(p)).first;
+    return it->second;
+  }
+
+  json output_hashes(const StagePlan& plan) {
+    json h = json::object();
+    for (const fs::path& p : plan.outputs) h[p.generic_string()] = hash_path(ctx_.out_dir / p);
+    return h;
+  }
+
+  // True when the manifest says the stage is done with these inputs and options, and its outputs are as it
+  // left them.
+  bool up_to_date(const json& manifest, const std::string& key, const StagePlan& plan) {
+    if (!manifest.is_object() || manifest.value("key", "") != key) return false;
+    try {
+      return manifest.at("outputs") == output_hashes(plan);
+    } catch (const std::exception&) {
+      return false;  // an output is missing or unreadable
+    }
+  }
+
+  void run_stage(const Stage& stage, bool forced, const std::string& tag, json& entry) {
+    const StagePlan plan = stage.plan(ctx_);
+    json inputs = json::object();
+    for (const fs::path& p : plan.inputs) inputs[fs::absolute(p).string()] = hash_of(p);
+    const std::string key = hash_text(json{
+        {"stage", stage.name},
+        {"inputs", inputs},
+        {"options", plan.options},
+        {"command", plan.command}}.dump());
+    const fs::path dir = ctx_.stage_dir(stage.name), manifest_path = dir / "manifest.json";
+    const json manifest = read_json(manifest_path);
+    if (!forced && up_to_date(manifest, key, plan)) {
+      ctx_.results[stage.name] = manifest.at("result");
+      entry.update({{"status", "up to date"},
+                    {"seconds", manifest.value("seconds", 0.0)},
+                    {"peak_host_bytes", manifest.value("peak_host_bytes", 0)},
+                    {"metrics", manifest.at("result").value("metrics", json::object())}});
+      out_ << tag << ": up to date (manifest matches), skipped\n";
+      return;
+    }
+    // Continue an interrupted resumable stage only if it started with these inputs and options.
+    const json started = read_json(dir / "started.json");
+    const bool resume = plan.resumable && !forced && started.is_object() && started.value("key", "") == key;
+    if (!resume) fs::remove_all(dir);
+    fs::remove(manifest_path);
+    fs::create_directories(dir);
+    write_json(dir / "started.json", {{"key", key}, {"started", now_text()}});
+    std::vector<std::string> command = plan.command;
+    if (resume) command.insert(command.end(), plan.resume_args.begin(), plan.resume_args.end());
+    out_ << tag << ": " << stage.what << (resume ? " (resuming from its checkpoint)" : "")
+         << (forced ? " (forced by --from)" : "") << "\n"
+         << std::flush;
+    ChildResult child;
+    if (!command.empty()) {
+      child = run_child(ctx_.engine, command, dir / "log.txt", out_);
+      if (child.exit_code != 0) {
+        std::string why = child.signal ? "killed by signal " + std::to_string(child.signal)
+                                       : "exit status " + std::to_string(child.exit_code);
+        const std::string last = last_line(child.tail);
+        if (!last.empty()) why += ": " + last;
+        entry.update({{"status", "failed"}, {"reason", why}, {"seconds", child.seconds}});
+        out_ << tag << ": FAILED (" << why << "); log: " << (dir / "log.txt").string()
+             << "; earlier stages' outputs are kept\n";
+        throw StageFailed(stage.name, why);
+      }
+    }
+    const json result = stage.result(ctx_);
+    ctx_.results[stage.name] = result;
+    // Written last: until it exists, the stage is not done.
+    write_json(manifest_path, {{"stage", stage.name},
+                               {"key", key},
+                               {"inputs", inputs},
+                               {"options", plan.options},
+                               {"command", plan.command},
+                               {"outputs", output_hashes(plan)},
+                               {"result", result},
+                               {"seconds", child.seconds},
+                               {"peak_host_bytes", child.peak_host_bytes},
+                               {"finished", now_text()}});
+    entry.update({{"status", "done"},
+                  {"seconds", child.seconds},
+                  {"peak_host_bytes", child.peak_host_bytes},
+                  {"metrics", result.value("metrics", json::object())}});
+    if (resume) entry["resumed"] = true;
+    char line[128];
+    std::snprintf(line, sizeof line, ": done in %.1f s, peak host memory %s\n", child.seconds,
+                  megabytes(child.peak_host_bytes).c_str());
+    out_ << tag << line;
+  }
+
+  // The child's last line that says something: CLI11's "Run with --help" hint is skipped.
+  static std::string last_line(const std::string& text) {
+    std::istringstream in(text);
+    std::string line, last;
+    while (std::getline(in, line)) {
+      while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+      if (!line.empty() && line.rfind("Run with --help", 0) != 0) last = line;
+    }
+    return last;
+  }
+
+  void finish(std::chrono::steady_clock::time_point start, const std::string& status) {
+    record_["status"] = status;
+    record_["total_seconds"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    write_json(ctx_.out_dir / "run.json", record_);
+  }
+
+  void summary() {
+    out_ << "run: summary (" << (ctx_.out_dir / "run.json").string() << ")\n";
+    for (const json& s : record_["stages"]) {
+      char line[256];
+      std::snprintf(line, sizeof line, "  %-8s %-24s", s["name"].get<std::string>().c_str(),
+                    s["status"].get<std::string>().c_str());
+      out_ << line;
+      if (s.contains("seconds")) {
+        std::snprintf(line, sizeof line, " %8.1f s, peak host memory %s", s["seconds"].get<double>(),
+                      megabytes(s.value("peak_host_bytes", uint64_t{0})).c_str());
+        out_ << line;
+      }
+      out_ << "\n";
+    }
+    const json& results = ctx_.results;
+    if (results.contains("eval")) {
+      const json& m = results["eval"]["metrics"];
+      const auto value = [&](const char* key) {
+        return m.value(key, json()).is_number() ? m[key].get<double>() : NAN;
+      };
+      char line[256];
+      std::snprintf(line, sizeof line,
+                    "run: held-out PSNR %.2f dB, SSIM %.4f, EMD %.4f m (sampling floor %.4f m), "
+                    "render %.1f ms/frame, %.0f Gaussians\n",
+                    value("psnr_db"), value("ssim"), value("emd_m"), value("emd_floor_m"),
+                    value("render_ms_per_frame"), value("gaussians"));
+      out_ << line;
+    }
+    if (results.contains("report"))
+      out_ << "run: report: " << results["report"]["report"].get<std::string>() << "\n";
+  }
+
+  const RunOptions& o_;
+  std::ostream& out_;
+  StageContext ctx_;
+  json record_;
+  std::map<std::string, std::string> hashes_;
+};
+
+}  // namespace
+
+nlohmann::json run_pipeline(const RunOptions& options, std::ostream& out) {
+  return Runner(options, out).run();
+}
+
+}  // namespace litgs::host::run

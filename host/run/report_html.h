@@ -1,0 +1,25 @@
+// DIR/report.html of a run: one self-contained file (Chart.js from Debian's libjs-chart.js inlined, pictures
+// as PNG data URIs; nothing is fetched at view time). Sections: the charts (held-out PSNR and training loss
+// against iterations and seconds, Gaussians over training), the held-out views (render beside the real
+// frame, error map, false colour, rendered depth), the summary of stages and metrics, the per-view table.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace litgs::host::run {
+
+// Reads DIR/run.json (optional), DIR/train/metrics.json, DIR/train/trace.jsonl, DIR/eval/eval.json and the
+// pictures it lists. io::IoError naming a missing or malformed file.
+std::string report_html(const std::filesystem::path& run_dir, unsigned max_views);
+
+// The training's progress records as one curve: a resumed run appends records from its checkpoint's iteration
+// on, so records at or after a restart's iteration from before the restart are dropped, and the restarted
+// session's seconds continue from the last kept record. Returns [{iteration, seconds, loss, gaussians,
+// psnr_db}] in iteration order.
+std::string trace_curve_json(const std::string& trace_jsonl_text);
+
+// RFC 4648 base64.
+std::string base64(const std::string& bytes);
+
+}  // namespace litgs::host::run

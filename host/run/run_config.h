@@ -1,0 +1,102 @@
+// run.yaml: every option of `litgs-engine run`, one section per stage, each key with its default and a
+// comment. The defaults live here only: the YAML reader, `run --print-config` and the stages' manifests all
+// walk the fields through for_each_field.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace litgs::host::run {
+
+struct RunConfig {
+  struct Import {
+    std::string calib;                      // ROS bag: M2DGR calibration_results.txt (also --calib)
+    std::string images;                     // Metashape/COLMAP: folder of the frames (default: see README)
+    std::vector<std::string> livo2_config;  // FAST-LIVO2: camera and extrinsic YAML file(s)
+    std::string synth_preset = "facade";    // synth:PRESET inputs: the preset (the INPUT's name wins)
+    uint32_t synth_frames = 40;             // synth: frames
+    uint32_t synth_width = 160;             // synth: image size
+    uint32_t synth_height = 128;
+    uint32_t synth_seed = 0;
+    std::vector<std::string> extra_args;  // passed to `litgs-engine import KIND` (or synth) as they are
+  } import;
+  struct Train {
+    uint32_t iterations = 2000;
+    double downscale = 1.0;
+    std::string strategy = "mcmc";   // mcmc: measured faster and better than adc on DUNR (README)
+    uint32_t max_gaussians = 20000;  // the MCMC budget (adc: a cap)
+    double mcmc_growth = 0.3;
+    double lambda_geo = 0.6;
+    std::string init = "auto";  // auto (LiDAR map, else random) | random | a .ply/.pcd file
+    uint32_t holdout_every = 8;
+    std::string intensity = "auto";
+    std::string poses = "estimated";
+    uint32_t seed = 0;
+    uint32_t eval_every = 250;            // held-out PSNR points of the report's curves
+    uint32_t checkpoint_every = 250;      // what an interruption loses at most
+    uint32_t progress_every = 50;         // progress lines, and the report's loss curve points
+    std::vector<std::string> extra_args;  // passed to `litgs-engine train` as they are
+  } train;
+  struct Eval {
+    uint32_t emd_samples = 1000;
+    uint32_t emd_rounds = 3;
+    uint32_t seed = 0;
+    bool geometry = true;
+  } eval;
+  struct Report {
+    uint32_t max_views = 4;  // held-out views shown as pictures
+  } report;
+};
+
+// Calls f(section, key, value&, comment) for every option, in the order run.yaml lists them.
+template <class Config, class F>
+void for_each_field(Config& c, F&& f) {
+  f("import", "calib", c.import.calib, "ROS bag: M2DGR calibration_results.txt (or --calib)");
+  f("import", "images", c.import.images,
+    "Metashape/COLMAP: folder of the frames (default: images/ beside the XML or model)");
+  f("import", "livo2_config", c.import.livo2_config, "FAST-LIVO2: camera and extrinsic YAML file(s)");
+  f("import", "synth_preset", c.import.synth_preset,
+    "synth inputs: facade | street | corridor (synth:NAME wins)");
+  f("import", "synth_frames", c.import.synth_frames, "synth inputs: frames");
+  f("import", "synth_width", c.import.synth_width, "synth inputs: image width");
+  f("import", "synth_height", c.import.synth_height, "synth inputs: image height");
+  f("import", "synth_seed", c.import.synth_seed, "synth inputs: seed");
+  f("import", "extra_args", c.import.extra_args,
+    "more flags for `litgs-engine import KIND` (or synth), as is");
+  f("train", "iterations", c.train.iterations, "training iterations");
+  f("train", "downscale", c.train.downscale, "divide image size and intrinsics by this");
+  f("train", "strategy", c.train.strategy, "mcmc (fixed budget; measured better and faster on DUNR) | adc");
+  f("train", "max_gaussians", c.train.max_gaussians, "MCMC budget (adc: cap)");
+  f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
+  f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
+  f("train", "init", c.train.init, "auto (LiDAR map, else random) | random | a .ply/.pcd file");
+  f("train", "holdout_every", c.train.holdout_every, "hold out every Nth frame for evaluation");
+  f("train", "intensity", c.train.intensity, "auto | percentile | linear");
+  f("train", "poses", c.train.poses, "estimated (poses.txt) | truth (gt/poses.txt)");
+  f("train", "seed", c.train.seed, "view order and densification seed");
+  f("train", "eval_every", c.train.eval_every, "held-out evaluation cadence (the report's PSNR curve)");
+  f("train", "checkpoint_every", c.train.checkpoint_every,
+    "checkpoint cadence: an interrupted run resumes from the last one");
+  f("train", "progress_every", c.train.progress_every, "progress line cadence (the report's loss curve)");
+  f("train", "extra_args", c.train.extra_args, "more flags for `litgs-engine train`, as is");
+  f("eval", "emd_samples", c.eval.emd_samples, "EMD: points drawn from each side (exact assignment, O(N^3))");
+  f("eval", "emd_rounds", c.eval.emd_rounds, "EMD: independent draws (mean, std)");
+  f("eval", "seed", c.eval.seed, "EMD: seed");
+  f("eval", "geometry", c.eval.geometry, "EMD and plane residuals");
+  f("report", "max_views", c.report.max_views, "held-out views shown as pictures");
+}
+
+// Reads run.yaml: sections and keys as above, any of them may be left out (its default stays). An unknown
+// section or key, a wrong type or a YAML syntax error is an io::IoError naming the file and the key.
+RunConfig read_run_config(const std::filesystem::path& path);
+// The configuration as run.yaml text, with each key's comment (run --print-config prints the defaults).
+std::string run_config_yaml(const RunConfig& config);
+// {section: {key: value}} (run.json, manifests).
+nlohmann::json to_json(const RunConfig& config);
+// The options of one section (a stage's manifest records only its own).
+nlohmann::json section_json(const RunConfig& config, const std::string& section);
+
+}  // namespace litgs::host::run

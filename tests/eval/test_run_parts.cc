@@ -1,0 +1,152 @@
+// The pipeline's parts that need no device: run.yaml, content hashes, INPUT kinds, the report's trace curve
+// and base64.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "host/run/content_hash.h"
+#include "host/run/input_kind.h"
+#include "host/run/report_html.h"
+#include "host/run/run_config.h"
+#include "io/error.h"
+
+namespace litgs::host::run {
+namespace {
+
+namespace fs = std::filesystem;
+
+class RunParts : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("litgs-run-parts-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    fs::create_directories(p.parent_path());
+    std::ofstream(p) << text;
+    return p;
+  }
+  std::string error_of(const fs::path& config) {
+    try {
+      read_run_config(config);
+    } catch (const io::IoError& e) {
+      return e.what();
+    }
+    return "";
+  }
+  fs::path dir_;
+};
+
+TEST_F(RunParts, PrintedDefaultsReadBackAsTheDefaults) {
+  const RunConfig defaults;
+  const fs::path p = write("run.yaml", run_config_yaml(defaults));
+  EXPECT_EQ(to_json(read_run_config(p)), to_json(defaults));
+  // And a changed value of each type survives the round trip.
+  RunConfig c;
+  c.train.iterations = 123;
+  c.train.downscale = 2.5;
+  c.train.strategy = "adc";
+  c.eval.geometry = false;
+  c.train.extra_args = {"--sh-degree", "1"};
+  EXPECT_EQ(to_json(read_run_config(write("changed.yaml", run_config_yaml(c)))), to_json(c));
+}
+
+TEST_F(RunParts, ConfigKeysMayBeLeftOut) {
+  const RunConfig c = read_run_config(write("partial.yaml", "train:\n  iterations: 50\n"));
+  EXPECT_EQ(c.train.iterations, 50u);
+  EXPECT_EQ(c.train.strategy, RunConfig().train.strategy);
+  EXPECT_EQ(to_json(read_run_config(write("empty.yaml", ""))), to_json(RunConfig()));
+}
+
+TEST_F(RunParts, UnknownKeysAndBadValuesAreErrorsNamingThem) {
+  std::string e = error_of(write("a.yaml", "train:\n  iterations: 5\n  iteratons: 7\n"));
+  EXPECT_NE(e.find("unknown key 'train.iteratons'"), std::string::npos) << e;
+  EXPECT_NE(e.find("a.yaml:3"), std::string::npos) << e;
+  e = error_of(write("b.yaml", "trian:\n  iterations: 5\n"));
+  EXPECT_NE(e.find("unknown section 'trian'"), std::string::npos) << e;
+  e = error_of(write("c.yaml", "train:\n  iterations: -3\n"));
+  EXPECT_NE(e.find("train.iterations"), std::string::npos) << e;
+  e = error_of(write("d.yaml", "eval:\n  geometry: maybe\n"));
+  EXPECT_NE(e.find("eval.geometry: expected true or false"), std::string::npos) << e;
+  e = error_of(write("e.yaml", "train: [1, 2\n"));
+  EXPECT_NE(e.find("YAML error"), std::string::npos) << e;
+  e = error_of(write("g.yaml", "train:\n  iterations: 5\n  iterations: 7\n"));
+  EXPECT_NE(e.find("'train.iterations' given twice"), std::string::npos) << e;
+  e = error_of(write("f.yaml", "train:\n  extra_args: --resume\n"));
+  EXPECT_NE(e.find("expected a list"), std::string::npos) << e;
+}
+
+TEST_F(RunParts, ContentHashFollowsContentNotTime) {
+  const fs::path a = write("d/x.txt", "hello");
+  write("d/sub/y.txt", "world");
+  const std::string file = hash_path(a), folder = hash_path(dir_ / "d");
+  EXPECT_EQ(file.size(), 16u);
+  EXPECT_EQ(hash_path(write("d/x.txt", "hello")), file);  // rewritten, same bytes
+  EXPECT_EQ(hash_path(dir_ / "d"), folder);
+  write("d/x.txt", "hellp");
+  EXPECT_NE(hash_path(a), file);
+  EXPECT_NE(hash_path(dir_ / "d"), folder);
+  write("d/x.txt", "hello");
+  fs::rename(dir_ / "d/sub/y.txt", dir_ / "d/sub/z.txt");  // a renamed file changes the folder's hash
+  EXPECT_NE(hash_path(dir_ / "d"), folder);
+  EXPECT_NE(hash_text(""), hash_text(std::string(1, '\0')));  // the length counts
+  EXPECT_THROW(hash_path(dir_ / "missing"), io::IoError);
+}
+
+TEST_F(RunParts, InputKinds) {
+  write("scene/scene.yaml", "");
+  write("x.bag", "");
+  write("cams.xml", "");
+  write("colmap/sparse/0/cameras.bin", "");
+  write("log/result/a.txt", "");
+  write("log/pcd/map.pcd", "");
+  write("notes.txt", "");
+  EXPECT_EQ(detect_input_kind((dir_ / "scene").string()), InputKind::kScene);
+  EXPECT_EQ(detect_input_kind((dir_ / "x.bag").string()), InputKind::kRosBag);
+  EXPECT_EQ(detect_input_kind((dir_ / "cams.xml").string()), InputKind::kMetashape);
+  EXPECT_EQ(detect_input_kind((dir_ / "colmap").string()), InputKind::kColmap);
+  EXPECT_EQ(detect_input_kind((dir_ / "log").string()), InputKind::kLivo2);
+  EXPECT_EQ(detect_input_kind("synth:street"), InputKind::kSynthetic);
+  EXPECT_EQ(synthetic_preset("synth:street"), "street");
+  EXPECT_EQ(detect_input_kind((dir_ / "notes.txt").string()), InputKind::kUnknown);
+  EXPECT_EQ(detect_input_kind((dir_ / "missing").string()), InputKind::kUnknown);
+  EXPECT_EQ(detect_input_kind(dir_.string()), InputKind::kUnknown);  // a folder of unrelated things
+}
+
+TEST(Report, TraceCurveOfAResumedRun) {
+  // Session 1 reported up to iteration 150, then was killed; the checkpoint was at 100, so session 2 starts
+  // again at 101: the records from 101 on of session 1 are dropped, and session 2's clock continues from the
+  // last kept record (iteration 100 at 20 s).
+  const std::string text =
+      "{\"iteration\":1,\"session_s\":1.0,\"loss\":0.5,\"gaussians\":10}\n"
+      "{\"iteration\":100,\"session_s\":20.0,\"loss\":0.3,\"gaussians\":12}\n"
+      "{\"iteration\":150,\"session_s\":30.0,\"loss\":0.2,\"gaussians\":13}\n"
+      "{\"iteration\":15"  // cut short by the kill
+      "\n{\"iteration\":101,\"session_s\":2.0,\"loss\":0.29,\"gaussians\":12}\n"
+      "{\"iteration\":200,\"session_s\":22.0,\"loss\":0.1,\"gaussians\":14}\n";
+  const nlohmann::json c = nlohmann::json::parse(trace_curve_json(text));
+  ASSERT_EQ(c.size(), 4u);
+  EXPECT_EQ(c[1]["iteration"], 100);
+  EXPECT_EQ(c[2]["iteration"], 101);
+  EXPECT_DOUBLE_EQ(c[2]["seconds"].get<double>(), 22.0);
+  EXPECT_DOUBLE_EQ(c[3]["seconds"].get<double>(), 42.0);
+}
+
+TEST(Report, Base64TestVectors) {  // RFC 4648, section 10
+  EXPECT_EQ(base64(""), "");
+  EXPECT_EQ(base64("f"), "Zg==");
+  EXPECT_EQ(base64("fo"), "Zm8=");
+  EXPECT_EQ(base64("foo"), "Zm9v");
+  EXPECT_EQ(base64("foob"), "Zm9vYg==");
+  EXPECT_EQ(base64("fooba"), "Zm9vYmE=");
+  EXPECT_EQ(base64("foobar"), "Zm9vYmFy");
+  EXPECT_EQ(base64(std::string("\xff\x00\xfe", 3)), "/wD+");
+}
+
+}  // namespace
+}  // namespace litgs::host::run

@@ -1,0 +1,157 @@
+// DIR/report.html in headless Chromium (Debian's chromium): the page runs without console messages, draws its
+// three charts, and the screenshot's pixels show the charts (their line colours in the chart band) and the
+// pictures (false-colour and gray pixels in the views band). Controls show each check can fail: a page
+// with a script error is caught, and the report without its charts has no chart pixels.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "io/image.h"
+#include "run_test_support.h"
+
+namespace litgs::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kRoot = LITGS_RUN_TEST_DIR;
+
+struct Browser {
+  std::string out, err;
+  int status;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// One headless Chromium call on a local page, with a fresh profile; `mode` is --dump-dom or
+// --screenshot=FILE. Its console messages come out on stderr as "...:CONSOLE:LINE] ...".
+Browser chromium(const fs::path& page, const std::string& mode, const std::string& extra = "") {
+  static int call = 0;
+  const fs::path profile =
+      kRoot / ("chromium-profile-" + std::to_string(::getpid()) + "-" + std::to_string(call++));
+  fs::remove_all(profile);
+  const fs::path out = profile.string() + ".out", err = profile.string() + ".err";
+  const std::string cmd =
+      "timeout 120 /usr/bin/chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run "
+      "--disable-background-networking --disable-component-update --disable-sync --hide-scrollbars "
+      "--enable-logging=stderr --v=0 --window-size=1280,1200 --user-data-dir=" +
+      profile.string() + " " + extra + " " + mode + " file://" + fs::absolute(page).string() + " > " +
+      out.string() + " 2> " + err.string();
+  Browser b;
+  b.status = std::system(cmd.c_str());
+  b.out = slurp(out);
+  b.err = slurp(err);
+  fs::remove_all(profile);
+  return b;
+}
+
+std::vector<std::string> console_lines(const std::string& err) {
+  std::vector<std::string> lines;
+  std::istringstream in(err);
+  for (std::string line; std::getline(in, line);)
+    if (line.find(":CONSOLE") != std::string::npos) lines.push_back(line);
+  return lines;
+}
+
+// Pixels of the screenshot rows [y0, y1) whose colour is within `tolerance` of `rgb` in every channel.
+size_t count_colour(const io::Image& img, int y0, int y1, std::array<int, 3> rgb, int tolerance = 24) {
+  size_t n = 0;
+  for (int y = y0; y < std::min(y1, img.height); ++y)
+    for (int x = 0; x < img.width; ++x) {
+      bool close = true;
+      for (int c = 0; c < 3; ++c) close = close && std::abs(int{img.at(x, y, c)} - rgb[c]) <= tolerance;
+      n += close;
+    }
+  return n;
+}
+
+// Strongly coloured pixels (max - min channel above 90) and mid-gray ones (channels within 6, 40..215).
+std::pair<size_t, size_t> colour_and_gray(const io::Image& img, int y0, int y1) {
+  size_t colour = 0, gray = 0;
+  for (int y = y0; y < std::min(y1, img.height); ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const int r = img.at(x, y, 0), g = img.at(x, y, 1), b = img.at(x, y, 2);
+      const int hi = std::max({r, g, b}), lo = std::min({r, g, b});
+      colour += hi - lo > 90;
+      gray += hi - lo <= 6 && lo >= 40 && hi <= 215;
+    }
+  return {colour, gray};
+}
+
+class RunReport : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    report_ = kRoot / "e2e" / "report.html";
+    ASSERT_TRUE(fs::exists(report_)) << report_
+                                     << " is missing: RunPipeline.SyntheticEndToEnd* makes it (ctest "
+                                     << "runs it first as this test's fixture)";
+    ASSERT_TRUE(fs::exists("/usr/bin/chromium")) << "install chromium (ci/setup)";
+  }
+  fs::path report_;
+};
+
+TEST_F(RunReport, LoadsWithoutConsoleMessagesAndDrawsItsCharts) {
+  const Browser b = chromium(report_, "--dump-dom");
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_EQ(console_lines(b.err), std::vector<std::string>{}) << "console messages while loading the report";
+  EXPECT_NE(b.out.find("data-charts=\"3\""), std::string::npos) << "the chart script did not finish";
+  // Self-contained: no address outside the file.
+  const std::string html = slurp(report_);
+  EXPECT_EQ(html.find("src=\"http"), std::string::npos);
+  EXPECT_EQ(html.find("href=\"http"), std::string::npos);
+
+  // Control: a script error in a page is seen by this check.
+  const fs::path bad =
+      write_text(kRoot / "bad-page.html", "<html><body><script>notAFunction();</script></body></html>");
+  const Browser c = chromium(bad, "--dump-dom");
+  ASSERT_EQ(console_lines(c.err).size(), 1u) << c.err;
+  EXPECT_NE(console_lines(c.err)[0].find("Uncaught ReferenceError"), std::string::npos);
+}
+
+TEST_F(RunReport, ScreenshotShowsChartsAndPictures) {
+  // Layout (report_html.cc's style, CSS pixels = screenshot pixels): the charts in rows 40..340, the
+  // held-out views from about 380 on, 196 rows each.
+  const fs::path shot = kRoot / "report-shot.png";
+  fs::remove(shot);
+  const Browser b = chromium(report_, "--screenshot=" + shot.string());
+  ASSERT_EQ(b.status, 0) << b.err;
+  const io::Image img = io::read_image(shot);
+  ASSERT_GE(img.channels, 3);
+  ASSERT_EQ(img.width, 1280);
+  const std::array<int, 3> red = {0xd6, 0x27, 0x28}, blue = {0x1f, 0x77, 0xb4}, green = {0x2c, 0xa0, 0x2c};
+  // Each curve and its legend box: a few hundred pixels at least (a legend box alone is 40x12).
+  EXPECT_GT(count_colour(img, 40, 340, red), 600u);
+  EXPECT_GT(count_colour(img, 40, 340, blue), 600u);
+  EXPECT_GT(count_colour(img, 40, 340, green), 600u);
+  // The pictures: five 160-row images per view; the error, false-colour and depth pictures are strongly
+  // coloured, the render and the frame gray.
+  const auto [colour, gray] = colour_and_gray(img, 380, 380 + 196);
+  EXPECT_GT(colour, 3u * 160 * 100) << "false-colour pictures missing";
+  EXPECT_GT(gray, 160u * 100) << "gray pictures missing";
+
+  // Control: the same report with the charts' construction taken out has no chart pixels (the check sees
+  // the charts, not the rest of the page).
+  std::string html = slurp(report_);
+  const size_t at = html.find("new Chart(");
+  ASSERT_NE(at, std::string::npos);
+  html.replace(at, 10, "void(");
+  const fs::path without = write_text(kRoot / "report-without-charts.html", html);
+  const fs::path off = kRoot / "report-shot-without-charts.png";
+  fs::remove(off);
+  ASSERT_EQ(chromium(without, "--screenshot=" + off.string()).status, 0);
+  const io::Image no_charts = io::read_image(off);
+  EXPECT_LT(count_colour(no_charts, 40, 340, red) + count_colour(no_charts, 40, 340, blue), 50u);
+}
+
+}  // namespace
+}  // namespace litgs::testing

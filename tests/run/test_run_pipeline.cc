@@ -1,0 +1,195 @@
+// `litgs-engine run` end to end on a small synthetic scene: stages, manifests, reruns, --from, and the bad
+// inputs the issue names (unknown INPUT, a failing stage, a changed input, an interrupted stage).
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "run_test_support.h"
+
+namespace litgs::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kRoot = LITGS_RUN_TEST_DIR;
+
+std::string run_args(const std::string& input, const fs::path& dir, const fs::path& config,
+                     const std::string& more = "") {
+  return "run " + input + " --out " + dir.string() + " --config " + config.string() + " " + more;
+}
+
+// Also the fixture of the report's browser test (tests/run/CMakeLists.txt): leaves kRoot/e2e behind.
+TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
+  const fs::path dir = kRoot / "e2e";
+  fs::remove_all(dir);
+  const fs::path config = write_text(kRoot / "e2e.yaml", small_run_yaml());
+  CommandResult r = run_engine(run_args("synth:facade", dir, config));
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char* stage : {"map", "match", "refine"}) {
+    EXPECT_EQ(stage_status(dir, stage), "skipped: not built yet");
+    EXPECT_NE(r.output.find(std::string("] ") + stage + ": skipped: not built yet"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(dir / stage)) << "a stage that is not built wrote something";
+  }
+  for (const char* stage : {"import", "train", "eval", "report"}) {
+    EXPECT_EQ(stage_status(dir, stage), "done") << stage;
+    EXPECT_TRUE(fs::exists(dir / stage / "manifest.json")) << stage;
+  }
+  const nlohmann::json run = read_json_file(dir / "run.json");
+  EXPECT_EQ(run["status"], "done");
+  for (const auto& s : run["stages"])
+    if (s["status"] == "done") {
+      EXPECT_GT(s["seconds"].get<double>(), 0.0) << s;
+      EXPECT_GT(s["peak_host_bytes"].get<double>(), 1e6) << s;  // a real process's resident set
+    }
+  const nlohmann::json eval = read_json_file(dir / "eval" / "eval.json");
+  EXPECT_GT(eval["psnr_db"].get<double>(), 5.0);
+  EXPECT_EQ(eval["views"].size(), eval["heldout_views"].get<size_t>());
+  EXPECT_EQ(read_json_file(dir / "train" / "metrics.json")["heldout_views"], eval["heldout_views"]);
+  EXPECT_NEAR(read_json_file(dir / "train" / "metrics.json")["heldout_psnr"].get<double>(),
+              eval["psnr_db"].get<double>(), 1e-6);  // the same renders of the same views
+  EXPECT_NE(r.output.find("report: " + (dir / "report.html").string()), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "run.yaml"));
+
+  // A rerun skips everything; --from eval reruns eval and report only.
+  r = run_engine(run_args("synth:facade", dir, config));
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char* stage : {"import", "train", "eval", "report"})
+    EXPECT_EQ(stage_status(dir, stage), "up to date");
+  r = run_engine(run_args("synth:facade", dir, config, "--from eval"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "train"), "up to date");
+  EXPECT_EQ(stage_status(dir, "eval"), "done");
+  EXPECT_EQ(stage_status(dir, "report"), "done");
+}
+
+TEST(RunBadInput, UnknownInputKind) {
+  const fs::path dir = kRoot / "unknown";
+  fs::remove_all(dir);
+  const fs::path notes = write_text(kRoot / "notes.txt", "not a dataset\n");
+  const CommandResult r = run_engine("run " + notes.string() + " --out " + dir.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("unknown kind of input"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("expected a scene directory"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "run.json"));
+}
+
+TEST(RunBadInput, FailingStageStopsNamesItAndKeepsEarlierOutputs) {
+  const fs::path dir = kRoot / "failing";
+  fs::remove_all(dir);
+  const fs::path config = write_text(kRoot / "failing.yaml", small_run_yaml("  strategy: bogus\n"));
+  const CommandResult r = run_engine(run_args("synth:facade", dir, config));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("stage 'train' failed"), std::string::npos) << r.output;
+  // Why: the child's own message, in the output and in run.json.
+  EXPECT_NE(r.output.find("stage 'train' failed: exit status 105: --strategy: bogus not in {adc,mcmc}"),
+            std::string::npos)
+      << r.output;
+  EXPECT_TRUE(fs::exists(dir / "import" / "manifest.json"));
+  EXPECT_TRUE(fs::exists(dir / "import" / "scene" / "scene.yaml"));
+  EXPECT_FALSE(fs::exists(dir / "train" / "manifest.json"));
+  EXPECT_FALSE(fs::exists(dir / "eval"));
+  EXPECT_EQ(stage_status(dir, "train"), "failed");
+  EXPECT_EQ(read_json_file(dir / "run.json")["status"], "failed");
+}
+
+TEST(RunBadInput, ChangedInputRerunsTheStagesWithoutMixing) {
+  const fs::path dir = kRoot / "changed", scene = kRoot / "changed-scene";
+  fs::remove_all(dir);
+  fs::remove_all(scene);
+  ASSERT_EQ(
+      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
+      0);
+  const fs::path config = write_text(kRoot / "changed.yaml", small_run_yaml());
+  CommandResult r = run_engine(run_args(scene.string(), dir, config, "--until train"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "eval"), "not run (after --until)");
+  write_text(dir / "train" / "left-over.txt", "from the first input");
+  r = run_engine(run_args(scene.string(), dir, config, "--until train"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "train"), "up to date");
+  // Change the input: a new file in the scene directory.
+  write_text(scene / "notes.txt", "changed");
+  r = run_engine(run_args(scene.string(), dir, config, "--until train"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "import"), "done");
+  EXPECT_EQ(stage_status(dir, "train"), "done");
+  EXPECT_FALSE(fs::exists(dir / "train" / "left-over.txt")) << "the rerun mixed with the old stage folder";
+  EXPECT_EQ(read_json_file(dir / "train" / "metrics.json")["resumes"].size(), 0u)
+      << "resumed the old input's run";
+}
+
+TEST(RunBadInput, InterruptedStageIsNotTakenAsDone) {
+  const fs::path dir = kRoot / "interrupted";
+  fs::remove_all(dir);
+  // Long enough to be killed after its first checkpoint (iteration 20).
+  const fs::path config = write_text(kRoot / "interrupted.yaml", small_run_yaml("", 400));
+  const std::string command = std::string(LITGS_ENGINE_BINARY) + " " + run_args("synth:facade", dir, config) +
+                              " > " + (kRoot / "interrupted.log").string() + " 2>&1 & echo $! > " +
+                              (kRoot / "interrupted.pid").string();
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  pid_t pid = 0;
+  std::ifstream(kRoot / "interrupted.pid") >> pid;
+  ASSERT_GT(pid, 0);
+  const auto start = std::chrono::steady_clock::now();
+  while (!fs::exists(dir / "train" / "checkpoints" / "iter_20.ckpt")) {
+    ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(300)) << "no checkpoint";
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);  // the runner; its train child dies with it (PR_SET_PDEATHSIG)
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_FALSE(fs::exists(dir / "train" / "manifest.json"));
+  EXPECT_EQ(stage_status(dir, "train"), "");  // run.json was last written after import
+
+  CommandResult r = run_engine(run_args("synth:facade", dir, config));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "import"), "up to date");
+  EXPECT_NE(r.output.find("train: Gaussian map on the Vulkan device (resuming from its checkpoint)"),
+            std::string::npos)
+      << r.output;
+  const nlohmann::json metrics = read_json_file(dir / "train" / "metrics.json");
+  ASSERT_GE(metrics["resumes"].size(), 1u);
+  EXPECT_GE(metrics["resumes"][0]["from_iteration"].get<int>(), 20);
+  EXPECT_EQ(metrics["iterations"], 400);
+
+  // A half-written output under a complete manifest (a crash of something else writing there, a full disk):
+  // the outputs' hashes no longer match, so the stage is not taken as done.
+  const fs::path eval_json = dir / "eval" / "eval.json";
+  const auto size = fs::file_size(eval_json);
+  fs::resize_file(eval_json, size / 2);
+  r = run_engine(run_args("synth:facade", dir, config));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "train"), "up to date");
+  EXPECT_EQ(stage_status(dir, "eval"), "done");
+  EXPECT_TRUE(read_json_file(eval_json).is_object());
+}
+
+}  // namespace
+}  // namespace litgs::testing
+
+namespace litgs::testing {
+namespace {
+
+// eval on its own, on the end-to-end test's run folder (its fixture).
+TEST(RunEval, JsonStatesLpipsAndRefusesASceneWithoutHeldOutViews) {
+  const fs::path dir = kRoot / "e2e";
+  ASSERT_TRUE(fs::exists(dir / "train" / "point_cloud.ply")) << "RunPipeline.SyntheticEndToEnd* makes it";
+  const std::string model = (dir / "train" / "point_cloud.ply").string(),
+                    scene = (dir / "import" / "scene").string();
+  CommandResult r = run_engine("eval --model " + model + " --scene " + scene +
+                               " --holdout-every 4 --emd-samples 50 --json");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(r.output.substr(r.output.find('{')));
+  EXPECT_NE(j["lpips"].get<std::string>().find("not available"), std::string::npos);
+  EXPECT_EQ(j["emd"]["samples"], 50);
+  EXPECT_LE(j["emd"]["mean_m"].get<double>(), 1e3);
+  r = run_engine("eval --model " + model + " --scene " + scene + " --holdout-every 0");
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("no held-out views to evaluate"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace litgs::testing
