@@ -51,10 +51,11 @@ void print_text(const host::ModelEvaluation& e) {
   if (e.emd)
     std::cout << "eval: EMD " << fixed(e.emd->mean_m, 4) << " m (sampling floor " << fixed(e.emd->floor_m, 4)
               << " m, std " << fixed(e.emd->std_m, 4) << " over " << e.emd->rounds << " draws of "
-              << e.emd->samples << " points; Gaussian centres by opacity against " << e.geometry_reference
-              << ", exact assignment)\n";
+              << e.emd->samples << " points; Gaussian centres "
+              << (e.emd->weighted_by_opacity ? "by opacity" : "uniformly") << " against "
+              << e.geometry_reference << ", exact assignment)\n";
   else
-    std::cout << "eval: EMD not measured (no reference cloud)\n";
+    std::cout << "eval: EMD not measured (--no-geometry, or no reference cloud)\n";
   if (e.centre_plane_counted > 0)
     std::cout << "eval: Gaussian centres to planes (" << e.plane_reference << "): RMS "
               << fixed(e.centre_plane_rms_m, 4) << " m, median " << fixed(e.centre_plane_median_m, 4)
@@ -105,6 +106,8 @@ void add_eval_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--seed", o->eval.emd.seed, "EMD: seed of the draws")->capture_default_str();
   cmd->add_flag("!--no-geometry", o->eval.geometry, "Skip EMD and the plane residuals");
+  cmd->add_flag("!--emd-uniform", o->eval.emd.weight_by_opacity,
+                "EMD: draw Gaussian centres uniformly instead of in proportion to opacity (a diagnostic)");
   cmd->callback([o] { run_eval(*o); });
 }
 

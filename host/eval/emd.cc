@@ -79,11 +79,14 @@ EmdResult gaussian_emd(const std::vector<Eigen::Vector3d>& centres, const std::v
   EmdResult r;
   r.samples = std::min(o.samples, reference.size());
   r.rounds = o.rounds;
+  r.weighted_by_opacity = o.weight_by_opacity;
   std::vector<double> per_round;
   for (uint32_t k = 0; k < o.rounds; ++k) {
     // A stream per draw, so that the reference draws do not depend on the model's size.
     const uint64_t seed = o.seed + 3 * uint64_t{k};
-    const auto a = sample_by_weight(centres, opacities, r.samples, seed);
+    const auto a = o.weight_by_opacity
+                       ? sample_by_weight(centres, opacities, r.samples, seed)
+                       : sample_by_weight(centres, std::vector<double>(centres.size(), 1.0), r.samples, seed);
     const auto b = sample_uniform(reference, r.samples, seed + 1);
     per_round.push_back(earth_movers_distance(a, b));
     r.floor_m += earth_movers_distance(sample_uniform(reference, r.samples, seed + 2), b) / o.rounds;

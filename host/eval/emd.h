@@ -27,6 +27,9 @@ struct EmdOptions {
   size_t samples = 1000;  // N per side (fewer if the reference cloud has fewer points)
   uint32_t rounds = 3;    // independent draws; the result is their mean and standard deviation
   uint64_t seed = 0;
+  // false: every Gaussian equally likely (a diagnostic: it separates where the model puts its opacity from
+  // where its centres are).
+  bool weight_by_opacity = true;
   void check() const;  // std::invalid_argument naming the bad field
 };
 
@@ -39,6 +42,7 @@ struct EmdResult {
   double floor_m = 0;
   size_t samples = 0;
   uint32_t rounds = 0;
+  bool weighted_by_opacity = true;
 };
 
 // EMD between Gaussian centres (drawn in proportion to `opacities`) and `reference`, both in one frame.

@@ -137,3 +137,34 @@ TEST(Emd, GaussianEmdOfAPerfectModelIsSmall) {
 
 }  // namespace
 }  // namespace litgs::host
+
+namespace litgs::host {
+namespace {
+
+TEST(Emd, UniformDrawsIgnoreOpacity) {
+  // Two clusters 10 m apart with the reference split evenly; all opacity on the first cluster. Weighted draws
+  // take only the first cluster, so half the mass must travel about 10 m (EMD near 5 m); uniform draws match
+  // the reference's split (EMD near the floor).
+  std::vector<Eigen::Vector3d> pts;
+  std::vector<double> opacity;
+  for (int i = 0; i < 200; ++i) {
+    pts.push_back({0.01 * i, 0, 0});
+    opacity.push_back(1.0);
+  }
+  for (int i = 0; i < 200; ++i) {
+    pts.push_back({10 + 0.01 * i, 0, 0});
+    opacity.push_back(0.0);
+  }
+  EmdOptions o;
+  o.samples = 100;
+  o.rounds = 1;
+  const EmdResult weighted = gaussian_emd(pts, opacity, pts, o);
+  o.weight_by_opacity = false;
+  const EmdResult uniform = gaussian_emd(pts, opacity, pts, o);
+  EXPECT_FALSE(uniform.weighted_by_opacity);
+  EXPECT_GT(weighted.mean_m, 3.0);
+  EXPECT_LT(uniform.mean_m, 1.0);
+}
+
+}  // namespace
+}  // namespace litgs::host
