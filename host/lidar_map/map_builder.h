@@ -40,8 +40,8 @@ struct LidarMapReport {
 // T_world_lidar at a LiDAR-clock time, or nullopt outside the trajectory.
 using LidarPoseAt = std::function<std::optional<Eigen::Matrix4d>(double t_lidar_s)>;
 
-// The scene's LiDAR pose: poses.txt (camera or IMU frame, on the camera clock) interpolated at
-// t_lidar - time_offset_cam_lidar_s, times T_cam_lidar or T_imu_lidar.
+// The scene's LiDAR pose: poses.txt interpolated (camera poses at t_lidar - time_offset_cam_lidar_s, IMU
+// poses, on the LiDAR clock, at t_lidar), times T_cam_lidar or T_imu_lidar.
 LidarPoseAt scene_lidar_pose(const io::Scene& scene);
 
 // The map from scans given one at a time (sensor frame; an extra field "time" holds each point's seconds

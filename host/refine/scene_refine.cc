@@ -43,11 +43,14 @@ std::vector<CameraPose> camera_poses_at(const std::vector<io::TumPose>& poses,
                                         const io::SceneConfig& config, const std::string& what) {
   std::vector<CameraPose> out;
   for (const auto& f : frames) {
-    const auto T = io::tum_pose_at(poses, f.t_s, 1e-6);
+    // IMU poses run on the LiDAR clock (the convention of export_scene).
+    const double t =
+        config.poses_frame == io::PoseFrame::kImu ? f.t_s + config.time_offset_cam_lidar_s : f.t_s;
+    const auto T = io::tum_pose_at(poses, t, 1e-6);
     if (!T)
       throw std::invalid_argument(what + " has no pose at frame time " + std::to_string(f.t_s) +
                                   " (outside the trajectory, or an unknown rotation)");
-    out.push_back(from_matrix(f.t_s, *T * body_from_camera(config)));
+    out.push_back(from_matrix(t, *T * body_from_camera(config)));
   }
   return out;
 }
