@@ -4,6 +4,7 @@
 #include <opencv2/core/hal/hal.hpp>
 #include <opencv2/features2d.hpp>
 #include <stdexcept>
+#include <string>
 
 namespace litgs::host::frontend {
 namespace {
@@ -13,6 +14,11 @@ cv::Mat descriptor_mat(const ImageFeatures& f) {
   if (f.float_descriptors)
     return cv::Mat(rows, f.descriptor_bytes / 4, CV_32F, const_cast<uint8_t*>(f.descriptors.data()));
   return cv::Mat(rows, f.descriptor_bytes, CV_8U, const_cast<uint8_t*>(f.descriptors.data()));
+}
+
+void check_same_kind(const ImageFeatures& a, const ImageFeatures& b, const char* who) {
+  if (a.float_descriptors != b.float_descriptors || a.descriptor_bytes != b.descriptor_bytes)
+    throw std::invalid_argument(std::string(who) + ": the two images have different descriptor kinds");
 }
 
 }  // namespace
@@ -26,8 +32,7 @@ std::vector<std::array<uint32_t, 2>> match_mutual(const ImageFeatures& a, const 
   o.check();
   std::vector<std::array<uint32_t, 2>> out;
   if (a.keypoints.empty() || b.keypoints.empty()) return out;
-  if (a.float_descriptors != b.float_descriptors || a.descriptor_bytes != b.descriptor_bytes)
-    throw std::invalid_argument("match_mutual: the two images have different descriptor kinds");
+  check_same_kind(a, b, "match_mutual");
   cv::BFMatcher matcher(a.float_descriptors ? cv::NORM_L2 : cv::NORM_HAMMING);
   const cv::Mat da = descriptor_mat(a), db = descriptor_mat(b);
   std::vector<std::vector<cv::DMatch>> ab, ba;
@@ -50,8 +55,7 @@ std::vector<std::array<uint32_t, 2>> match_mutual_among(const ImageFeatures& a, 
   o.check();
   std::vector<std::array<uint32_t, 2>> out;
   if (a.keypoints.empty() || b.keypoints.empty()) return out;
-  if (a.float_descriptors != b.float_descriptors || a.descriptor_bytes != b.descriptor_bytes)
-    throw std::invalid_argument("match_mutual_among: the two images have different descriptor kinds");
+  check_same_kind(a, b, "match_mutual_among");
   if (allowed.size() != a.keypoints.size())
     throw std::invalid_argument("match_mutual_among: one candidate list per keypoint of a is needed");
   const size_t bytes = static_cast<size_t>(a.descriptor_bytes);

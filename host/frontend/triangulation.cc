@@ -18,6 +18,21 @@ double error_px(const TriangulationView& v, const Eigen::Vector3d& X, double fx,
   return std::hypot((c.x() / c.z() - v.xy.x()) * fx, (c.y() / c.z() - v.xy.y()) * fy);
 }
 
+// The views whose reprojection error of X is below max_error_px; `sum` gets their errors' sum.
+std::vector<size_t> agreeing_views(const std::vector<TriangulationView>& views, const Eigen::Vector3d& X,
+                                   double fx, double fy, double max_error_px, double& sum) {
+  std::vector<size_t> agree;
+  sum = 0;
+  for (size_t k = 0; k < views.size(); ++k) {
+    const double e = error_px(views[k], X, fx, fy);
+    if (e < max_error_px) {
+      agree.push_back(k);
+      sum += e;
+    }
+  }
+  return agree;
+}
+
 Eigen::Vector3d centre(const TriangulationView& v) {
   return -v.R_cam_world.transpose() * v.t_cam_world;
 }
@@ -122,15 +137,8 @@ TriangulatedPoint triangulate(const std::vector<TriangulationView>& views, doubl
   for (const Candidate& c : candidates) {
     const Eigen::Vector3d X = triangulate_linear(views, {c.i, c.j});
     if (!X.allFinite()) continue;
-    std::vector<size_t> agree;
     double sum = 0;
-    for (size_t k = 0; k < views.size(); ++k) {
-      const double e = error_px(views[k], X, fx, fy);
-      if (e < o.max_error_px) {
-        agree.push_back(k);
-        sum += e;
-      }
-    }
+    const std::vector<size_t> agree = agreeing_views(views, X, fx, fy, o.max_error_px, sum);
     if (agree.size() > best_views.size() || (agree.size() == best_views.size() && sum < best_sum)) {
       best_views = agree;
       best_sum = sum;
@@ -145,15 +153,8 @@ TriangulatedPoint triangulate(const std::vector<TriangulationView>& views, doubl
   Eigen::Vector3d X = triangulate_linear(views, best_views);
   if (!X.allFinite()) X = best_X;
   X = refine(views, best_views, X, fx, fy, o.gauss_newton_iterations);
-  std::vector<size_t> agree;
   double sum = 0;
-  for (size_t k = 0; k < views.size(); ++k) {
-    const double e = error_px(views[k], X, fx, fy);
-    if (e < o.max_error_px) {
-      agree.push_back(k);
-      sum += e;
-    }
-  }
+  std::vector<size_t> agree = agreeing_views(views, X, fx, fy, o.max_error_px, sum);
   if (!X.allFinite() || agree.size() < o.min_views) {
     out.outcome = TriangulationOutcome::kLargeError;
     return out;

@@ -161,3 +161,35 @@ TEST_F(FrontendScene, BadOptionsAreNamed) {
 
 }  // namespace
 }  // namespace litgs::host::frontend
+
+namespace litgs::host::frontend {
+namespace {
+
+class SfmFiles : public testing::TempDirTest {};
+
+TEST_F(SfmFiles, RoundTripAndErrorsNameFileAndLine) {
+  io::SfmData d;
+  d.images = {{"thermal/1.png", false, {{1.5f, 2.25f, 3, 45}, {7, 8, 2, -1}}},
+              {"thermal/2.png", true, {}},
+              {"thermal/3.png", false, {{4, 5, 6, 7}}}};
+  d.pairs = {{0, 2, {{0, 0, true}, {1, 0, false}}}};
+  d.tracks = {{{{0, 0}, {2, 0}}, 0}};
+  d.points = {{Eigen::Vector3d(0.1, -2, 1e3 / 3), 0.25, {{0, 0}, {2, 0}}}};
+  write_sfm(dir_ / "sfm", d, "{}");
+  const io::SfmData back = io::read_sfm(dir_ / "sfm");
+  ASSERT_EQ(back.images.size(), 3u);
+  EXPECT_TRUE(back.images[1].frozen);
+  EXPECT_EQ(back.images[0].keypoints[0].y, 2.25f);
+  ASSERT_EQ(back.pairs.size(), 1u);
+  EXPECT_FALSE(back.pairs[0].matches[1].inlier);
+  EXPECT_EQ(back.tracks[0].observations, d.tracks[0].observations);
+  EXPECT_EQ(back.points[0].xyz, d.points[0].xyz);  // exact round trip
+  // A point that names a keypoint image 2 does not have.
+  std::ofstream(dir_ / "sfm/points.txt") << "# header\n0 0 0 1 0.5 2 0 0 2 1\n";
+  testing::expect_io_error([&] { io::read_sfm(dir_ / "sfm"); }, {"points.txt", ":2", "keypoint"});
+  d.points[0].xyz.x() = NAN;
+  EXPECT_THROW(write_sfm(dir_ / "sfm", d, "{}"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace litgs::host::frontend
