@@ -5,14 +5,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "host/refine/weights.h"
+
 namespace litgs::host::refine {
 namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 // median + k * 1.4826 * MAD, at least floor.
 double robust_bound(const std::vector<double>& v, double k, double floor) {
@@ -57,6 +53,8 @@ void deactivate_weak_points(std::vector<TrackPoint>& points, size_t* dropped) {
     }
 }
 
+}  // namespace
+
 bool all_finite(const std::vector<CameraPose>& poses, const std::vector<TrackPoint>& points) {
   for (const auto& c : poses)
     if (!c.p.allFinite() || !c.q.coeffs().allFinite()) return false;
@@ -64,8 +62,6 @@ bool all_finite(const std::vector<CameraPose>& poses, const std::vector<TrackPoi
     if (p.active && !p.X.allFinite()) return false;
   return true;
 }
-
-}  // namespace
 
 size_t TrackPoint::active_observations() const {
   size_t n = 0;

@@ -77,4 +77,7 @@ RefineReport refine(RefineInput& input, std::vector<CameraPose>& poses, const Re
 ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::vector<CameraPose>& poses,
                              const PinholeCamera& camera);
 
+// Every pose and every active point finite.
+bool all_finite(const std::vector<CameraPose>& poses, const std::vector<TrackPoint>& points);
+
 }  // namespace litgs::host::refine

@@ -7,13 +7,14 @@
 #include <stdexcept>
 
 namespace litgs::host::refine {
-namespace {
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
   return v[v.size() / 2];
 }
+
+namespace {
 
 // (x - median) / (1.4826 MAD), with the scale floored at `floor` so that a constant sequence gives zeros.
 std::vector<double> standardize(const std::vector<double>& x, double floor) {

@@ -26,14 +26,6 @@ double ate(const std::vector<CameraPose>& poses, const std::vector<CameraPose>& 
   return absolute_trajectory_error(tum(poses), tum(truth), AteAlignment::kSE3).rmse_m;
 }
 
-bool all_finite(const std::vector<CameraPose>& poses, const std::vector<TrackPoint>& points) {
-  for (const auto& c : poses)
-    if (!c.p.allFinite() || !c.q.coeffs().allFinite()) return false;
-  for (const auto& p : points)
-    if (p.active && !p.X.allFinite()) return false;
-  return true;
-}
-
 void make_test_scene(TestScene& s, const TestSceneOptions& o) {
   synth::World& w = s.world;
   w.add_texture({});

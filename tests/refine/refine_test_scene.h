@@ -46,6 +46,4 @@ void make_test_scene(TestScene& scene, const TestSceneOptions& options);
 // SE(3)-aligned ATE of poses against the truth.
 double ate(const std::vector<CameraPose>& poses, const std::vector<CameraPose>& truth);
 
-bool all_finite(const std::vector<CameraPose>& poses, const std::vector<TrackPoint>& points);
-
 }  // namespace litgs::host::refine::testing
