@@ -22,8 +22,9 @@
 namespace litgs::serve {
 
 struct ServeOptions {
-  std::string model;  // loaded as "default" at start
-  std::string scene;  // optional: poses in its frame, its cameras in GET /model
+  std::string model;   // loaded as "default" at start
+  std::string scene;   // optional: poses in its frame, its cameras in GET /model
+  std::string levels;  // train's levels.json of --model (default: the one beside it, if any): data units
   std::string host = "127.0.0.1";
   int port = 8080;        // 0: any free port (printed)
   size_t max_queue = 32;  // renders waiting for the device before 503
@@ -63,7 +64,9 @@ class Service {
   RenderedView render(const RenderRequest& request, ModelSummary* used);
   // Loads (or reloads) `name` from `path` (already confined): parsed here, uploaded on the device thread,
   // then swapped in atomically.
-  ModelSummary load(const std::string& name, const std::filesystem::path& path);
+  // The image units come from `levels` if given, else from a levels.json beside `path`.
+  ModelSummary load(const std::string& name, const std::filesystem::path& path,
+                    const std::string& levels = {});
   // The real frame `index` of the scene as an 8-bit PNG (16-bit frames stretched min-max); 404 if none.
   std::vector<uint8_t> scene_frame_png(size_t index) const;
   // Finishes the queued device work and stops the device thread.
