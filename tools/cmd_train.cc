@@ -226,7 +226,9 @@ void add_train_command(CLI::App& app) {
                 "The LiDAR term moves Gaussians but leaves their opacity to the image");
   cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")
       ->capture_default_str();
-  cmd->add_option("--init", o->init, "auto (LiDAR map, else random), random, sfm (the front end's points in SCENE/sfm/), or a .ply/.pcd point file")
+  cmd->add_option("--init", o->init,
+                  "auto (LiDAR map, else random), random, sfm (the front end's points in SCENE/sfm/), or a "
+                  ".ply/.pcd point file")
       ->capture_default_str();
   cmd->add_option("--init-flatness", o->init_flatness,
                   "LiDAR-map init: thickness / radius of the discs on LiDAR planes (1: spheres)")

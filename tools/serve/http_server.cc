@@ -168,6 +168,10 @@ void add_routes(httplib::Server& svr, Service& service) {
                 "# HELP litgs_queue_depth Device jobs waiting.\n# TYPE litgs_queue_depth gauge\n";
             gauges += "litgs_queue_depth " + std::to_string(service.queue_depth()) + "\n";
             gauges +=
+                "# HELP litgs_renders_in_flight Render requests not yet answered.\n# TYPE "
+                "litgs_renders_in_flight gauge\nlitgs_renders_in_flight " +
+                std::to_string(service.renders_in_flight()) + "\n";
+            gauges +=
                 "# HELP litgs_model_gaussians Gaussians of each loaded model.\n# TYPE litgs_model_gaussians "
                 "gauge\n";
             std::string bytes =

@@ -104,6 +104,11 @@ Result Service::on_device(Job&& job, double timeout_s, const char* what) {
 }
 
 RenderedView Service::render(const RenderRequest& r, ModelSummary* used) {
+  ++renders_in_flight_;
+  struct InFlight {
+    std::atomic<size_t>& count;
+    ~InFlight() { --count; }
+  } counted{renders_in_flight_};
   const std::optional<ModelSummary> summary = models_.summary(r.model);
   if (!summary) {
     std::string names;

@@ -2,6 +2,7 @@
 // the scene's cameras. http_server.cc maps requests onto it.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -55,6 +56,8 @@ class Service {
   Metrics& metrics() { return metrics_; }
   const std::vector<SceneCamera>& scene_cameras() const { return scene_cameras_; }
   size_t queue_depth() const { return worker_->depth(); }
+  // Render requests accepted and not yet answered (queued, on the device, or being encoded).
+  size_t renders_in_flight() const { return renders_in_flight_.load(); }
   const engine::DeviceInfo& device() const { return device_info_; }
   // Validation-layer errors so far, where the layer is on (LITGS_VALIDATION=1; the tests use it).
   std::optional<size_t> validation_errors() const;
@@ -73,6 +76,7 @@ class Service {
   void stop();
 
  private:
+  std::atomic<size_t> renders_in_flight_{0};
   template <class Result, class Job>
   Result on_device(Job&& job, double timeout_s, const char* what);
 
