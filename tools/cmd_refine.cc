@@ -31,7 +31,8 @@ void add_refine_command(CLI::App& app) {
       ->capture_default_str();
   c->add_option(
        "--tracks", o->tracks,
-       "Track source: synthetic (from a synth scene's ground truth, until the front end writes tracks)")
+       "Track source: sfm (the front end's SCENE/sfm/, from litgs-engine match), synthetic (from a synth "
+       "scene's ground truth), auto (sfm when present, else synthetic)")
       ->capture_default_str();
   c->add_option("--outliers", o->synthetic.outlier_fraction, "Synthetic tracks: fraction of wrong matches")
       ->capture_default_str();
@@ -42,11 +43,12 @@ void add_refine_command(CLI::App& app) {
     o->refine.use_planes = *planes;
     const host::refine::SceneRefineReport r = host::refine::refine_scene(*scene, *o);
     const auto& rr = r.refine;
-    std::cout << std::fixed << std::setprecision(3) << "refine: " << rr.status << "; " << rr.frames
-              << " frames, " << r.points_written << " points (" << rr.anchor_association.anchored_tracks
-              << " anchored), " << rr.rounds.size() << " rounds in " << rr.seconds << " s; reprojection RMS "
-              << rr.before.reprojection_rms_px << " -> " << rr.after.reprojection_rms_px << " px, plane RMS "
-              << rr.before.plane_rms_m << " -> " << rr.after.plane_rms_m << " m";
+    std::cout << std::fixed << std::setprecision(3) << "refine: " << rr.status << "; " << r.tracks
+              << " tracks; " << rr.frames << " frames, " << r.points_written << " points ("
+              << rr.anchor_association.anchored_tracks << " anchored), " << rr.rounds.size() << " rounds in "
+              << rr.seconds << " s; reprojection RMS " << rr.before.reprojection_rms_px << " -> "
+              << rr.after.reprojection_rms_px << " px, plane RMS " << rr.before.plane_rms_m << " -> "
+              << rr.after.plane_rms_m << " m";
     if (r.has_truth) std::cout << "; ATE " << r.ate_before_m << " -> " << r.ate_after_m << " m";
     std::cout << "\n";
     for (const auto& note : rr.notes) std::cout << "  note: " << note << "\n";

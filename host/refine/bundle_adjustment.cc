@@ -150,7 +150,7 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
       const size_t a = static_cast<size_t>(p.anchor);
       auto* cost = new ceres::AutoDiffCostFunction<AnchorPrior, 3, 3>(
           new AnchorPrior{(*b.anchors)[a].p, b.anchor_sqrt_information[a]});
-      problem.AddResidualBlock(cost, new ceres::HuberLoss(w.anchor_loss), p.X.data());
+      problem.AddResidualBlock(cost, new ceres::CauchyLoss(w.anchor_loss), p.X.data());
       ++s.anchor_residuals;
     }
   }

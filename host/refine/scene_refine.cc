@@ -11,6 +11,7 @@
 #include "io/pcd.h"
 #include "io/scene.h"
 #include "io/scene_text.h"
+#include "io/sfm_files.h"
 
 namespace litgs::host::refine {
 namespace fs = std::filesystem;
@@ -161,7 +162,7 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                       {"rounds", rounds},
                       {"seconds", r.seconds},
                       {"notes", r.notes},
-                      {"tracks", o.tracks},
+                      {"tracks", sr.tracks},
                       {"options",
                        {{"rounds", o.refine.rounds},
                         {"anchors", o.refine.use_anchors},
@@ -170,6 +171,11 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                         {"alpha_max", o.refine.weights.alpha_max},
                         {"window", o.refine.window},
                         {"threads", o.refine.threads}}}};
+  if (sr.tracks == "sfm")
+    j["sfm"] = {{"tracks", sr.sfm.tracks},
+                {"from_front_end_points", sr.sfm.from_front_end_points},
+                {"triangulated_here", sr.sfm.triangulated_here},
+                {"untriangulated", sr.sfm.untriangulated}};
   if (sr.has_truth) {
     j["ate_before_m"] = sr.ate_before_m;
     j["ate_after_m"] = sr.ate_after_m;
@@ -186,9 +192,7 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   ro.check_images = false;
   const io::Scene scene = io::read_scene(dir, ro);
   const io::CameraIntrinsics& k = scene.config.camera;
-  for (double d : k.distortion)
-    if (d != 0 && o.tracks != "synthetic")
-      throw std::invalid_argument("refine: the camera has distortion; tracks must come undistorted");
+  const std::string source = o.tracks != "auto" ? o.tracks : io::has_sfm(dir / "sfm") ? "sfm" : "synthetic";
   RefineInput in;
   in.camera = {k.fx, k.fy, k.cx, k.cy, k.width, k.height};
   const fs::path prior_path = dir / "poses_prior.txt";
@@ -204,8 +208,17 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
     truth = camera_poses_at(scene.gt->poses, scene.frames, scene.config, "gt/poses.txt");
     report.has_truth = true;
   }
-  if (o.tracks == "synthetic") {
-    if (truth.empty()) throw std::invalid_argument("refine --tracks synthetic needs gt/poses.txt");
+  report.tracks = source;
+  if (source == "sfm") {
+    if (!io::has_sfm(dir / "sfm"))
+      throw std::invalid_argument((dir / "sfm").string() +
+                                  ": no front-end tracks here (run litgs-engine match SCENE first)");
+    in.points = sfm_tracks(io::read_sfm(dir / "sfm"), k, in.priors, &report.sfm);
+  } else if (source == "synthetic") {
+    if (truth.empty())
+      throw std::invalid_argument(dir.string() +
+                                  ": no front-end tracks (sfm/) and no gt/poses.txt for synthetic ones; "
+                                  "run litgs-engine match SCENE first");
     const synth::World world = synthetic_world(scene.config, dir);
     std::vector<Eigen::Vector3d> anchors_true;
     if (fs::exists(dir / "gt/anchors.txt"))
@@ -214,7 +227,7 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
     if (fs::exists(dir / "gt/frozen.txt")) so.frozen_frames = read_frozen(dir / "gt/frozen.txt");
     in.points = synthetic_tracks(world, truth, in.priors, in.camera, anchors_true, so);
   } else {
-    throw std::invalid_argument("refine: unknown track source '" + o.tracks + "' (synthetic)");
+    throw std::invalid_argument("refine: unknown track source '" + o.tracks + "' (auto, sfm, synthetic)");
   }
   PlanarMap planar;
   if (scene.map && o.refine.use_planes) {
