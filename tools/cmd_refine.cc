@@ -38,6 +38,14 @@ void add_refine_command(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--pixel-noise", o->synthetic.pixel_noise_px, "Synthetic tracks: pixel noise (px)")
       ->capture_default_str();
+  c->add_flag("--absolute-priors", o->refine.ba.absolute_priors,
+              "The prior poses are absolute (Metashape, COLMAP with control points), not an odometry: a pose "
+              "prior on every frame");
+  c->add_option("--control-points", o->control_points_csv,
+                "Surveyed control points (CSV: ID,X,Y,Z,accuracy) to check the poses with (needs --markers)")
+      ->check(CLI::ExistingFile);
+  c->add_option("--markers", o->markers_xml, "Metashape camera XML with the control points' image observations")
+      ->check(CLI::ExistingFile);
   c->callback([scene, o, anchors, planes] {
     o->refine.use_anchors = *anchors;
     o->refine.use_planes = *planes;
@@ -51,6 +59,10 @@ void add_refine_command(CLI::App& app) {
               << rr.after.plane_rms_m << " m";
     if (r.has_truth) std::cout << "; ATE " << r.ate_before_m << " -> " << r.ate_after_m << " m";
     std::cout << "\n";
+    if (r.control)
+      std::cout << "control points: median reprojection " << r.control->median_prior_px
+                << " px through the prior poses, " << r.control->median_refined_px
+                << " px through the refined poses (" << r.control->observations << " observations)\n";
     for (const auto& note : rr.notes) std::cout << "  note: " << note << "\n";
   });
 }

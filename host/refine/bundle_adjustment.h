@@ -31,6 +31,9 @@ struct BaWeights {
   double rel_sigma_r_per_m = 0.002;  // ... plus this per metre travelled
   double gauge_sigma_t_m = 0.01;     // the first frame's pose prior: the odometry's per-frame accuracy
   double gauge_sigma_r_rad = 0.003;  // (as rel_sigma_t_m, rel_sigma_r_rad)
+  // Priors that are absolute (a georeferenced photogrammetric solution such as Metashape's, not an
+  // odometry): every frame, not only the first, gets the gauge prior.
+  bool absolute_priors = false;
 };
 
 struct BaProblem {

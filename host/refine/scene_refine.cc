@@ -170,7 +170,13 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                         {"alpha_min", o.refine.weights.alpha_min},
                         {"alpha_max", o.refine.weights.alpha_max},
                         {"window", o.refine.window},
-                        {"threads", o.refine.threads}}}};
+                        {"threads", o.refine.threads},
+                        {"absolute_priors", o.refine.ba.absolute_priors}}}};
+  if (sr.control)
+    j["control_points"] = {{"observations", sr.control->observations},
+                           {"unmatched_cameras", sr.control->unmatched_cameras},
+                           {"median_prior_px", sr.control->median_prior_px},
+                           {"median_refined_px", sr.control->median_refined_px}};
   if (sr.tracks == "sfm")
     j["sfm"] = {{"tracks", sr.sfm.tracks},
                 {"from_front_end_points", sr.sfm.from_front_end_points},
@@ -203,6 +209,15 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   for (const auto& a : scene.anchors) in.anchors.push_back({a.p_world, a.cov_m2});
 
   SceneRefineReport report;
+  if (o.control_points_csv.empty() != o.markers_xml.empty())
+    throw std::invalid_argument("refine: control points need both the CSV and the markers' XML");
+  // Read first: a bad file stops before anything is written.
+  std::vector<io::ControlPoint> control_points;
+  std::optional<io::MetashapeDocument> markers;
+  if (!o.control_points_csv.empty()) {
+    control_points = io::read_control_points_csv(o.control_points_csv);
+    markers = io::read_metashape_xml(o.markers_xml);
+  }
   std::vector<CameraPose> truth;
   if (scene.gt && scene.gt->poses.size() >= 3) {
     truth = camera_poses_at(scene.gt->poses, scene.frames, scene.config, "gt/poses.txt");
@@ -237,6 +252,9 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   std::vector<CameraPose> poses = in.priors;
   report.refine = refine(in, poses, o.refine);
 
+  if (markers)
+    report.control = control_point_errors(*markers, control_points, scene.config.world_offset_m, in.camera,
+                                          in.priors, poses);
   if (report.has_truth) {
     report.ate_before_m =
         absolute_trajectory_error(to_tum(in.priors, {}), to_tum(truth, {}), AteAlignment::kSE3).rmse_m;

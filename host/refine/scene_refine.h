@@ -5,8 +5,10 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
+#include "host/refine/control_points.h"
 #include "host/refine/refine.h"
 #include "host/refine/sfm_tracks.h"
 #include "host/refine/synthetic_tracks.h"
@@ -20,6 +22,8 @@ struct SceneRefineOptions {
   // has it, else synthetic.
   std::string tracks = "auto";
   SyntheticTrackOptions synthetic;
+  // With both: the surveyed control points' reprojection through the prior and the refined poses.
+  std::filesystem::path control_points_csv, markers_xml;
 };
 
 struct SceneRefineReport {
@@ -30,6 +34,7 @@ struct SceneRefineReport {
   size_t points_written = 0;
   std::string tracks;  // the source used: "sfm" or "synthetic"
   SfmTrackReport sfm;  // with tracks == "sfm"
+  std::optional<ControlPointErrors> control;
 };
 
 SceneRefineReport refine_scene(const std::filesystem::path& scene_dir, const SceneRefineOptions& options);
