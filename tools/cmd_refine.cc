@@ -44,7 +44,8 @@ void add_refine_command(CLI::App& app) {
   c->add_option("--control-points", o->control_points_csv,
                 "Surveyed control points (CSV: ID,X,Y,Z,accuracy) to check the poses with (needs --markers)")
       ->check(CLI::ExistingFile);
-  c->add_option("--markers", o->markers_xml, "Metashape camera XML with the control points' image observations")
+  c->add_option("--markers", o->markers_xml,
+                "Metashape camera XML with the control points' image observations")
       ->check(CLI::ExistingFile);
   c->callback([scene, o, anchors, planes] {
     o->refine.use_anchors = *anchors;

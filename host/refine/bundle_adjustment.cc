@@ -174,7 +174,8 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
     add_pose(f);
     auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(
         new AbsolutePose{priors[f].q, priors[f].p, 1 / w.gauge_sigma_t_m, 1 / w.gauge_sigma_r_rad});
-    problem.AddResidualBlock(cost, nullptr, poses[f].q.coeffs().data(), poses[f].p.data());
+    problem.AddResidualBlock(cost, w.absolute_priors ? nullptr : new ceres::CauchyLoss(1.0),
+                             poses[f].q.coeffs().data(), poses[f].p.data());
     ++s.prior_residuals;
   }
   if (problem.NumResidualBlocks() == 0) {

@@ -7,7 +7,8 @@
 // - relative-pose priors between consecutive frames from the odometry (the priors' relative motion; sigma
 //   grows with the distance travelled), which keep metric scale, and a prior on the first frame's
 //   pose at the odometry's own per-frame accuracy (the map and the odometry share their first frame), which
-//   holds the gauge where planes do not (along a street, translation along it);
+//   holds the gauge where planes do not (along a street, translation along it); Cauchy loss at 1 sigma, so
+//   that priors offset from the map as a whole (a false statement of that accuracy) give way to the planes;
 // - anchor position priors L^-1 (X - a) with the anchor's (guarded) covariance Sigma = L L^T, Cauchy loss
 //   at 1 sigma: a wrongly associated anchor (a neighbouring track) loses its pull instead of keeping the
 //   constant pull of a Huber loss.

@@ -13,7 +13,7 @@
 namespace litgs::host::refine {
 
 struct ControlPointErrors {
-  size_t observations = 0;  // marker observations in a camera that matches a frame
+  size_t observations = 0;       // marker observations in a camera that matches a frame
   size_t unmatched_cameras = 0;  // observations whose camera matches no frame's prior pose
   double median_prior_px = 0, median_refined_px = 0;
 };
