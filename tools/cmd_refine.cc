@@ -31,24 +31,39 @@ void add_refine_command(CLI::App& app) {
       ->capture_default_str();
   c->add_option(
        "--tracks", o->tracks,
-       "Track source: synthetic (from a synth scene's ground truth, until the front end writes tracks)")
+       "Track source: sfm (the front end's SCENE/sfm/, from litgs-engine match), synthetic (from a synth "
+       "scene's ground truth), auto (sfm when present, else synthetic)")
       ->capture_default_str();
   c->add_option("--outliers", o->synthetic.outlier_fraction, "Synthetic tracks: fraction of wrong matches")
       ->capture_default_str();
   c->add_option("--pixel-noise", o->synthetic.pixel_noise_px, "Synthetic tracks: pixel noise (px)")
       ->capture_default_str();
+  c->add_flag("--absolute-priors", o->refine.ba.absolute_priors,
+              "The prior poses are absolute (Metashape, COLMAP with control points), not an odometry: a pose "
+              "prior on every frame");
+  c->add_option("--control-points", o->control_points_csv,
+                "Surveyed control points (CSV: ID,X,Y,Z,accuracy) to check the poses with (needs --markers)")
+      ->check(CLI::ExistingFile);
+  c->add_option("--markers", o->markers_xml,
+                "Metashape camera XML with the control points' image observations")
+      ->check(CLI::ExistingFile);
   c->callback([scene, o, anchors, planes] {
     o->refine.use_anchors = *anchors;
     o->refine.use_planes = *planes;
     const host::refine::SceneRefineReport r = host::refine::refine_scene(*scene, *o);
     const auto& rr = r.refine;
-    std::cout << std::fixed << std::setprecision(3) << "refine: " << rr.status << "; " << rr.frames
-              << " frames, " << r.points_written << " points (" << rr.anchor_association.anchored_tracks
-              << " anchored), " << rr.rounds.size() << " rounds in " << rr.seconds << " s; reprojection RMS "
-              << rr.before.reprojection_rms_px << " -> " << rr.after.reprojection_rms_px << " px, plane RMS "
-              << rr.before.plane_rms_m << " -> " << rr.after.plane_rms_m << " m";
+    std::cout << std::fixed << std::setprecision(3) << "refine: " << rr.status << "; " << r.tracks
+              << " tracks; " << rr.frames << " frames, " << r.points_written << " points ("
+              << rr.anchor_association.anchored_tracks << " anchored), " << rr.rounds.size() << " rounds in "
+              << rr.seconds << " s; reprojection RMS " << rr.before.reprojection_rms_px << " -> "
+              << rr.after.reprojection_rms_px << " px, plane RMS " << rr.before.plane_rms_m << " -> "
+              << rr.after.plane_rms_m << " m";
     if (r.has_truth) std::cout << "; ATE " << r.ate_before_m << " -> " << r.ate_after_m << " m";
     std::cout << "\n";
+    if (r.control)
+      std::cout << "control points: median reprojection " << r.control->median_prior_px
+                << " px through the prior poses, " << r.control->median_refined_px
+                << " px through the refined poses (" << r.control->observations << " observations)\n";
     for (const auto& note : rr.notes) std::cout << "  note: " << note << "\n";
   });
 }

@@ -7,6 +7,8 @@
 #include <optional>
 #include <unordered_map>
 
+#include "host/refine/triangulation.h"
+
 namespace litgs::host::refine {
 namespace {
 
@@ -113,7 +115,13 @@ AnchorAssociationReport associate_anchors(std::vector<TrackPoint>& points,
       size_t shared = 0;  // frames that see the anchor and observe the track
       for (const auto& ob : points[track].obs)
         shared += ob.active && std::binary_search(visible[a].begin(), visible[a].end(), ob.frame);
-      if (n >= o.min_agreeing && 2 * n >= shared)
+      // The track's own point, triangulated again from its observations: the refined X of a track that
+      // held this anchor in the previous round was pulled to it and would confirm itself.
+      if (n < o.min_agreeing || 2 * n < shared) continue;
+      const auto X = triangulate(points[track].obs, poses, camera);
+      if (!X) continue;
+      const Eigen::Vector3d e = *X - anchors[a].p;
+      if (e.dot(anchors[a].cov.ldlt().solve(e)) <= o.gate_chi2)  // NaN fails too
         pairs.emplace_back(n, -dist[a][track] / static_cast<double>(n), a, track);
     }
   }

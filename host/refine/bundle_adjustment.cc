@@ -150,7 +150,7 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
       const size_t a = static_cast<size_t>(p.anchor);
       auto* cost = new ceres::AutoDiffCostFunction<AnchorPrior, 3, 3>(
           new AnchorPrior{(*b.anchors)[a].p, b.anchor_sqrt_information[a]});
-      problem.AddResidualBlock(cost, new ceres::HuberLoss(w.anchor_loss), p.X.data());
+      problem.AddResidualBlock(cost, new ceres::CauchyLoss(w.anchor_loss), p.X.data());
       ++s.anchor_residuals;
     }
   }
@@ -169,11 +169,13 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
                              poses[f + 1].q.coeffs().data(), poses[f + 1].p.data());
     ++s.prior_residuals;
   }
-  if (n > 0 && variable(0)) {
-    add_pose(0);
+  for (size_t f = 0; f < (w.absolute_priors ? n : std::min<size_t>(n, 1)); ++f) {
+    if (!variable(f)) continue;
+    add_pose(f);
     auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(
-        new AbsolutePose{priors[0].q, priors[0].p, 1 / w.gauge_sigma_t_m, 1 / w.gauge_sigma_r_rad});
-    problem.AddResidualBlock(cost, nullptr, poses[0].q.coeffs().data(), poses[0].p.data());
+        new AbsolutePose{priors[f].q, priors[f].p, 1 / w.gauge_sigma_t_m, 1 / w.gauge_sigma_r_rad});
+    problem.AddResidualBlock(cost, w.absolute_priors ? nullptr : new ceres::CauchyLoss(1.0),
+                             poses[f].q.coeffs().data(), poses[f].p.data());
     ++s.prior_residuals;
   }
   if (problem.NumResidualBlocks() == 0) {

@@ -5,9 +5,13 @@
 // - the signed point-to-plane distance n . (X - l) / plane_sigma_m of a point associated with a LiDAR
 //   plane (Huber at 1 sigma; a signed residual, differentiable at zero), scaled by the point's weight;
 // - relative-pose priors between consecutive frames from the odometry (the priors' relative motion; sigma
-//   grows with the distance travelled), which keep metric scale, and a weak prior on the first frame's
-//   pose (gauge sigmas), which holds the gauge when neither planes nor anchors do;
-// - anchor position priors L^-1 (X - a) with the anchor's (guarded) covariance Sigma = L L^T.
+//   grows with the distance travelled), which keep metric scale, and a prior on the first frame's
+//   pose at the odometry's own per-frame accuracy (the map and the odometry share their first frame), which
+//   holds the gauge where planes do not (along a street, translation along it); Cauchy loss at 1 sigma, so
+//   that priors offset from the map as a whole (a false statement of that accuracy) give way to the planes;
+// - anchor position priors L^-1 (X - a) with the anchor's (guarded) covariance Sigma = L L^T, Cauchy loss
+//   at 1 sigma: a wrongly associated anchor (a neighbouring track) loses its pull instead of keeping the
+//   constant pull of a Huber loss.
 // Ceres stays inside bundle_adjustment.cc.
 #pragma once
 
@@ -21,13 +25,16 @@ namespace litgs::host::refine {
 struct BaWeights {
   double pixel_loss_px = 2;          // Cauchy scale of the reprojection residual
   double plane_sigma_m = 0.02;       // point-to-plane: residual = distance / sigma
-  double anchor_loss = 3;            // Huber scale of the whitened anchor residual
+  double anchor_loss = 1;            // Cauchy scale of the whitened anchor residual
   double rel_sigma_t_m = 0.01;       // relative-pose prior: translation sigma ...
   double rel_sigma_t_per_m = 0.02;   // ... plus this per metre travelled between the frames
   double rel_sigma_r_rad = 0.003;    // rotation sigma ...
   double rel_sigma_r_per_m = 0.002;  // ... plus this per metre travelled
-  double gauge_sigma_t_m = 1.0;      // the first frame's pose prior: weak, planes and anchors override it
-  double gauge_sigma_r_rad = 0.1;
+  double gauge_sigma_t_m = 0.01;     // the first frame's pose prior: the odometry's per-frame accuracy
+  double gauge_sigma_r_rad = 0.003;  // (as rel_sigma_t_m, rel_sigma_r_rad)
+  // Priors that are absolute (a georeferenced photogrammetric solution such as Metashape's, not an
+  // odometry): every frame, not only the first, gets the gauge prior.
+  bool absolute_priors = false;
 };
 
 struct BaProblem {

@@ -16,10 +16,11 @@ namespace litgs::host::refine {
 struct RefineOptions {
   size_t rounds = 3;
   bool use_anchors = true, use_planes = true;
-  size_t window = 20;            // frames per local window (step: half of it); 0: no local pass
-  double reject_k = 3;           // rejection bound: median + k * 1.4826 * MAD ...
-  double reject_floor_px = 1.5;  // ... but never below this (reprojection, pixels)
-  double reject_floor_m = 0.03;  // ... or this (point-to-plane, metres)
+  size_t window = 20;             // frames per local window (step: half of it); 0: no local pass
+  double reject_k = 3;            // rejection bound: median + k * 1.4826 * MAD ...
+  double reject_floor_px = 1.5;   // ... but never below this (reprojection, pixels)
+  double reject_floor_m = 0.03;   // ... or this (point-to-plane, metres)
+  size_t anchors_from_round = 1;  // 0-based: the first round is solved without anchors (docs/refinement.md)
   int threads = 1;
   int max_iterations = 50;  // per Ceres solve
   WeightOptions weights;

@@ -11,6 +11,7 @@
 #include "io/pcd.h"
 #include "io/scene.h"
 #include "io/scene_text.h"
+#include "io/sfm_files.h"
 
 namespace litgs::host::refine {
 namespace fs = std::filesystem;
@@ -161,7 +162,7 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                       {"rounds", rounds},
                       {"seconds", r.seconds},
                       {"notes", r.notes},
-                      {"tracks", o.tracks},
+                      {"tracks", sr.tracks},
                       {"options",
                        {{"rounds", o.refine.rounds},
                         {"anchors", o.refine.use_anchors},
@@ -169,7 +170,18 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                         {"alpha_min", o.refine.weights.alpha_min},
                         {"alpha_max", o.refine.weights.alpha_max},
                         {"window", o.refine.window},
-                        {"threads", o.refine.threads}}}};
+                        {"threads", o.refine.threads},
+                        {"absolute_priors", o.refine.ba.absolute_priors}}}};
+  if (sr.control)
+    j["control_points"] = {{"observations", sr.control->observations},
+                           {"unmatched_cameras", sr.control->unmatched_cameras},
+                           {"median_prior_px", sr.control->median_prior_px},
+                           {"median_refined_px", sr.control->median_refined_px}};
+  if (sr.tracks == "sfm")
+    j["sfm"] = {{"tracks", sr.sfm.tracks},
+                {"from_front_end_points", sr.sfm.from_front_end_points},
+                {"triangulated_here", sr.sfm.triangulated_here},
+                {"untriangulated", sr.sfm.untriangulated}};
   if (sr.has_truth) {
     j["ate_before_m"] = sr.ate_before_m;
     j["ate_after_m"] = sr.ate_after_m;
@@ -186,9 +198,7 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   ro.check_images = false;
   const io::Scene scene = io::read_scene(dir, ro);
   const io::CameraIntrinsics& k = scene.config.camera;
-  for (double d : k.distortion)
-    if (d != 0 && o.tracks != "synthetic")
-      throw std::invalid_argument("refine: the camera has distortion; tracks must come undistorted");
+  const std::string source = o.tracks != "auto" ? o.tracks : io::has_sfm(dir / "sfm") ? "sfm" : "synthetic";
   RefineInput in;
   in.camera = {k.fx, k.fy, k.cx, k.cy, k.width, k.height};
   const fs::path prior_path = dir / "poses_prior.txt";
@@ -199,13 +209,31 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   for (const auto& a : scene.anchors) in.anchors.push_back({a.p_world, a.cov_m2});
 
   SceneRefineReport report;
+  if (o.control_points_csv.empty() != o.markers_xml.empty())
+    throw std::invalid_argument("refine: control points need both the CSV and the markers' XML");
+  // Read first: a bad file stops before anything is written.
+  std::vector<io::ControlPoint> control_points;
+  std::optional<io::MetashapeDocument> markers;
+  if (!o.control_points_csv.empty()) {
+    control_points = io::read_control_points_csv(o.control_points_csv);
+    markers = io::read_metashape_xml(o.markers_xml);
+  }
   std::vector<CameraPose> truth;
   if (scene.gt && scene.gt->poses.size() >= 3) {
     truth = camera_poses_at(scene.gt->poses, scene.frames, scene.config, "gt/poses.txt");
     report.has_truth = true;
   }
-  if (o.tracks == "synthetic") {
-    if (truth.empty()) throw std::invalid_argument("refine --tracks synthetic needs gt/poses.txt");
+  report.tracks = source;
+  if (source == "sfm") {
+    if (!io::has_sfm(dir / "sfm"))
+      throw std::invalid_argument((dir / "sfm").string() +
+                                  ": no front-end tracks here (run litgs-engine match SCENE first)");
+    in.points = sfm_tracks(io::read_sfm(dir / "sfm"), k, in.priors, &report.sfm);
+  } else if (source == "synthetic") {
+    if (truth.empty())
+      throw std::invalid_argument(dir.string() +
+                                  ": no front-end tracks (sfm/) and no gt/poses.txt for synthetic ones; "
+                                  "run litgs-engine match SCENE first");
     const synth::World world = synthetic_world(scene.config, dir);
     std::vector<Eigen::Vector3d> anchors_true;
     if (fs::exists(dir / "gt/anchors.txt"))
@@ -214,7 +242,7 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
     if (fs::exists(dir / "gt/frozen.txt")) so.frozen_frames = read_frozen(dir / "gt/frozen.txt");
     in.points = synthetic_tracks(world, truth, in.priors, in.camera, anchors_true, so);
   } else {
-    throw std::invalid_argument("refine: unknown track source '" + o.tracks + "' (synthetic)");
+    throw std::invalid_argument("refine: unknown track source '" + o.tracks + "' (auto, sfm, synthetic)");
   }
   PlanarMap planar;
   if (scene.map && o.refine.use_planes) {
@@ -224,6 +252,9 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   std::vector<CameraPose> poses = in.priors;
   report.refine = refine(in, poses, o.refine);
 
+  if (markers)
+    report.control = control_point_errors(*markers, control_points, scene.config.world_offset_m, in.camera,
+                                          in.priors, poses);
   if (report.has_truth) {
     report.ate_before_m =
         absolute_trajectory_error(to_tum(in.priors, {}), to_tum(truth, {}), AteAlignment::kSE3).rmse_m;

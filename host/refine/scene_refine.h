@@ -5,19 +5,25 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
+#include "host/refine/control_points.h"
 #include "host/refine/refine.h"
+#include "host/refine/sfm_tracks.h"
 #include "host/refine/synthetic_tracks.h"
 
 namespace litgs::host::refine {
 
 struct SceneRefineOptions {
   RefineOptions refine;
-  // Where the tracks come from. "synthetic": from a synthetic scene's ground truth (synthetic_tracks.h),
-  // the stand-in until the thermal front end writes its tracks.
-  std::string tracks = "synthetic";
+  // Where the tracks come from. "sfm": the front end's SCENE/sfm/ (`litgs-engine match`, sfm_tracks.h);
+  // "synthetic": from a synthetic scene's ground truth (synthetic_tracks.h); "auto": sfm/ when the scene
+  // has it, else synthetic.
+  std::string tracks = "auto";
   SyntheticTrackOptions synthetic;
+  // With both: the surveyed control points' reprojection through the prior and the refined poses.
+  std::filesystem::path control_points_csv, markers_xml;
 };
 
 struct SceneRefineReport {
@@ -26,6 +32,9 @@ struct SceneRefineReport {
   double ate_before_m = 0, ate_after_m = 0;  // SE(3)-aligned, against gt/poses.txt at the frame times
   double plane_rms_true_m = -1;  // refined points on true planes (gt/map.pcd plane ids): RMS distance
   size_t points_written = 0;
+  std::string tracks;  // the source used: "sfm" or "synthetic"
+  SfmTrackReport sfm;  // with tracks == "sfm"
+  std::optional<ControlPointErrors> control;
 };
 
 SceneRefineReport refine_scene(const std::filesystem::path& scene_dir, const SceneRefineOptions& options);
