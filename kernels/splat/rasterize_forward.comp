@@ -35,7 +35,7 @@ layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]
 // pixels, and every lane then reads those entries from lane k by shuffle, in list order. No shared memory,
 // no barriers; on CPU drivers a shuffle is a register permute, far cheaper than a load per entry.
 void main() {
-  const uvec2 pixel = gl_GlobalInvocationID.xy;
+  const uvec2 pixel = tile_pixel();
   const bool inside = pixel.x < view.width && pixel.y < view.height;
   const uint tile = gl_WorkGroupID.y * view.tiles_x + gl_WorkGroupID.x;
   const uvec2 range = ranges[tile];
@@ -77,7 +77,8 @@ void main() {
       conic_opacity = vec4(conic, opacity);
       for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
       depth = depths[g];
-      relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
+      relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi) &&
+                 footprint_touches_box(mean_extent, conic_opacity, subgroup_lo, subgroup_hi);
     }
     uvec4 todo = subgroupBallot(relevant);
     for (uint word = 0u; word < 4u; ++word) {
