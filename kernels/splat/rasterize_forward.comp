@@ -52,6 +52,7 @@ void main() {
   vec4 accum = vec4(0.0);  // a vector, not an array: CPU drivers spill dynamically indexed arrays
   float depth_sum = 0.0;
   uint last = 0u;
+  uint contributions = 0u;
   bool done = !inside;
   if (segment.begin > 0u && inside) {  // continue from the previous pass's state
     T = alpha_out[pix];
@@ -100,6 +101,7 @@ void main() {
         depth_sum += w * subgroupShuffle(depth, k);
         T = hit && !stop ? next_T : T;
         last = hit && !stop ? chunk + k - range.x + 1u : last;
+        contributions += hit && !stop ? 1u : 0u;
       }
     }
   }
@@ -107,6 +109,9 @@ void main() {
   // count it, so that a pass sized wrongly for a device is seen (SPLAT_COUNTER_FORWARD_WALKS_CUT).
   if (chunk < end && !subgroupAll(done) && subgroupElect())
     atomicAdd(counters[SPLAT_COUNTER_FORWARD_WALKS_CUT], 1u);
+  const uint subgroup_contributions = subgroupAdd(contributions);
+  if (subgroupElect() && subgroup_contributions > 0u)
+    atomicAdd(counters[SPLAT_COUNTER_CONTRIBUTIONS], subgroup_contributions);
   if (!inside) return;
   for (uint c = 0u; c < CHANNELS; ++c) image[c * plane + pix] = accum[c];
   if (!final_pass) {  // more of the list follows in the next pass
