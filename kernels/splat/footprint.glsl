@@ -32,11 +32,11 @@ uvec2 tile_pixel() {
   return gl_WorkGroupID.xy * uint(SPLAT_TILE_SIZE) + uvec2(x, y);
 }
 
-// sigma along the edge x = dx (relative to the mean) of a box, at its smallest: dy = -b dx / c clamped to
-// [dy_lo, dy_hi] (sigma is a convex quadratic). Lowered by 1e-5 of the terms' magnitudes, so that float
+// sigma along the edge x = dx (relative to the mean) of a box, at its smallest: dy = -(b / c) dx clamped
+// to [dy_lo, dy_hi] (sigma is a convex quadratic). Lowered by 1e-5 of the terms' magnitudes, so that float
 // rounding here can never exceed the rounding of the walk's own sigma at a pixel centre on the edge.
-float edge_min_sigma(float a, float b, float c, float dx, float dy_lo, float dy_hi) {
-  const float dy = clamp(-b * dx / c, dy_lo, dy_hi);
+float edge_min_sigma(float a, float b, float c, float b_over_c, float dx, float dy_lo, float dy_hi) {
+  const float dy = clamp(-b_over_c * dx, dy_lo, dy_hi);
   const float xx = 0.5 * a * dx * dx, yy = 0.5 * c * dy * dy, xy = b * dx * dy;
   return xx + yy + xy - 1e-5 * (xx + yy + abs(xy));
 }
@@ -52,10 +52,13 @@ bool footprint_touches_box(vec4 mean_extent, vec4 conic_opacity, vec2 lo, vec2 h
   const bool definite = a > 0.0 && c > 0.0 && a * c - b * b > 0.0;
   const bool inside = all(lessThanEqual(d_lo, vec2(0.0))) && all(greaterThanEqual(d_hi, vec2(0.0)));
   const float a_s = definite ? a : 1.0, c_s = definite ? c : 1.0;  // no division by 0 when not used
-  const float least = min(min(edge_min_sigma(a_s, b, c_s, d_lo.x, d_lo.y, d_hi.y),
-                              edge_min_sigma(a_s, b, c_s, d_hi.x, d_lo.y, d_hi.y)),
-                          min(edge_min_sigma(c_s, b, a_s, d_lo.y, d_lo.x, d_hi.x),
-                              edge_min_sigma(c_s, b, a_s, d_hi.y, d_lo.x, d_hi.x)));
-  const float limit = log(max(conic_opacity.w * 255.0, 1e-30)) + 0.02;
+  const float b_over_c = b / c_s, b_over_a = b / a_s;
+  const float least = min(min(edge_min_sigma(a_s, b, c_s, b_over_c, d_lo.x, d_lo.y, d_hi.y),
+                              edge_min_sigma(a_s, b, c_s, b_over_c, d_hi.x, d_lo.y, d_hi.y)),
+                          min(edge_min_sigma(c_s, b, a_s, b_over_a, d_lo.y, d_lo.x, d_hi.x),
+                              edge_min_sigma(c_s, b, a_s, b_over_a, d_hi.y, d_lo.x, d_hi.x)));
+  // The logarithm alpha_extent takes (the compiler computes it once): below opacity 1/255 nothing hits
+  // anyway, and the limit 0.02 keeps the entry only where sigma <= 0.02.
+  const float limit = log(max(conic_opacity.w * 255.0, 1.0)) + 0.02;
   return !definite || inside || !(least > limit);
 }
