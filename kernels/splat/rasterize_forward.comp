@@ -78,8 +78,9 @@ void main() {
       conic_opacity = vec4(conic, opacity);
       for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
       depth = depths[g];
-      relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi) &&
-                 footprint_touches_box(mean_extent, conic_opacity, subgroup_lo, subgroup_hi);
+      // The bounding box only: the backward's exact ellipse test (footprint_touches_box) costs the forward
+      // more than the cheap blends it skips (measured on lavapipe, docs/experiments.md).
+      relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
     }
     uvec4 todo = subgroupBallot(relevant);
     for (uint word = 0u; word < 4u; ++word) {
