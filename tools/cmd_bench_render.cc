@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "engine/context.h"
 #include "kernels/splat/rasterizer.h"
@@ -13,7 +15,9 @@
 #include "tools/bench_stats.h"
 #include "tools/commands.h"
 #include "tools/device_json.h"
+#include "tools/fma_peak.h"
 #include "tools/kernel_profile.h"
+#include "tools/rasterizer_flops.h"
 
 namespace litgs::tools {
 namespace {
@@ -35,6 +39,25 @@ struct BenchRenderOptions {
     if (runs < 1) throw std::invalid_argument("--runs must be at least 1");
   }
 };
+
+// GPU milliseconds of the profile's kernels whose name starts with `prefix`.
+double kernel_ms(const std::vector<engine::KernelTime>& profile, const std::string& prefix) {
+  double ms = 0.0;
+  for (const auto& k : profile)
+    if (k.name.rfind(prefix, 0) == 0) ms += k.ms;
+  return ms;
+}
+
+// Useful work per second (rasterizer_flops.h) in GFLOP/s and as a fraction of the measured peak.
+struct Efficiency {
+  double gflops = 0.0, of_peak = 0.0;
+};
+Efficiency efficiency(double flops, double ms, double peak_gflops) {
+  Efficiency e;
+  if (ms > 0.0) e.gflops = flops / (ms * 1e6);
+  if (peak_gflops > 0.0) e.of_peak = e.gflops / peak_gflops;
+  return e;
+}
 
 void run_bench_render(const BenchRenderOptions& o) {
   o.check();
@@ -67,6 +90,18 @@ void run_bench_render(const BenchRenderOptions& o) {
   const kernels::RasterizerCounters counters = rasterizer.read_counters();
   const double per_gaussian =
       o.gaussians ? static_cast<double>(rasterizer.intersections()) / o.gaussians : 0.0;
+  // Useful FLOP/s against the FMA peak measured in this run (same driver, same threads).
+  const FmaPeak peak = measure_fma_peak(context);
+  const double pairs = counters.contributions;
+  const double fwd_flops = pairs * forward_flops_per_pair(o.channels);
+  const double bwd_flops = pairs * backward_flops_per_pair(o.channels);
+  const Efficiency fwd_kernel =
+      efficiency(fwd_flops, kernel_ms(profile, "splat/rasterize_forward"), peak.gflops);
+  const Efficiency bwd_kernel =
+      efficiency(bwd_flops, kernel_ms(profile, "splat/rasterize_backward"), peak.gflops);
+  const Efficiency fwd_all = efficiency(fwd_flops, median(forward_ms), peak.gflops);
+  const Efficiency both_all =
+      efficiency(fwd_flops + bwd_flops, o.backward ? median(total_ms) : 0.0, peak.gflops);
   if (o.json) {
     nlohmann::json j = {{"gaussians", o.gaussians},
                         {"width", o.width},
@@ -82,8 +117,20 @@ void run_bench_render(const BenchRenderOptions& o) {
                         {"longest_tile_list", counters.longest_tile_list},
                         {"forward_passes", counters.forward_passes},
                         {"backward_passes", counters.backward_passes},
-                        {"walks_cut_short", counters.walks_cut_short}};
-    if (o.backward) j["forward_backward_ms"] = median(total_ms);
+                        {"walks_cut_short", counters.walks_cut_short},
+                        {"blended_pairs", counters.contributions},
+                        {"fma_peak_gflops", peak.gflops},
+                        {"forward_useful_gflops", fwd_all.gflops},
+                        {"forward_fraction_of_peak", fwd_all.of_peak},
+                        {"rasterize_forward_useful_gflops", fwd_kernel.gflops},
+                        {"rasterize_forward_fraction_of_peak", fwd_kernel.of_peak}};
+    if (o.backward) {
+      j["forward_backward_ms"] = median(total_ms);
+      j["forward_backward_useful_gflops"] = both_all.gflops;
+      j["forward_backward_fraction_of_peak"] = both_all.of_peak;
+      j["rasterize_backward_useful_gflops"] = bwd_kernel.gflops;
+      j["rasterize_backward_fraction_of_peak"] = bwd_kernel.of_peak;
+    }
     std::cout << j.dump(2) << "\n";
     return;
   }
@@ -105,6 +152,19 @@ void run_bench_render(const BenchRenderOptions& o) {
                   : rasterizer.uses_float_atomics() ? " (float atomics)"
                                                     : " (CAS atomics)")
               << "\n";
+  std::cout << "  FMA peak             " << peak.gflops
+            << " GFLOP/s (kernels/bench/fma_peak.comp, best of 3)\n"
+            << "  blended pairs        " << counters.contributions
+            << " (pixel, Gaussian); useful FLOPs per pair " << forward_flops_per_pair(o.channels)
+            << " forward, " << backward_flops_per_pair(o.channels) << " backward (tools/rasterizer_flops.h)\n"
+            << std::setprecision(1) << "  useful GFLOP/s       forward " << fwd_all.gflops << " ("
+            << 100.0 * fwd_all.of_peak << "% of peak), rasterize_forward alone " << fwd_kernel.gflops << " ("
+            << 100.0 * fwd_kernel.of_peak << "%)\n";
+  if (o.backward)
+    std::cout << "                       forward + backward " << both_all.gflops << " ("
+              << 100.0 * both_all.of_peak << "% of peak), rasterize_backward alone " << bwd_kernel.gflops
+              << " (" << 100.0 * bwd_kernel.of_peak << "%)\n";
+  std::cout << std::setprecision(2);
   print_kernel_profile(std::cout, profile);
 }
 

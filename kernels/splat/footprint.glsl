@@ -18,3 +18,47 @@ bool footprint_reaches(vec4 mean_extent, vec2 lo, vec2 hi) {
 // Beyond this sigma alpha is below 1/255 for any opacity <= 1 (ln 255 = 5.5): clamping sigma there changes
 // no result and keeps exp() away from denormals, which are very slow on CPUs.
 const float SIGMA_CUTOFF = 30.0;
+
+// The pixel of this invocation. A tile's pixels are numbered in Z (Morton) order, so that a subgroup of S
+// consecutive invocations covers a compact block (S = 8: 4x2, 16: 4x4, 32: 8x4) instead of a one-pixel-high
+// strip: fewer of the tile's footprints reach a compact block, and the subgroup skips the rest.
+#if SPLAT_TILE_SIZE != 16
+#error "tile_pixel() numbers the pixels of a 16x16 tile"
+#endif
+uvec2 tile_pixel() {
+  const uint i = gl_LocalInvocationIndex;
+  const uint x = (i & 1u) | ((i >> 1u) & 2u) | ((i >> 2u) & 4u) | ((i >> 3u) & 8u);
+  const uint y = ((i >> 1u) & 1u) | ((i >> 2u) & 2u) | ((i >> 3u) & 4u) | ((i >> 4u) & 8u);
+  return gl_WorkGroupID.xy * uint(SPLAT_TILE_SIZE) + uvec2(x, y);
+}
+
+// sigma along the edge x = dx (relative to the mean) of a box, at its smallest: dy = -(b / c) dx clamped
+// to [dy_lo, dy_hi] (sigma is a convex quadratic). Lowered by 1e-5 of the terms' magnitudes, so that float
+// rounding here can never exceed the rounding of the walk's own sigma at a pixel centre on the edge.
+float edge_min_sigma(float a, float b, float c, float b_over_c, float dx, float dy_lo, float dy_hi) {
+  const float dy = clamp(-b_over_c * dx, dy_lo, dy_hi);
+  const float xx = 0.5 * a * dx * dx, yy = 0.5 * c * dy * dy, xy = b * dx * dy;
+  return xx + yy + xy - 1e-5 * (xx + yy + abs(xy));
+}
+
+// Whether the Gaussian's alpha can reach 1/255 at any pixel centre in the box [lo, hi]: its smallest sigma
+// over the box (0 with the mean inside, else the least over the four edges) against ln(255 opacity), with
+// 0.02 of margin for the rounding of exp, log and the walk's pixel offsets (sigma changes by under 1e-3 for
+// a 1e-4 pixel offset within the footprint). Conservative: true for a conic that is not positive definite.
+// An entry this rejects adds exactly nothing in the walk (alpha < 1/255 at every pixel of the box).
+bool footprint_touches_box(vec4 mean_extent, vec4 conic_opacity, vec2 lo, vec2 hi) {
+  const float a = conic_opacity.x, b = conic_opacity.y, c = conic_opacity.z;
+  const vec2 d_lo = lo - mean_extent.xy, d_hi = hi - mean_extent.xy;
+  const bool definite = a > 0.0 && c > 0.0 && a * c - b * b > 0.0;
+  const bool inside = all(lessThanEqual(d_lo, vec2(0.0))) && all(greaterThanEqual(d_hi, vec2(0.0)));
+  const float a_s = definite ? a : 1.0, c_s = definite ? c : 1.0;  // no division by 0 when not used
+  const float b_over_c = b / c_s, b_over_a = b / a_s;
+  const float least = min(min(edge_min_sigma(a_s, b, c_s, b_over_c, d_lo.x, d_lo.y, d_hi.y),
+                              edge_min_sigma(a_s, b, c_s, b_over_c, d_hi.x, d_lo.y, d_hi.y)),
+                          min(edge_min_sigma(c_s, b, a_s, b_over_a, d_lo.y, d_lo.x, d_hi.x),
+                              edge_min_sigma(c_s, b, a_s, b_over_a, d_hi.y, d_lo.x, d_hi.x)));
+  // The logarithm alpha_extent takes (the compiler computes it once): below opacity 1/255 nothing hits
+  // anyway, and the limit 0.02 keeps the entry only where sigma <= 0.02.
+  const float limit = log(max(conic_opacity.w * 255.0, 1.0)) + 0.02;
+  return !definite || inside || !(least > limit);
+}

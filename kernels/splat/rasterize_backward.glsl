@@ -169,7 +169,8 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 cent
   relevant = false;
   if (rel < chunk_end) {
     load_entry(list_start + rel, g, mean_extent, conic_opacity, color, depth);
-    relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
+    relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi) &&
+               footprint_touches_box(mean_extent, conic_opacity, subgroup_lo, subgroup_hi);
   }
   a0 = vec4(0.0);
   a1 = vec4(0.0);
@@ -201,7 +202,7 @@ uint chunk_start_below(uint chunk_end) {
 }
 
 void main() {
-  const uvec2 pixel = gl_GlobalInvocationID.xy;
+  const uvec2 pixel = tile_pixel();
   const bool inside = pixel.x < view.width && pixel.y < view.height;
   const uint tile = gl_WorkGroupID.y * view.tiles_x + gl_WorkGroupID.x;
   const uvec2 range = ranges[tile];

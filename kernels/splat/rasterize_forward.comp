@@ -35,7 +35,7 @@ layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]
 // pixels, and every lane then reads those entries from lane k by shuffle, in list order. No shared memory,
 // no barriers; on CPU drivers a shuffle is a register permute, far cheaper than a load per entry.
 void main() {
-  const uvec2 pixel = gl_GlobalInvocationID.xy;
+  const uvec2 pixel = tile_pixel();
   const bool inside = pixel.x < view.width && pixel.y < view.height;
   const uint tile = gl_WorkGroupID.y * view.tiles_x + gl_WorkGroupID.x;
   const uvec2 range = ranges[tile];
@@ -52,6 +52,7 @@ void main() {
   vec4 accum = vec4(0.0);  // a vector, not an array: CPU drivers spill dynamically indexed arrays
   float depth_sum = 0.0;
   uint last = 0u;
+  uint contributions = 0u;
   bool done = !inside;
   if (segment.begin > 0u && inside) {  // continue from the previous pass's state
     T = alpha_out[pix];
@@ -77,6 +78,8 @@ void main() {
       conic_opacity = vec4(conic, opacity);
       for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
       depth = depths[g];
+      // The bounding box only: the backward's exact ellipse test (footprint_touches_box) costs the forward
+      // more than the cheap blends it skips (measured on lavapipe, docs/experiments.md).
       relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
     }
     uvec4 todo = subgroupBallot(relevant);
@@ -99,6 +102,7 @@ void main() {
         depth_sum += w * subgroupShuffle(depth, k);
         T = hit && !stop ? next_T : T;
         last = hit && !stop ? chunk + k - range.x + 1u : last;
+        contributions += hit && !stop ? 1u : 0u;
       }
     }
   }
@@ -106,6 +110,9 @@ void main() {
   // count it, so that a pass sized wrongly for a device is seen (SPLAT_COUNTER_FORWARD_WALKS_CUT).
   if (chunk < end && !subgroupAll(done) && subgroupElect())
     atomicAdd(counters[SPLAT_COUNTER_FORWARD_WALKS_CUT], 1u);
+  const uint subgroup_contributions = subgroupAdd(contributions);
+  if (subgroupElect() && subgroup_contributions > 0u)
+    atomicAdd(counters[SPLAT_COUNTER_CONTRIBUTIONS], subgroup_contributions);
   if (!inside) return;
   for (uint c = 0u; c < CHANNELS; ++c) image[c * plane + pix] = accum[c];
   if (!final_pass) {  // more of the list follows in the next pass

@@ -206,6 +206,7 @@ RasterizerCounters Rasterizer::read_counters() const {
   r.forward_passes = forward_passes_;
   r.backward_passes = backward_passes_;
   r.walks_cut_short = uint64_t{c[SPLAT_COUNTER_FORWARD_WALKS_CUT]} + c[SPLAT_COUNTER_BACKWARD_WALKS_CUT];
+  r.contributions = c[SPLAT_COUNTER_CONTRIBUTIONS];
   return r;
 }
 
@@ -279,6 +280,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   engine::Sequence s1(ctx);
   // Zero the per-render counters; the walks-cut counters after them keep running.
   s1.fill(b.counters->buffer(), 0u, (SPLAT_COUNTER_MAX_LIST + 1) * sizeof(uint32_t));
+  s1.fill(b.counters->buffer(), 0u, sizeof(uint32_t), SPLAT_COUNTER_CONTRIBUTIONS * sizeof(uint32_t));
   s1.fill(b.corners->buffer(), 0u, corner_cells * sizeof(uint32_t));
   s1.dispatch(*project_, elementwise_groups(*context_, n, "splat/project"),
               {{PROJECT_BINDING_MEANS, &g.means.buffer(), Access::kRead},

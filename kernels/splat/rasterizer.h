@@ -42,6 +42,8 @@ struct RasterizerCounters {
   uint32_t backward_passes = 0;    // ... and of the last backward
   uint64_t walks_cut_short = 0;    // subgroup walks that a driver's loop limit ended early, all renders so
                                    // far (forward + backward); 0 unless a pass size is wrong for the device
+  uint32_t contributions = 0;      // (pixel, Gaussian) pairs the last forward blended (and its backward
+                                   // walks again): SPLAT_COUNTER_CONTRIBUTIONS
 };
 
 // A Gaussian model on the device, one buffer per attribute (structure of arrays, each binding bounded).

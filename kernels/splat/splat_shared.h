@@ -57,6 +57,10 @@ using uint = uint32_t;
 // loop-cost bound below is wrong for this device.
 #define SPLAT_COUNTER_FORWARD_WALKS_CUT 4
 #define SPLAT_COUNTER_BACKWARD_WALKS_CUT 5
+// Zeroed by every forward: the (pixel, Gaussian) pairs the forward blended (alpha >= 1/255 before the pixel
+// stopped), which the backward walks again: the useful work of a render (bench render's FLOP/s). 32 bits:
+// wraps beyond 2^32 pairs (a 4K image with 500 per pixel).
+#define SPLAT_COUNTER_CONTRIBUTIONS 6
 #define SPLAT_COUNTER_COUNT 8
 
 // ---- gather_counts.comp: one invocation per depth-sorted position ----

@@ -1,6 +1,8 @@
 // Forward rasterization on the device against the double-precision reference.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "gpu_test.h"
 #include "kernels/splat/rasterizer.h"
 #include "kernels/splat/reference.h"
@@ -34,6 +36,24 @@ TEST_F(RasterizerForward, RandomSceneMatchesReference) {
     EXPECT_GE(dep.fraction_within, 0.995);
     EXPECT_GE(alp.fraction_within, 0.995);
   }
+}
+
+TEST_F(RasterizerForward, CountsOneBlendedPairPerCoveredPixelOfOneGaussian) {
+  // bench render's useful FLOP/s rest on the forward's count of blended (pixel, Gaussian) pairs: with one
+  // Gaussian that is the number of pixels it reaches (alpha > 0), here a few hundred of 64x48.
+  auto model = testing::random_scene(1, 1, 3, 71);
+  model.means = {0.05f, -0.03f, 3.0f};
+  model.log_scales = {-1.8f, -2.2f, -2.0f};
+  const auto camera = testing::camera_looking_down_z(64, 48);
+  DeviceGaussians g(context(), model);
+  Rasterizer r(context(), 1);
+  r.forward(g, camera);
+  const auto images = r.download_images();
+  const auto covered = static_cast<uint32_t>(
+      std::count_if(images.alpha.begin(), images.alpha.end(), [](float a) { return a > 0; }));
+  EXPECT_GT(covered, 100u);
+  EXPECT_LT(covered, 64u * 48u);
+  EXPECT_EQ(r.read_counters().contributions, covered);
 }
 
 }  // namespace
