@@ -92,11 +92,6 @@ class Runner {
         entry["status"] = "not run (after --until)";
         continue;
       }
-      if (!stage.built) {
-        entry["status"] = "skipped: not built yet";
-        out_ << tag << ": skipped: not built yet (" << stage.what << ")\n";
-        continue;
-      }
       try {
         run_stage(stage, !o_.from.empty() && i >= from, tag, entry);
       } catch (const StageFailed&) {
@@ -142,6 +137,16 @@ class Runner {
 
   void run_stage(const Stage& stage, bool forced, const std::string& tag, json& entry) {
     const StagePlan plan = stage.plan(ctx_);
+    const fs::path dir = ctx_.stage_dir(stage.name), manifest_path = dir / "manifest.json";
+    if (!plan.skip_reason.empty()) {
+      // Nothing to do: what an earlier run left there would be taken for this run's.
+      fs::remove_all(dir);
+      ctx_.results[stage.name] = {{"skipped", plan.skip_reason}};
+      entry["status"] = "skipped: " + plan.skip_reason;
+      out_ << tag << ": skipped: " << plan.skip_reason << "\n";
+      return;
+    }
+    if (!plan.notes.empty()) entry["notes"] = plan.notes;
     json inputs = json::object();
     for (const fs::path& p : plan.inputs) inputs[fs::absolute(p).string()] = hash_of(p);
     const std::string key = hash_text(json{
@@ -149,7 +154,6 @@ class Runner {
         {"inputs", inputs},
         {"options", plan.options},
         {"command", plan.command}}.dump());
-    const fs::path dir = ctx_.stage_dir(stage.name), manifest_path = dir / "manifest.json";
     const json manifest = read_json(manifest_path);
     if (!forced && up_to_date(manifest, key, plan)) {
       ctx_.results[stage.name] = manifest.at("result");
@@ -167,11 +171,13 @@ class Runner {
     fs::remove(manifest_path);
     fs::create_directories(dir);
     write_json(dir / "started.json", {{"key", key}, {"started", now_text()}});
+    if (plan.scene_copy && !resume) make_scene_copy(*plan.scene_copy, dir / "scene");
     std::vector<std::string> command = plan.command;
     if (resume) command.insert(command.end(), plan.resume_args.begin(), plan.resume_args.end());
     out_ << tag << ": " << stage.what << (resume ? " (resuming from its checkpoint)" : "")
-         << (forced ? " (forced by --from)" : "") << "\n"
-         << std::flush;
+         << (forced ? " (forced by --from)" : "") << "\n";
+    for (const std::string& note : plan.notes) out_ << tag << ": note: " << note << "\n";
+    out_ << std::flush;
     ChildResult child;
     if (!command.empty()) {
       child = run_child(ctx_.engine, command, dir / "log.txt", out_);

@@ -111,7 +111,7 @@ nlohmann::json result(const StageContext& c) {
 }  // namespace
 
 Stage import_stage() {
-  return {"import", "INPUT to a scene directory", true, plan, result};
+  return {"import", "INPUT to a scene directory", plan, result};
 }
 
 }  // namespace litgs::host::run

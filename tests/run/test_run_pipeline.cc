@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <map>
 #include <thread>
 
 #include "run_test_support.h"
@@ -28,18 +29,24 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
   const fs::path config = write_text(kRoot / "e2e.yaml", small_run_yaml());
   CommandResult r = run_engine(run_args("synth:facade", dir, config));
   ASSERT_EQ(r.status, 0) << r.output;
-  for (const char* stage : {"map", "match", "refine"}) {
-    EXPECT_EQ(stage_status(dir, stage), "skipped: not built yet");
-    EXPECT_NE(r.output.find(std::string("] ") + stage + ": skipped: not built yet"), std::string::npos)
-        << r.output;
-    EXPECT_FALSE(fs::exists(dir / stage)) << "a stage that is not built wrote something";
-  }
-  for (const char* stage : {"import", "train", "eval", "report"}) {
+  // The synthetic scene comes with its LiDAR map: map has nothing to do and says why.
+  EXPECT_EQ(stage_status(dir, "map"),
+            "skipped: scene has a LiDAR map already (map.build: always rebuilds it from the scans)");
+  EXPECT_FALSE(fs::exists(dir / "map"));
+  for (const char* stage : {"import", "match", "refine", "train", "eval", "report"}) {
     EXPECT_EQ(stage_status(dir, stage), "done") << stage;
     EXPECT_TRUE(fs::exists(dir / stage / "manifest.json")) << stage;
   }
   const nlohmann::json run = read_json_file(dir / "run.json");
   EXPECT_EQ(run["status"], "done");
+  // train and eval used the refined scene.
+  EXPECT_TRUE(fs::exists(dir / "refine" / "scene" / "poses_prior.txt"));
+  EXPECT_NE(read_json_file(dir / "train" / "manifest.json")["command"].dump().find(
+                (dir / "refine" / "scene").string()),
+            std::string::npos);
+  EXPECT_NE(read_json_file(dir / "eval" / "manifest.json")["command"].dump().find(
+                (dir / "refine" / "scene").string()),
+            std::string::npos);
   for (const auto& s : run["stages"])
     if (s["status"] == "done") {
       EXPECT_GT(s["seconds"].get<double>(), 0.0) << s;
@@ -57,13 +64,86 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
   // A rerun skips everything; --from eval reruns eval and report only.
   r = run_engine(run_args("synth:facade", dir, config));
   ASSERT_EQ(r.status, 0) << r.output;
-  for (const char* stage : {"import", "train", "eval", "report"})
+  for (const char* stage : {"import", "match", "refine", "train", "eval", "report"})
     EXPECT_EQ(stage_status(dir, stage), "up to date");
   r = run_engine(run_args("synth:facade", dir, config, "--from eval"));
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(stage_status(dir, "train"), "up to date");
   EXPECT_EQ(stage_status(dir, "eval"), "done");
   EXPECT_EQ(stage_status(dir, "report"), "done");
+}
+
+std::map<std::string, std::string> file_contents(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) {
+      std::ifstream in(e.path(), std::ios::binary);
+      files[fs::relative(e.path(), dir).string()] = {std::istreambuf_iterator<char>(in), {}};
+    }
+  return files;
+}
+
+// map, match and refine each change their own copy of the scene; the user's scene directory stays as it was.
+TEST(RunStages, SceneStagesWorkOnCopiesAndLeaveTheInputAlone) {
+  const fs::path dir = kRoot / "copies", scene = kRoot / "copies-scene";
+  fs::remove_all(dir);
+  fs::remove_all(scene);
+  ASSERT_EQ(
+      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
+      0);
+  const auto before = file_contents(scene);
+  const fs::path config = write_text(kRoot / "copies.yaml", small_run_yaml() + "map:\n  build: always\n");
+  const CommandResult r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char* stage : {"map", "match", "refine"}) EXPECT_EQ(stage_status(dir, stage), "done") << stage;
+  EXPECT_EQ(file_contents(scene), before) << "a stage modified the INPUT";
+  const fs::path refined = dir / "refine" / "scene";
+  EXPECT_TRUE(fs::exists(dir / "map" / "scene" / "lidar" / "map.pcd"));
+  EXPECT_TRUE(fs::exists(dir / "match" / "scene" / "sfm" / "frontend.json"));
+  EXPECT_TRUE(fs::exists(refined / "sfm" / "frontend.json")) << "refine's copy lost match's output";
+  EXPECT_EQ(file_contents(refined).at("poses_prior.txt"), before.at("poses.txt"));
+  EXPECT_NE(file_contents(refined).at("poses.txt"), before.at("poses.txt")) << "poses not refined";
+  const std::string frame =
+      "thermal/" + fs::directory_iterator(scene / "thermal")->path().filename().string();
+  EXPECT_TRUE(fs::equivalent(scene / frame, refined / frame)) << "unchanged files are hard links";
+  const nlohmann::json run = read_json_file(dir / "run.json");
+  EXPECT_TRUE(run["stages"][3]["metrics"]["ate_after_m"].is_number()) << run["stages"][3];
+}
+
+// A stage with nothing to do says why: no scans, no ground truth for synthetic tracks; refine without a
+// LiDAR map runs without the plane term.
+TEST(RunStages, NothingToDoSaysWhy) {
+  const fs::path dir = kRoot / "why", scene = kRoot / "why-scene";
+  fs::remove_all(dir);
+  fs::remove_all(scene);
+  ASSERT_EQ(
+      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
+      0);
+  // No LiDAR at all, as a photogrammetry import.
+  fs::remove_all(scene / "lidar");
+  std::ifstream in(scene / "scene.yaml");
+  std::string yaml{std::istreambuf_iterator<char>(in), {}};
+  const size_t at = yaml.find("lidar_map: true");
+  ASSERT_NE(at, std::string::npos);
+  write_text(scene / "scene.yaml", yaml.replace(at, 15, "lidar_map: false"));
+  const fs::path config = write_text(kRoot / "why.yaml", small_run_yaml());
+  CommandResult r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "map"), "skipped: scene has no scans (lidar/scans/)");
+  EXPECT_NE(r.output.find("map: skipped: scene has no scans"), std::string::npos) << r.output;
+  EXPECT_EQ(stage_status(dir, "refine"), "done");
+  EXPECT_NE(r.output.find("refine: note: the scene has no LiDAR map: refine runs without the plane term"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(read_json_file(dir / "refine" / "manifest.json")["command"].dump().find("--no-planes"),
+            std::string::npos);
+  // Without ground truth the synthetic tracks cannot be made: refine is skipped, and its old folder goes.
+  fs::remove_all(scene / "gt");
+  r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "refine"),
+            "skipped: refine.tracks is synthetic and the scene has no gt/poses.txt to make them from");
+  EXPECT_FALSE(fs::exists(dir / "refine"));
 }
 
 TEST(RunBadInput, UnknownInputKind) {
