@@ -261,6 +261,15 @@ class Runner {
                     value("psnr_db"), value("ssim"), value("emd_m"), value("emd_floor_m"),
                     value("render_ms_per_frame"), value("gaussians"));
       out_ << line;
+      if (m.contains("ate_m")) {
+        std::snprintf(line, sizeof line, "run: ATE %.4f m", value("ate_m"));
+        out_ << line;
+        if (m["ate_prior_m"].is_number()) {
+          std::snprintf(line, sizeof line, " (before refinement %.4f m)", value("ate_prior_m"));
+          out_ << line;
+        }
+        out_ << " against gt/poses.txt\n";
+      }
     }
     if (results.contains("report"))
       out_ << "run: report: " << results["report"]["report"].get<std::string>() << "\n";

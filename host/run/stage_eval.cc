@@ -44,6 +44,8 @@ nlohmann::json result(const StageContext& c) {
     metrics["emd_floor_m"] = e["emd"]["floor_m"];
   }
   metrics["lpips"] = e.at("lpips");
+  if (e.value("trajectory", nlohmann::json()).is_object())
+    metrics.update(pick(e["trajectory"], {"ate_m", "ate_prior_m"}));
   return {{"eval", (c.stage_dir("eval") / "eval.json").string()}, {"metrics", metrics}};
 }
 

@@ -28,8 +28,8 @@ StagePlan plan(const StageContext& c) {
     p.notes.push_back("the scene has no LiDAR map: refine runs without the plane term");
   }
   p.command = {"refine", copy.string()};
-  const auto flags = option_flags(flags_from, {"tracks", "anchors=!--no-anchors", "planes=!--no-planes",
-                                               "rounds", "threads"});
+  const auto flags = option_flags(
+      flags_from, {"tracks", "anchors=!--no-anchors", "planes=!--no-planes", "rounds", "threads"});
   p.command.insert(p.command.end(), flags.begin(), flags.end());
   p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
   p.outputs = {"refine/scene"};

@@ -24,7 +24,8 @@ std::string number_arg(double value) {
   return buf;
 }
 
-std::vector<std::string> option_flags(const nlohmann::json& section, std::initializer_list<const char*> specs) {
+std::vector<std::string> option_flags(const nlohmann::json& section,
+                                      std::initializer_list<const char*> specs) {
   std::vector<std::string> args;
   for (const std::string spec : specs) {
     const size_t eq = spec.find('=');

@@ -1,10 +1,10 @@
 // The stage adapters' shared parts: run.yaml options as flags, and the scene copies of map, match, refine.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
-#include <sys/stat.h>
 
 #include "host/run/stage.h"
 
@@ -14,10 +14,10 @@ namespace {
 namespace fs = std::filesystem;
 
 TEST(StageFlags, EveryKindOfValue) {
-  const nlohmann::json section = {{"max_keypoints", 3000},   {"lambda_geo", 0.1},  {"features", "orb"},
-                                  {"clahe", false},          {"deskew", true},     {"geometry", true},
+  const nlohmann::json section = {{"max_keypoints", 3000}, {"lambda_geo", 0.1}, {"features", "orb"},
+                                  {"clahe", false},        {"deskew", true},    {"geometry", true},
                                   {"extra", {"--a", "b"}}};
-  const std::vector<std::string> expected = {"--max-keypoints", "3000", "--lambda", "0.10000000000000001",
+  const std::vector<std::string> expected = {"--max-keypoints", "3000", "--lambda",   "0.10000000000000001",
                                              "--features",      "orb",  "--no-clahe", "--deskew",
                                              "--extra",         "--a",  "b"};
   EXPECT_EQ(option_flags(section, {"max_keypoints", "lambda_geo=--lambda", "features", "clahe=!--no-clahe",

@@ -54,6 +54,13 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
     }
   const nlohmann::json eval = read_json_file(dir / "eval" / "eval.json");
   EXPECT_GT(eval["psnr_db"].get<double>(), 5.0);
+  // ATE before and after refinement: eval measures it with refine's Umeyama ATE at the same frames.
+  const nlohmann::json refined = read_json_file(dir / "refine" / "scene" / "refine.json");
+  ASSERT_TRUE(eval["trajectory"].is_object()) << eval["trajectory"];
+  EXPECT_NEAR(eval["trajectory"]["ate_m"].get<double>(), refined["ate_after_m"].get<double>(), 1e-12);
+  EXPECT_NEAR(eval["trajectory"]["ate_prior_m"].get<double>(), refined["ate_before_m"].get<double>(), 1e-12);
+  EXPECT_EQ(eval["trajectory"]["top_view"]["truth"].size(), 16u);
+  EXPECT_NE(r.output.find("run: ATE "), std::string::npos) << r.output;
   EXPECT_EQ(eval["views"].size(), eval["heldout_views"].get<size_t>());
   EXPECT_EQ(read_json_file(dir / "train" / "metrics.json")["heldout_views"], eval["heldout_views"]);
   EXPECT_NEAR(read_json_file(dir / "train" / "metrics.json")["heldout_psnr"].get<double>(),
