@@ -38,7 +38,8 @@ std::vector<io::TumPose> at_times(const std::vector<io::TumPose>& poses, const s
 }
 
 std::vector<Eigen::Vector2d> top_view(const std::vector<io::TumPose>& poses, const refine::Similarity& align,
-                                      const Eigen::Vector3d& centre, const Eigen::Matrix<double, 3, 2>& axes) {
+                                      const Eigen::Vector3d& centre,
+                                      const Eigen::Matrix<double, 3, 2>& axes) {
   std::vector<Eigen::Vector2d> out;
   for (const auto& p : poses) out.push_back(axes.transpose() * (align.apply(p.p_world) - centre));
   return out;
@@ -93,8 +94,10 @@ nlohmann::json to_json(const TrajectoryEvaluation& t) {
           {"ate_prior_m", t.prior ? nlohmann::json(t.prior->rmse_m) : nlohmann::json(nullptr)},
           {"pairs", t.estimate.pairs},
           {"alignment", "SE(3) Umeyama, positions at the frame times"},
-          {"top_view", {{"truth", points(t.truth_top)}, {"prior", points(t.prior_top)},
-                        {"estimate", points(t.estimate_top)}}}};
+          {"top_view",
+           {{"truth", points(t.truth_top)},
+            {"prior", points(t.prior_top)},
+            {"estimate", points(t.estimate_top)}}}};
 }
 
 }  // namespace litgs::host

@@ -17,8 +17,9 @@
 namespace litgs::host {
 
 struct TrajectoryEvaluation {
-  std::optional<refine::AteResult> prior;  // poses_prior.txt: before refinement (absent if refine did not run)
-  refine::AteResult estimate;              // poses.txt
+  std::optional<refine::AteResult>
+      prior;                   // poses_prior.txt: before refinement (absent if refine did not run)
+  refine::AteResult estimate;  // poses.txt
   // Top view: positions (truth, and the others after their alignment) in the plane of the truth's two
   // largest principal axes, about its centroid; metres.
   std::vector<Eigen::Vector2d> truth_top, prior_top, estimate_top;

@@ -166,7 +166,10 @@ class Runner {
     }
     // Continue an interrupted resumable stage only if it started with these inputs and options.
     const json started = read_json(dir / "started.json");
-    const bool resume = plan.resumable && !forced && started.is_object() && started.value("key", "") == key;
+    // Only from a checkpoint: one killed (or out of disk space) before its first has nothing to continue.
+    const fs::path checkpoints = ctx_.out_dir / plan.resume_from;
+    const bool resume = plan.resumable && !forced && started.is_object() && started.value("key", "") == key &&
+                        fs::is_directory(checkpoints) && !fs::is_empty(checkpoints);
     if (!resume) fs::remove_all(dir);
     fs::remove(manifest_path);
     fs::create_directories(dir);

@@ -46,6 +46,7 @@ struct StagePlan {
   std::vector<std::filesystem::path> outputs;  // files or folders, relative to DIR, complete when it ends
   bool resumable = false;  // the command continues from its own checkpoints (train): not wiped on rerun
   std::vector<std::string> resume_args;  // added to the command when it continues
+  std::filesystem::path resume_from;     // relative to DIR: a folder that must hold a checkpoint to continue
   std::string skip_reason;               // non-empty: nothing to do, reported as "skipped: REASON"
   std::vector<std::string> notes;        // printed with the stage's progress line and kept in run.json
   std::optional<SceneCopy> scene_copy;   // made in DIR/<stage>/scene before the command runs

@@ -42,6 +42,7 @@ StagePlan plan(const StageContext& c) {
   p.outputs = {"train/point_cloud.ply", "train/metrics.json", "train/trace.jsonl"};
   p.resumable = true;
   p.resume_args = {"--resume"};
+  p.resume_from = "train/checkpoints";
   return p;
 }
 

@@ -2,6 +2,8 @@
 // inputs the issue names (unknown INPUT, a failing stage, a changed input, an interrupted stage).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -252,6 +254,54 @@ TEST(RunBadInput, InterruptedStageIsNotTakenAsDone) {
   EXPECT_EQ(stage_status(dir, "train"), "up to date");
   EXPECT_EQ(stage_status(dir, "eval"), "done");
   EXPECT_TRUE(read_json_file(eval_json).is_object());
+}
+
+// `litgs-engine ARGS` with every file it (and its stages) write limited to `max_file_bytes`: writes past
+// that fail with EFBIG (SIGXFSZ ignored, as the limit and the disposition pass to the stages' children), as
+// on a full disk, without needing one.
+CommandResult run_engine_with_file_limit(const std::string& args, rlim_t max_file_bytes) {
+  const fs::path log = kRoot / "file-limit.log";
+  fs::remove(log);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const rlimit limit{max_file_bytes, max_file_bytes};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    ::signal(SIGXFSZ, SIG_IGN);
+    const std::string command =
+        std::string(LITGS_ENGINE_BINARY) + " " + args + " > " + log.string() + " 2>&1";
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = -1;
+  ::waitpid(pid, &status, 0);
+  std::ifstream in(log);
+  return {status, std::string{std::istreambuf_iterator<char>(in), {}}};
+}
+
+TEST(RunBadInput, FullDiskFailsTheStageWithoutAManifestAndARerunRedoesIt) {
+  const fs::path dir = kRoot / "full-disk";
+  fs::remove_all(dir);
+  const fs::path config = write_text(kRoot / "full-disk.yaml", small_run_yaml());
+  CommandResult r = run_engine(run_args("synth:facade", dir, config, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  // 600 kB per file: run.json and the manifests fit, train's checkpoint (about 1 MB) does not.
+  r = run_engine_with_file_limit(run_args("synth:facade", dir, config), 600'000);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("stage 'train' failed: exit status 1: litgs-engine: error: " +
+                          (dir / "train" / "checkpoints").string()),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("write failed (disk full?)"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "train" / "manifest.json"));
+  EXPECT_TRUE(fs::is_empty(dir / "train" / "checkpoints")) << "a half-written checkpoint was left";
+  EXPECT_EQ(stage_status(dir, "train"), "failed");
+  EXPECT_EQ(stage_status(dir, "refine"), "up to date");
+  // With space again: train runs afresh (there is no checkpoint to continue from), then eval and report.
+  r = run_engine(run_args("synth:facade", dir, config));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.find("resuming"), std::string::npos) << r.output;
+  for (const char* stage : {"train", "eval", "report"}) EXPECT_EQ(stage_status(dir, stage), "done") << stage;
+  EXPECT_EQ(read_json_file(dir / "train" / "metrics.json")["iterations"], 40);
 }
 
 }  // namespace
