@@ -71,9 +71,11 @@ class Runner {
     ctx_.out_dir = fs::absolute(o_.out_dir);
     ctx_.engine = o_.engine;
     ctx_.config = o_.config;
-    fs::create_directories(ctx_.out_dir);
+    ctx_.shared_stages = o_.shared_stages;
+    record_path_ = ctx_.out_dir / (o_.record + ".json");
+    fs::create_directories(record_path_.parent_path());
     // The run's options beside its results: `run INPUT --out DIR --config DIR/run.yaml` repeats it.
-    io::write_file_atomic(ctx_.out_dir / "run.yaml",
+    io::write_file_atomic(ctx_.out_dir / (o_.record + ".yaml"),
                           [&](std::ostream& s) { s << run_config_yaml(o_.config); });
     record_ = {{"input", o_.input},
                {"kind", kind_name(ctx_.kind)},
@@ -103,7 +105,7 @@ class Runner {
         finish(start, "failed");
         throw StageFailed(stage.name, e.what());
       }
-      write_json(ctx_.out_dir / "run.json", record_);
+      write_json(record_path_, record_);
     }
     finish(start, "done");
     summary();
@@ -234,11 +236,11 @@ class Runner {
     record_["status"] = status;
     record_["total_seconds"] =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    write_json(ctx_.out_dir / "run.json", record_);
+    write_json(record_path_, record_);
   }
 
   void summary() {
-    out_ << "run: summary (" << (ctx_.out_dir / "run.json").string() << ")\n";
+    out_ << "run: summary (" << (record_path_).string() << ")\n";
     for (const json& s : record_["stages"]) {
       char line[256];
       std::snprintf(line, sizeof line, "  %-8s %-24s", s["name"].get<std::string>().c_str(),
@@ -282,6 +284,7 @@ class Runner {
   std::ostream& out_;
   StageContext ctx_;
   json record_;
+  fs::path record_path_;  // DIR/run.json
   std::map<std::string, std::string> hashes_;
 };
 

@@ -23,7 +23,12 @@ struct StageContext {
   std::filesystem::path engine;   // the litgs-engine binary the stages' commands run
   RunConfig config;
   nlohmann::json results = nlohmann::json::object();  // {stage: its result} of the stages done so far
-  std::filesystem::path stage_dir(const std::string& stage) const { return out_dir / stage; }
+  // Stages' folders are DIR/<stage>, or with shared_stages (ablate: runs that share what they can)
+  // DIR/stages/<stage>-<hash of the INPUT and the options of this stage and those before it>, so runs whose
+  // options agree up to a stage find it done.
+  bool shared_stages = false;
+  std::filesystem::path stage_rel(const std::string& stage) const;  // relative to DIR
+  std::filesystem::path stage_dir(const std::string& stage) const { return out_dir / stage_rel(stage); }
   // The scene the next stage works on: the last "scene" among the results (import's, or the copy that map,
   // match or refine changed).
   std::filesystem::path scene() const;
@@ -42,8 +47,9 @@ struct SceneCopy {
 struct StagePlan {
   std::vector<std::filesystem::path> inputs;          // files or folders whose content decides a rerun
   nlohmann::json options = nlohmann::json::object();  // the options that decide a rerun
-  std::vector<std::string> command;            // argv[1..] of `engine`; empty: nothing to run (result only)
-  std::vector<std::filesystem::path> outputs;  // files or folders, relative to DIR, complete when it ends
+  std::vector<std::string> command;  // argv[1..] of `engine`; empty: nothing to run (result only)
+  std::vector<std::filesystem::path>
+      outputs;             // files or folders, relative to DIR (stage_rel), complete when it ends
   bool resumable = false;  // the command continues from its own checkpoints (train): not wiped on rerun
   std::vector<std::string> resume_args;  // added to the command when it continues
   std::filesystem::path resume_from;     // relative to DIR: a folder that must hold a checkpoint to continue

@@ -29,7 +29,7 @@ StagePlan plan(const StageContext& c) {
        {option_flags(train, {"downscale", "holdout_every", "intensity", "poses"}),
         option_flags(p.options, {"emd_samples", "emd_rounds", "seed", "geometry=!--no-geometry"})})
     p.command.insert(p.command.end(), flags.begin(), flags.end());
-  p.outputs = {"eval/eval.json", "eval/views"};
+  p.outputs = {c.stage_rel("eval") / "eval.json", c.stage_rel("eval") / "views"};
   return p;
 }
 

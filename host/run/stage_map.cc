@@ -37,7 +37,7 @@ StagePlan plan(const StageContext& c) {
   const auto flags = option_flags(p.options, {"voxel", "deskew=!--no-deskew"});
   p.command.insert(p.command.end(), flags.begin(), flags.end());
   p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
-  p.outputs = {"map/scene"};
+  p.outputs = {c.stage_rel("map") / "scene"};
   return p;
 }
 

@@ -22,7 +22,7 @@ StagePlan plan(const StageContext& c) {
       option_flags(p.options, {"features", "clahe=!--no-clahe", "pairs", "max_keypoints", "threads"});
   p.command.insert(p.command.end(), flags.begin(), flags.end());
   p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
-  p.outputs = {"match/scene"};
+  p.outputs = {c.stage_rel("match") / "scene"};
   return p;
 }
 

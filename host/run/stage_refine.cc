@@ -32,7 +32,7 @@ StagePlan plan(const StageContext& c) {
       flags_from, {"tracks", "anchors=!--no-anchors", "planes=!--no-planes", "rounds", "threads"});
   p.command.insert(p.command.end(), flags.begin(), flags.end());
   p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
-  p.outputs = {"refine/scene"};
+  p.outputs = {c.stage_rel("refine") / "scene"};
   return p;
 }
 

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <system_error>
 
+#include "host/run/content_hash.h"
 #include "host/run/stage.h"
 #include "io/error.h"
 
@@ -16,6 +17,17 @@ fs::path StageContext::scene() const {
     if (results.contains(stage.name) && results[stage.name].contains("scene"))
       scene = results[stage.name]["scene"].get<std::string>();
   return scene;
+}
+
+fs::path StageContext::stage_rel(const std::string& stage) const {
+  if (!shared_stages) return stage;
+  const nlohmann::json sections = to_json(config);
+  nlohmann::json prefix = {{"input", input.string()}};
+  for (const Stage& s : stage_table()) {
+    if (sections.contains(s.name)) prefix[s.name] = sections[s.name];
+    if (s.name == stage) break;
+  }
+  return fs::path("stages") / (stage + "-" + hash_text(prefix.dump()));
 }
 
 std::string number_arg(double value) {

@@ -39,10 +39,11 @@ StagePlan plan(const StageContext& c) {
         init_flags(c, p.inputs), std::vector<std::string>{"--trace", (dir / "trace.jsonl").string()},
         o.extra_args})
     p.command.insert(p.command.end(), flags.begin(), flags.end());
-  p.outputs = {"train/point_cloud.ply", "train/metrics.json", "train/trace.jsonl"};
+  const fs::path rel = c.stage_rel("train");
+  p.outputs = {rel / "point_cloud.ply", rel / "metrics.json", rel / "trace.jsonl"};
   p.resumable = true;
   p.resume_args = {"--resume"};
-  p.resume_from = "train/checkpoints";
+  p.resume_from = rel / "checkpoints";
   return p;
 }
 

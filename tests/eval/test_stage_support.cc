@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "host/run/ablate.h"
 #include "host/run/stage.h"
 
 namespace litgs::host::run {
@@ -68,6 +69,32 @@ TEST_F(SceneCopyTest, CopiesLinksAndLeavesOutAsAsked) {
 
 TEST_F(SceneCopyTest, MissingSceneIsAnError) {
   EXPECT_THROW(make_scene_copy({root_ / "absent", {}, {}}, root_ / "out"), fs::filesystem_error);
+}
+
+}  // namespace
+}  // namespace litgs::host::run
+
+namespace litgs::host::run {
+namespace {
+
+TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
+  RunConfig base;
+  base.train.max_gaussians = 8000;
+  const auto all = ablation_studies("all", base);
+  ASSERT_EQ(all.size(), 4u);
+  EXPECT_EQ(all[0].variants.size(), 2u);  // refine off, on
+  EXPECT_EQ(all[1].variants.size(), 5u);  // lambda_geo 0 .. 0.8
+  EXPECT_EQ(all[2].variants.size(), 6u);  // 3 feature types x CLAHE
+  ASSERT_EQ(all[3].variants.size(), 6u);  // adc, mcmc x 3 budgets
+  RunConfig c = base;
+  all[3].variants[0].apply(c);
+  EXPECT_EQ(c.train.strategy, "adc");
+  EXPECT_EQ(c.train.max_gaussians, 2000u);
+  // Synthetic tracks: refine and train do not depend on the features, so the study stops after match.
+  EXPECT_EQ(all[2].variants[0].until, "match");
+  base.refine.tracks = "sfm";
+  EXPECT_EQ(ablation_studies("features", base)[0].variants[0].until, "eval");
+  EXPECT_THROW(ablation_studies("colour", base), std::invalid_argument);
 }
 
 }  // namespace

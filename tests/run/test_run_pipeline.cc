@@ -304,6 +304,38 @@ TEST(RunBadInput, FullDiskFailsTheStageWithoutAManifestAndARerunRedoesIt) {
   EXPECT_EQ(read_json_file(dir / "train" / "metrics.json")["iterations"], 40);
 }
 
+// ablate: the variants share the stages their options agree on, and the table holds what the runs measured.
+TEST(RunAblate, RefineStudySharesStagesAndWritesItsTable) {
+  const fs::path dir = kRoot / "ablate";
+  fs::remove_all(dir);
+  const fs::path config = write_text(kRoot / "ablate.yaml", small_run_yaml());
+  const CommandResult r =
+      run_engine("ablate synth:facade --out " + dir.string() + " --study refine --config " + config.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  size_t imports = 0, refines = 0, trains = 0;
+  for (const auto& e : fs::directory_iterator(dir / "stages")) {
+    const std::string name = e.path().filename().string();
+    imports += name.rfind("import-", 0) == 0;
+    refines += name.rfind("refine-", 0) == 0;
+    trains += name.rfind("train-", 0) == 0;
+  }
+  EXPECT_EQ(imports, 1u) << "the two runs did not share import";
+  EXPECT_EQ(refines, 1u) << "only the run with refinement has a refine folder";
+  EXPECT_EQ(trains, 2u);
+  for (const char* stage : {"import", "match"})
+    EXPECT_EQ(stage_status(dir / "runs", "refine-on", stage), "up to date") << stage;
+  EXPECT_EQ(stage_status(dir / "runs", "refine-off", "refine"), "skipped: refine.enabled is false");
+  std::ifstream in(dir / "ablation.md");
+  const std::string md{std::istreambuf_iterator<char>(in), {}};
+  EXPECT_NE(md.find("| pose refinement | ATE (m) | PSNR (dB) |"), std::string::npos) << md;
+  const nlohmann::json on = read_json_file(dir / "runs" / "refine-on.json");
+  char row[64];
+  std::snprintf(row, sizeof row, "| yes | %.4f | %.2f |", on["stages"][5]["metrics"]["ate_m"].get<double>(),
+                on["stages"][5]["metrics"]["psnr_db"].get<double>());
+  EXPECT_NE(md.find(row), std::string::npos) << row << "\n" << md;
+  EXPECT_NE(md.find("Made by `litgs-engine ablate synth:facade"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace litgs::testing
 
