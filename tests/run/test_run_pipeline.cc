@@ -105,6 +105,8 @@ TEST(RunStages, SceneStagesWorkOnCopiesAndLeaveTheInputAlone) {
   const CommandResult r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
   ASSERT_EQ(r.status, 0) << r.output;
   for (const char* stage : {"map", "match", "refine"}) EXPECT_EQ(stage_status(dir, stage), "done") << stage;
+  EXPECT_EQ(stage_status(dir, "import"), "done");  // a scene directory: nothing to run, used in place
+  EXPECT_FALSE(fs::exists(dir / "import" / "scene"));
   EXPECT_EQ(file_contents(scene), before) << "a stage modified the INPUT";
   const fs::path refined = dir / "refine" / "scene";
   EXPECT_TRUE(fs::exists(dir / "map" / "scene" / "lidar" / "map.pcd"));
@@ -117,6 +119,10 @@ TEST(RunStages, SceneStagesWorkOnCopiesAndLeaveTheInputAlone) {
   EXPECT_TRUE(fs::equivalent(scene / frame, refined / frame)) << "unchanged files are hard links";
   const nlohmann::json run = read_json_file(dir / "run.json");
   EXPECT_TRUE(run["stages"][3]["metrics"]["ate_after_m"].is_number()) << run["stages"][3];
+}
+
+std::string init_refined(std::string yaml) {
+  return yaml.replace(yaml.find("init: random"), 12, "init: refined");
 }
 
 // A stage with nothing to do says why: no scans, no ground truth for synthetic tracks; refine without a
@@ -153,6 +159,34 @@ TEST(RunStages, NothingToDoSaysWhy) {
   EXPECT_EQ(stage_status(dir, "refine"),
             "skipped: refine.tracks is synthetic and the scene has no gt/poses.txt to make them from");
   EXPECT_FALSE(fs::exists(dir / "refine"));
+  // Training from refine's points needs refine: the run stops at train and says why.
+  const fs::path refined_init = write_text(kRoot / "why-refined.yaml", init_refined(small_run_yaml()));
+  r = run_engine(run_args(scene.string(), dir, refined_init, "--until train"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("stage 'train' failed: train.init is refined but the refine stage did not run "
+                          "(refine.tracks is synthetic and the scene has no gt/poses.txt"),
+            std::string::npos)
+      << r.output;
+}
+
+// train.init: refined starts the Gaussians from refine's points (scene frame).
+TEST(RunStages, TrainStartsFromRefinedPoints) {
+  const fs::path dir = kRoot / "refined-init";
+  fs::remove_all(dir);
+  const fs::path config = write_text(kRoot / "refined-init.yaml", init_refined(small_run_yaml("", 20)));
+  const CommandResult r = run_engine(run_args("synth:facade", dir, config, "--until train"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const size_t at =
+      r.output.find(" Gaussians from " + (dir / "refine" / "scene" / "refine" / "points.pcd").string());
+  ASSERT_NE(at, std::string::npos) << r.output;
+  // As many Gaussians as refine wrote points (the PCD header's POINTS line).
+  const size_t init = r.output.rfind("init ", at);
+  std::ifstream pcd(dir / "refine" / "scene" / "refine" / "points.pcd");
+  size_t points = 0;
+  for (std::string line; std::getline(pcd, line) && line.rfind("DATA", 0) != 0;)
+    if (line.rfind("POINTS ", 0) == 0) points = std::stoul(line.substr(7));
+  EXPECT_GT(points, 0u);
+  EXPECT_EQ(std::stoul(r.output.substr(init + 5, at - init - 5)), points) << r.output;
 }
 
 TEST(RunBadInput, UnknownInputKind) {
