@@ -16,6 +16,9 @@ void add_serve_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--scene", o->scene, "Scene directory: poses in its frame, its cameras in GET /model")
       ->check(CLI::ExistingDirectory);
+  cmd->add_option("--levels", o->levels,
+                  "train's levels.json: legends in the data's units (default: levels.json beside --model)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--host", o->host, "Address to bind (loopback by default)")->capture_default_str();
   cmd->add_option("--port", o->port, "TCP port (0: any free port, printed)")->capture_default_str();
   cmd->add_option("--max-queue", o->max_queue, "Renders waiting for the device before 503")

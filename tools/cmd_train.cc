@@ -20,6 +20,7 @@
 #include "host/train/training_data.h"
 #include "host/train/true_planes.h"
 #include "io/scene.h"
+#include "io/sfm_files.h"
 #include "tools/commands.h"
 #include "tools/data_flags.h"
 
@@ -122,6 +123,19 @@ void run_train(TrainCliOptions o) {
         host::neighbour_scales(pts, init, data.scene_extent_m * 0.01), normals, planar, o.init_flatness);
     model = host::init_from_points(pts, data, init, covariances);
     init_what = std::to_string(pts.size()) + " LiDAR map points";
+  } else if (o.init == "sfm") {
+    // The front end's triangulated points (`match`), already in the scene's recentred frame.
+    const std::filesystem::path sfm_dir = std::filesystem::path(o.scene) / "sfm";
+    if (!io::has_sfm(sfm_dir))
+      throw std::invalid_argument("--init sfm: " + sfm_dir.string() +
+                                  " holds no front-end results (run `litgs-engine match` first)");
+    const io::SfmData sfm = io::read_sfm(sfm_dir);
+    std::vector<Eigen::Vector3d> pts;
+    for (const io::SfmPoint& p : sfm.points) pts.push_back(p.xyz);
+    if (pts.empty())
+      throw std::invalid_argument("--init sfm: the front end triangulated no point in " + sfm_dir.string());
+    model = host::init_from_points(pts, data, init, {});
+    init_what = std::to_string(pts.size()) + " front-end points (" + sfm_dir.string() + ")";
   } else {
     const host::InitPoints file =
         host::load_points(o.init, o.init_in_scene_frame ? Eigen::Vector3d::Zero() : data.world_offset_m);
@@ -214,7 +228,9 @@ void add_train_command(CLI::App& app) {
                 "The LiDAR term moves Gaussians but leaves their opacity to the image");
   cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")
       ->capture_default_str();
-  cmd->add_option("--init", o->init, "auto (LiDAR map, else random), random, or a .ply/.pcd point file")
+  cmd->add_option("--init", o->init,
+                  "auto (LiDAR map, else random), random, sfm (the front end's points in SCENE/sfm/), or a "
+                  ".ply/.pcd point file")
       ->capture_default_str();
   cmd->add_option_function<std::string>(
          "--init-frame", [o](const std::string& frame) { o->init_in_scene_frame = frame == "scene"; },

@@ -8,10 +8,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// train.init as `train --init` flags: "refined" is the refine stage's points (scene frame).
+// train.init as `train --init` flags: "sfm" is the front end's points (the scene's sfm/, from match),
+// "refined" the refine stage's (refine/points.pcd, scene frame).
 std::vector<std::string> init_flags(const StageContext& c, std::vector<std::filesystem::path>& inputs) {
   const std::string& init = c.config.train.init;
-  if (init == "auto" || init == "random") return {"--init", init};
+  if (init == "auto" || init == "random" || init == "sfm") return {"--init", init};  // sfm: match's points
   if (init == "refined") {
     const fs::path points = c.scene() / "refine" / "points.pcd";
     if (!c.results.contains("refine") || !c.results["refine"].contains("scene"))

@@ -23,6 +23,13 @@ void ServeTest::SetUpTestSuite() {
   io::write_gaussian_ply(dir_ / "models" / "other.ply", random_scene(200, 1, 1, 9));
   io::write_gaussian_ply(dir_ / "models" / "same.ply", random_scene(300, 1, 3, 5));
   io::write_gaussian_ply(dir_ / "outside.ply", random_scene(10, 1, 0, 1));
+  // A model with train's levels.json beside it: its intensity 0..1 is raw counts 1000..2000.
+  fs::create_directories(dir_ / "models" / "counts");
+  io::write_gaussian_ply(dir_ / "models" / "counts" / "model.ply", random_scene(300, 1, 3, 5));
+  // (written by hand: Eigen, which host/train/level_plan.h pulls in, clashes with httplib's resolv.h)
+  std::ofstream(dir_ / "models" / "counts" / "levels.json")
+      << R"({"level_model": "none", "stretch_low": 1000, "stretch_high": 2000, "vignetting_k1": 0,
+             "vignetting_k2": 0, "frames": []})";
   fs::create_symlink(dir_ / "outside.ply", dir_ / "models" / "link.ply");
   std::ofstream(dir_ / "models" / "broken.ply") << "ply\nformat ascii 1.0\nend_header\n";
   std::vector<std::string> args = {"--model", model_path(), "--models-dir", path("models"),   "--max-pixels",

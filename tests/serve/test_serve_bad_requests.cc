@@ -136,6 +136,21 @@ Received read_until_closed(int fd, int seconds) {
   return r;
 }
 
+TEST_F(ServeBadRequest, BodylessPutAndPatchAre405NotMalformed) {
+  // httplib refuses these before any handler runs; the answer must still name the method as the mistake.
+  for (const char* method : {"PUT", "PATCH"}) {
+    const int fd = connect_to(port());
+    const std::string request =
+        std::string(method) + " /render HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
+    ASSERT_EQ(send(fd, request.data(), request.size(), 0), static_cast<ssize_t>(request.size()));
+    const Received r = read_until_closed(fd, 10);
+    close(fd);
+    EXPECT_EQ(r.text.rfind("HTTP/1.1 405", 0), 0u) << method << ":\n" << r.text;
+    EXPECT_NE(r.text.find("Allow: GET, POST"), std::string::npos) << r.text;
+    EXPECT_NE(r.text.find(std::string(method) + " is not allowed on /render"), std::string::npos) << r.text;
+  }
+}
+
 TEST_F(ServeBadRequest, SlowClientIsDisconnectedWithoutBlockingOthers) {
   const int fd = connect_to(port());
   const std::string start = "POST /render HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n";

@@ -158,7 +158,7 @@ TEST_F(ServeTest, MetricsAreInPrometheusTextFormat) {
        {"# TYPE litgs_http_requests_total counter",
         "litgs_http_requests_total{endpoint=\"/render\",status=\"200\"}",
         "# TYPE litgs_render_latency_seconds histogram", "litgs_render_latency_seconds_bucket{le=\"+Inf\"}",
-        "litgs_render_device_seconds_count", "litgs_queue_depth 0",
+        "litgs_render_device_seconds_count", "litgs_queue_depth 0", "litgs_renders_in_flight 0",
         "litgs_model_gaussians{model=\"default\"}", "process_resident_memory_bytes"})
     EXPECT_NE(res->body.find(line), std::string::npos) << line << "\n" << res->body;
 }
@@ -215,7 +215,15 @@ TEST_F(ServeTest, SignalsFinishInFlightRequestsAndExitZero) {
       status = big ? big->status : -1;
       if (!big) error = httplib::to_string(big.error());
     });
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the request is in flight
+    // Signal only once the server holds the request (a fixed sleep lost that race on a loaded machine).
+    httplib::Client probe("127.0.0.1", server.port());
+    bool in_flight = false;
+    for (int i = 0; i < 600 && !in_flight; ++i) {
+      const auto m = probe.Get("/metrics");
+      in_flight = m && m->body.find("litgs_renders_in_flight 1") != std::string::npos;
+      if (!in_flight) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ASSERT_TRUE(in_flight) << "the render never reached the server\n" << server.output();
     EXPECT_EQ(server.stop(sig), 0) << server.output();
     request.join();
     EXPECT_EQ(status, 200) << error << "\n" << server.output();

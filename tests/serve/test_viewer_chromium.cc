@@ -108,5 +108,33 @@ TEST_F(ViewerChromium, NavigationStepChangesThePicture) {
   EXPECT_GT(moved, before.size() / 10) << "half a metre forward changes the view";
 }
 
+// The text of the element with id `id` in a dumped DOM ("" if absent).
+std::string element_text(const std::string& dom, const std::string& id) {
+  const std::string open = "id=\"" + id + "\">";
+  const size_t at = dom.find(open);
+  if (at == std::string::npos) return "";
+  const size_t start = at + open.size();
+  return dom.substr(start, dom.find('<', start) - start);
+}
+
+TEST_F(ViewerChromium, LegendAndRangeAreInTheDataUnitsOfLevelsJson) {
+  // models/counts/ holds a levels.json mapping intensity 0..1 to raw counts 1000..2000.
+  const auto load =
+      client()->Post("/models/load", R"({"name": "counts", "path": "counts/model.ply"})", "application/json");
+  ASSERT_TRUE(load);
+  ASSERT_EQ(load->status, 200) << load->body;
+  const std::string dom = chromium(std::string(kViewCamera) + "&model=counts&palette=gray", "--dump-dom");
+  EXPECT_NE(dom.find("data-frames=\"1\""), std::string::npos) << dom;
+  EXPECT_EQ(element_text(dom, "legend-unit"), "intensity (raw counts)") << dom;
+  const double lo = std::atof(element_text(dom, "legend-lo").c_str());
+  const double hi = std::atof(element_text(dom, "legend-hi").c_str());
+  EXPECT_GE(lo, 1000.0) << dom;  // the auto range of the render, in counts
+  EXPECT_LE(hi, 2000.0) << dom;
+  EXPECT_GT(hi, lo + 10.0) << dom;
+  // The default model has no levels.json: model units.
+  const std::string plain = chromium(std::string(kViewCamera) + "&palette=gray", "--dump-dom");
+  EXPECT_EQ(element_text(plain, "legend-unit"), "intensity (model units)") << plain;
+}
+
 }  // namespace
 }  // namespace litgs::testing

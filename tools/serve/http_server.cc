@@ -75,8 +75,30 @@ void refuse_query(const httplib::Request& req, const std::vector<std::string>& a
       throw RequestError(400, "unknown query parameter '" + name + "' for " + req.path);
 }
 
+// The methods each known path takes (405 for the others).
+constexpr std::pair<const char*, const char*> kMethods[] = {
+    {"/", "GET"},        {"/viewer.js", "GET"},    {"/palettes", "GET"},
+    {"/healthz", "GET"}, {"/metrics", "GET"},      {"/model", "GET"},
+    {"/models", "GET"},  {"/models/load", "POST"}, {"/render", "GET, POST"}};
+
+const char* allowed_methods(const std::string& path) {
+  for (const auto& [p, allowed] : kMethods)
+    if (path == p) return allowed;
+  return nullptr;
+}
+
+void refuse_method(const httplib::Request& req, httplib::Response& res, const std::string& allowed) {
+  send_error(res, 405, req.method + " is not allowed on " + req.path + " (allowed: " + allowed + ")");
+  res.set_header("Allow", allowed);
+}
+
 json array3(const std::array<double, 3>& a) {
   return json::array({a[0], a[1], a[2]});
+}
+
+json units_json(const std::optional<ImageUnits>& u) {
+  if (!u) return {{"name", "model units"}, {"low", 0.0}, {"high", 1.0}, {"source", nullptr}};
+  return {{"name", u->name}, {"low", u->low}, {"high", u->high}, {"source", u->source}};
 }
 
 json summary_json(const ModelSummary& s) {
@@ -89,7 +111,8 @@ json summary_json(const ModelSummary& s) {
           {"bounds", {{"min", array3(s.bounds_min)}, {"max", array3(s.bounds_max)}}},
           {"pose_frame", s.frame},
           {"frame_offset_m", array3(s.frame_offset)},
-          {"device_bytes", s.device_bytes}};
+          {"device_bytes", s.device_bytes},
+          {"image_units", units_json(s.image_units)}};
 }
 
 json camera_json(const SceneCamera& c) {
@@ -144,6 +167,10 @@ void add_routes(httplib::Server& svr, Service& service) {
             std::string gauges =
                 "# HELP litgs_queue_depth Device jobs waiting.\n# TYPE litgs_queue_depth gauge\n";
             gauges += "litgs_queue_depth " + std::to_string(service.queue_depth()) + "\n";
+            gauges +=
+                "# HELP litgs_renders_in_flight Render requests not yet answered.\n# TYPE "
+                "litgs_renders_in_flight gauge\nlitgs_renders_in_flight " +
+                std::to_string(service.renders_in_flight()) + "\n";
             gauges +=
                 "# HELP litgs_model_gaussians Gaussians of each loaded model.\n# TYPE litgs_model_gaussians "
                 "gauge\n";
@@ -242,15 +269,10 @@ void add_routes(httplib::Server& svr, Service& service) {
           }));
 
   // Known paths with a method they do not take: 405 naming the one they do.
-  const std::pair<const char*, const char*> methods[] = {
-      {"/", "GET"},        {"/viewer.js", "GET"},    {"/palettes", "GET"},
-      {"/healthz", "GET"}, {"/metrics", "GET"},      {"/model", "GET"},
-      {"/models", "GET"},  {"/models/load", "POST"}, {"/render", "GET, POST"}};
-  for (const auto& [path, allowed] : methods) {
+  for (const auto& [path, allowed] : kMethods) {
     const auto refuse = guarded(
         metrics, [allowed = std::string(allowed)](const httplib::Request& req, httplib::Response& res) {
-          send_error(res, 405, req.method + " is not allowed on " + req.path + " (allowed: " + allowed + ")");
-          res.set_header("Allow", allowed);
+          refuse_method(req, res, allowed);
         });
     if (std::string(allowed).find("POST") == std::string::npos) svr.Post(path, refuse);
     if (std::string(allowed).find("GET") == std::string::npos) svr.Get(path, refuse);
@@ -272,6 +294,14 @@ void configure(httplib::Server& svr, Service& service) {
   svr.set_error_handler(httplib::Server::HandlerWithResponse(
       [max_body = o.max_body_bytes, &service](const httplib::Request& req, httplib::Response& res) {
         if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;  // ours: counted already
+        // httplib refuses a body-less PUT/PATCH with 400 before any handler runs: the method is the mistake.
+        const char* allowed = allowed_methods(req.path);
+        if (res.status == 400 && allowed && !req.method.empty() &&
+            std::string(allowed).find(req.method) == std::string::npos) {
+          refuse_method(req, res, allowed);
+          service.metrics().count_request(endpoint_label(req.path), res.status, 0.0);
+          return httplib::Server::HandlerResponse::Handled;
+        }
         service.metrics().count_request(endpoint_label(req.path), res.status, 0.0);
         std::string message = "error " + std::to_string(res.status);
         if (res.status == 404) message = "no such endpoint: " + req.method + " " + req.path;

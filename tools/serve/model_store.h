@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "kernels/splat/rasterizer.h"
+#include "tools/serve/image_units.h"
 
 namespace litgs::serve {
 
@@ -28,6 +29,7 @@ struct ModelSummary {
   std::string frame;                                 // the frame poses are given in: scene | model
   std::array<double, 3> frame_offset{};              // pose-frame coordinates + this = original world
   uint64_t device_bytes = 0;
+  std::optional<ImageUnits> image_units;  // the image channel's data units (levels.json), if known
 };
 
 struct DeviceModel {

@@ -59,7 +59,7 @@ Service::Service(const ServeOptions& options) : options_(options) {
         context_.reset();
       });
   worker_->wait_ready();
-  load("default", options_.model);
+  load("default", options_.model, options_.levels);
 }
 
 Service::~Service() {
@@ -104,6 +104,11 @@ Result Service::on_device(Job&& job, double timeout_s, const char* what) {
 }
 
 RenderedView Service::render(const RenderRequest& r, ModelSummary* used) {
+  ++renders_in_flight_;
+  struct InFlight {
+    std::atomic<size_t>& count;
+    ~InFlight() { --count; }
+  } counted{renders_in_flight_};
   const std::optional<ModelSummary> summary = models_.summary(r.model);
   if (!summary) {
     std::string names;
@@ -158,7 +163,7 @@ RenderedView Service::render(const RenderRequest& r, ModelSummary* used) {
   return std::move(done.view);
 }
 
-ModelSummary Service::load(const std::string& name, const fs::path& path) {
+ModelSummary Service::load(const std::string& name, const fs::path& path, const std::string& levels) {
   // Parsing is CPU work: done here, on the HTTP thread, while the device keeps rendering.
   auto framed = std::make_shared<tools::FramedModel>(
       tools::load_framed_model(path, "auto", scene_offset_, options_.scene));
@@ -169,6 +174,7 @@ ModelSummary Service::load(const std::string& name, const fs::path& path) {
   s.channels = framed->model.channels;
   s.sh_degree = framed->model.sh_degree;
   s.frame = framed->frame;
+  s.image_units = find_image_units(path, levels);
   for (int a = 0; a < 3; ++a) {
     s.frame_offset[a] = framed->frame_offset[a];
     s.bounds_min[a] = s.gaussians ? 1e300 : 0;

@@ -2,6 +2,7 @@
 // the scene's cameras. http_server.cc maps requests onto it.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -22,8 +23,9 @@
 namespace litgs::serve {
 
 struct ServeOptions {
-  std::string model;  // loaded as "default" at start
-  std::string scene;  // optional: poses in its frame, its cameras in GET /model
+  std::string model;   // loaded as "default" at start
+  std::string scene;   // optional: poses in its frame, its cameras in GET /model
+  std::string levels;  // train's levels.json of --model (default: the one beside it, if any): data units
   std::string host = "127.0.0.1";
   int port = 8080;        // 0: any free port (printed)
   size_t max_queue = 32;  // renders waiting for the device before 503
@@ -54,6 +56,8 @@ class Service {
   Metrics& metrics() { return metrics_; }
   const std::vector<SceneCamera>& scene_cameras() const { return scene_cameras_; }
   size_t queue_depth() const { return worker_->depth(); }
+  // Render requests accepted and not yet answered (queued, on the device, or being encoded).
+  size_t renders_in_flight() const { return renders_in_flight_.load(); }
   const engine::DeviceInfo& device() const { return device_info_; }
   // Validation-layer errors so far, where the layer is on (LITGS_VALIDATION=1; the tests use it).
   std::optional<size_t> validation_errors() const;
@@ -63,13 +67,16 @@ class Service {
   RenderedView render(const RenderRequest& request, ModelSummary* used);
   // Loads (or reloads) `name` from `path` (already confined): parsed here, uploaded on the device thread,
   // then swapped in atomically.
-  ModelSummary load(const std::string& name, const std::filesystem::path& path);
+  // The image units come from `levels` if given, else from a levels.json beside `path`.
+  ModelSummary load(const std::string& name, const std::filesystem::path& path,
+                    const std::string& levels = {});
   // The real frame `index` of the scene as an 8-bit PNG (16-bit frames stretched min-max); 404 if none.
   std::vector<uint8_t> scene_frame_png(size_t index) const;
   // Finishes the queued device work and stops the device thread.
   void stop();
 
  private:
+  std::atomic<size_t> renders_in_flight_{0};
   template <class Result, class Job>
   Result on_device(Job&& job, double timeout_s, const char* what);
 

@@ -143,7 +143,8 @@ async function renderNow(factor) {
                                          body: JSON.stringify(body) });
     const reply = await res.json();
     if (!res.ok) throw new Error('render: ' + res.status + ' ' + reply.error);
-    state.data = { w, h, channels: reply.outputs.image.channels, image: decode(reply.outputs.image),
+    const channels = reply.outputs.image.channels;
+    state.data = { w, h, channels, image: toDataUnits(decode(reply.outputs.image), channels),
                    depth: decode(reply.outputs.depth), alpha: decode(reply.outputs.alpha), full: factor === 1 };
     state.frames += 1;
     draw();
@@ -173,6 +174,13 @@ function sharpen() {
 }
 
 const UNITS = { image: 'intensity (model units)', depth: 'depth (m)', alpha: 'alpha' };
+// A one-channel model's intensity in the data's units (GET /model's image_units: train's stretch window).
+function toDataUnits(image, channels) {
+  const u = state.units;
+  if (!u || channels !== 1) return image;
+  for (let i = 0; i < image.length; i += 1) image[i] = u.low + image[i] * (u.high - u.low);
+  return image;
+}
 function plane() {
   const d = state.data, s = show();
   if (s === 'image') return d.channels === 1 ? d.image : d.image.subarray(0, d.w * d.h);  // RGB: channel 0
@@ -258,7 +266,8 @@ function showValue(e) {
   const y = Math.floor((e.clientY - rect.top) * d.h / rect.height);
   if (x < 0 || y < 0 || x >= d.w || y >= d.h) return;
   const i = y * d.w + x;
-  $('cursor').textContent = `value under the cursor (${x}, ${y}): intensity ${d.image[i].toPrecision(4)}, ` +
+  $('cursor').textContent = `value under the cursor (${x}, ${y}): intensity ${d.image[i].toPrecision(4)}` +
+      `${state.units ? ' ' + state.units.name : ''}, ` +
       `depth ${d.depth[i].toPrecision(4)} m, alpha ${d.alpha[i].toPrecision(3)}`;
 }
 
@@ -282,6 +291,10 @@ async function start() {
       return j;
     })]);
   state.palettes = palettes;
+  if (model.image_units && model.image_units.source) {
+    state.units = model.image_units;
+    UNITS.image = `intensity (${model.image_units.name})`;
+  }
   for (const name of Object.keys(palettes)) $('palette').add(new Option(name, name));
   $('palette').value = params.get('palette') || 'ironbow';
   const cameras = (model.scene && model.scene.cameras) || [];
