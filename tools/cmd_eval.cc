@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "host/eval/evaluate_model.h"
+#include "host/eval/trajectory_eval.h"
 #include "host/eval/view_images.h"
 #include "io/atomic_file.h"
 #include "tools/commands.h"
@@ -31,7 +32,7 @@ std::string fixed(double v, int digits) {
   return buf;
 }
 
-void print_text(const host::ModelEvaluation& e) {
+void print_text(const host::ModelEvaluation& e, const nlohmann::json& trajectory) {
   const bool counts = e.bit_depth == 16;
   std::cout << "eval: " << e.views.size() << " held-out views at " << e.width << "x" << e.height << ", "
             << e.gaussians << " Gaussians, on " << e.device << "\n"
@@ -60,6 +61,14 @@ void print_text(const host::ModelEvaluation& e) {
     std::cout << "eval: Gaussian centres to planes (" << e.plane_reference << "): RMS "
               << fixed(e.centre_plane_rms_m, 4) << " m, median " << fixed(e.centre_plane_median_m, 4)
               << " m over " << e.centre_plane_counted << " of " << e.gaussians << " centres\n";
+  if (trajectory.is_object()) {
+    std::cout << "eval: ATE " << fixed(trajectory["ate_m"].get<double>(), 4) << " m";
+    if (trajectory["ate_prior_m"].is_number())
+      std::cout << " (before refinement " << fixed(trajectory["ate_prior_m"].get<double>(), 4) << " m)";
+    std::cout << " against gt/poses.txt, " << trajectory["alignment"].get<std::string>() << "\n";
+  } else {
+    std::cout << "eval: ATE " << trajectory.get<std::string>() << "\n";
+  }
   std::cout << "eval: LPIPS " << host::kLpipsNote << "\n";
 }
 
@@ -70,6 +79,15 @@ void run_eval(const EvalCliOptions& cli) {
   const host::ModelEvaluation e =
       host::evaluate_model(cli.model, cli.scene, o, cli.views_out.empty() ? nullptr : &images);
   nlohmann::json j = host::to_json(e);
+  // The trajectories where the scene has ground truth; a trajectory ATE cannot use is said, not fatal.
+  std::string why_not;
+  try {
+    const auto trajectories = host::evaluate_trajectories(cli.scene, &why_not);
+    if (trajectories) j["trajectory"] = host::to_json(*trajectories);
+  } catch (const std::invalid_argument& error) {
+    why_not = error.what();
+  }
+  if (!j.contains("trajectory")) j["trajectory"] = "not available: " + why_not;
   if (!cli.views_out.empty()) {
     std::filesystem::create_directories(cli.views_out);
     nlohmann::json pictures = nlohmann::json::array();
@@ -81,7 +99,7 @@ void run_eval(const EvalCliOptions& cli) {
   if (cli.json)
     std::cout << j.dump(2) << "\n";
   else
-    print_text(e);
+    print_text(e, j["trajectory"]);
 }
 
 }  // namespace

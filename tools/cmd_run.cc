@@ -20,13 +20,6 @@ struct RunCliOptions {
   bool print_config = false;
 };
 
-std::filesystem::path this_executable() {
-  char buf[PATH_MAX];
-  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
-  if (n <= 0) throw std::runtime_error("cannot find this program's path (/proc/self/exe)");
-  return std::string(buf, static_cast<size_t>(n));
-}
-
 void run_run(const RunCliOptions& o) {
   host::run::RunConfig config;
   if (!o.config.empty()) config = host::run::read_run_config(o.config);
@@ -41,6 +34,13 @@ void run_run(const RunCliOptions& o) {
 }
 
 }  // namespace
+
+std::filesystem::path this_executable() {
+  char buf[PATH_MAX];
+  const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
+  if (n <= 0) throw std::runtime_error("cannot find this program's path (/proc/self/exe)");
+  return std::string(buf, static_cast<size_t>(n));
+}
 
 void add_run_command(CLI::App& app) {
   auto o = std::make_shared<RunCliOptions>();

@@ -29,8 +29,9 @@ namespace {
 
 struct TrainCliOptions {
   std::string scene, out;
-  std::string init = "auto";      // auto | random | a .ply/.pcd file (in the scene's original world frame)
-  uint32_t random_count = 20000;  // Gaussians of --init random
+  std::string init = "auto";         // auto | random | a .ply/.pcd file (in the scene's original world frame)
+  bool init_in_scene_frame = false;  // --init-frame scene: the file is in the recentred scene frame
+  uint32_t random_count = 20000;     // Gaussians of --init random
   uint32_t max_init_points = 200000;  // LiDAR-map initialization keeps at most this many points
   // LiDAR-map initialization: a point on a LiDAR plane becomes a disc this thin relative to its radius
   // (host::surfel_covariances); 1: spheres, as 3DGS.
@@ -136,7 +137,8 @@ void run_train(TrainCliOptions o) {
     model = host::init_from_points(pts, data, init, {});
     init_what = std::to_string(pts.size()) + " front-end points (" + sfm_dir.string() + ")";
   } else {
-    const host::InitPoints file = host::load_points(o.init, data.world_offset_m);
+    const host::InitPoints file =
+        host::load_points(o.init, o.init_in_scene_frame ? Eigen::Vector3d::Zero() : data.world_offset_m);
     model = host::init_from_points(file.positions, data, init, file.covariances);
     init_what = o.init + (file.covariances.empty() ? "" : " (with covariances)");
   }
@@ -230,6 +232,11 @@ void add_train_command(CLI::App& app) {
                   "auto (LiDAR map, else random), random, sfm (the front end's points in SCENE/sfm/), or a "
                   ".ply/.pcd point file")
       ->capture_default_str();
+  cmd->add_option_function<std::string>(
+         "--init-frame", [o](const std::string& frame) { o->init_in_scene_frame = frame == "scene"; },
+         "--init FILE's frame: world (the original, scene + world_offset_m) or scene (recentred, as the "
+         "front end's and refine's points)")
+      ->check(CLI::IsMember({"world", "scene"}));
   cmd->add_option("--init-flatness", o->init_flatness,
                   "LiDAR-map init: thickness / radius of the discs on LiDAR planes (1: spheres)")
       ->check(CLI::Range(1e-3, 1.0))

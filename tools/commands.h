@@ -1,6 +1,7 @@
 // The subcommands of litgs-engine. Each registers itself on the CLI11 app and runs when chosen.
 #pragma once
 
+#include <filesystem>
 #include <string>
 
 namespace CLI {
@@ -32,5 +33,8 @@ void print_lidar_map_report(const host::LidarMapReport& report, const std::strin
 void add_eval_command(CLI::App& app);
 void add_run_command(CLI::App& app);  // and its report: tools/cmd_run.cc
 void add_report_command(CLI::App& app);
+void add_ablate_command(CLI::App& app);  // tools/cmd_ablate.cc
+// This program's path (/proc/self/exe): `run` and `ablate` run their stages with it.
+std::filesystem::path this_executable();
 
 }  // namespace litgs::tools

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   litgs::tools::add_eval_command(app);
   litgs::tools::add_run_command(app);
   litgs::tools::add_report_command(app);
+  litgs::tools::add_ablate_command(app);
   litgs::tools::add_export_command(app);
   litgs::tools::add_match_command(app);
   litgs::tools::add_map_command(app);

@@ -71,9 +71,11 @@ class Runner {
     ctx_.out_dir = fs::absolute(o_.out_dir);
     ctx_.engine = o_.engine;
     ctx_.config = o_.config;
-    fs::create_directories(ctx_.out_dir);
+    ctx_.shared_stages = o_.shared_stages;
+    record_path_ = ctx_.out_dir / (o_.record + ".json");
+    fs::create_directories(record_path_.parent_path());
     // The run's options beside its results: `run INPUT --out DIR --config DIR/run.yaml` repeats it.
-    io::write_file_atomic(ctx_.out_dir / "run.yaml",
+    io::write_file_atomic(ctx_.out_dir / (o_.record + ".yaml"),
                           [&](std::ostream& s) { s << run_config_yaml(o_.config); });
     record_ = {{"input", o_.input},
                {"kind", kind_name(ctx_.kind)},
@@ -92,11 +94,6 @@ class Runner {
         entry["status"] = "not run (after --until)";
         continue;
       }
-      if (!stage.built) {
-        entry["status"] = "skipped: not built yet";
-        out_ << tag << ": skipped: not built yet (" << stage.what << ")\n";
-        continue;
-      }
       try {
         run_stage(stage, !o_.from.empty() && i >= from, tag, entry);
       } catch (const StageFailed&) {
@@ -108,7 +105,7 @@ class Runner {
         finish(start, "failed");
         throw StageFailed(stage.name, e.what());
       }
-      write_json(ctx_.out_dir / "run.json", record_);
+      write_json(record_path_, record_);
     }
     finish(start, "done");
     summary();
@@ -142,6 +139,16 @@ class Runner {
 
   void run_stage(const Stage& stage, bool forced, const std::string& tag, json& entry) {
     const StagePlan plan = stage.plan(ctx_);
+    const fs::path dir = ctx_.stage_dir(stage.name), manifest_path = dir / "manifest.json";
+    if (!plan.skip_reason.empty()) {
+      // Nothing to do: what an earlier run left there would be taken for this run's.
+      fs::remove_all(dir);
+      ctx_.results[stage.name] = {{"skipped", plan.skip_reason}};
+      entry["status"] = "skipped: " + plan.skip_reason;
+      out_ << tag << ": skipped: " << plan.skip_reason << "\n";
+      return;
+    }
+    if (!plan.notes.empty()) entry["notes"] = plan.notes;
     json inputs = json::object();
     for (const fs::path& p : plan.inputs) inputs[fs::absolute(p).string()] = hash_of(p);
     const std::string key = hash_text(json{
@@ -149,7 +156,6 @@ class Runner {
         {"inputs", inputs},
         {"options", plan.options},
         {"command", plan.command}}.dump());
-    const fs::path dir = ctx_.stage_dir(stage.name), manifest_path = dir / "manifest.json";
     const json manifest = read_json(manifest_path);
     if (!forced && up_to_date(manifest, key, plan)) {
       ctx_.results[stage.name] = manifest.at("result");
@@ -162,16 +168,21 @@ class Runner {
     }
     // Continue an interrupted resumable stage only if it started with these inputs and options.
     const json started = read_json(dir / "started.json");
-    const bool resume = plan.resumable && !forced && started.is_object() && started.value("key", "") == key;
+    // Only from a checkpoint: one killed (or out of disk space) before its first has nothing to continue.
+    const fs::path checkpoints = ctx_.out_dir / plan.resume_from;
+    const bool resume = plan.resumable && !forced && started.is_object() && started.value("key", "") == key &&
+                        fs::is_directory(checkpoints) && !fs::is_empty(checkpoints);
     if (!resume) fs::remove_all(dir);
     fs::remove(manifest_path);
     fs::create_directories(dir);
     write_json(dir / "started.json", {{"key", key}, {"started", now_text()}});
+    if (plan.scene_copy && !resume) make_scene_copy(*plan.scene_copy, dir / "scene");
     std::vector<std::string> command = plan.command;
     if (resume) command.insert(command.end(), plan.resume_args.begin(), plan.resume_args.end());
     out_ << tag << ": " << stage.what << (resume ? " (resuming from its checkpoint)" : "")
-         << (forced ? " (forced by --from)" : "") << "\n"
-         << std::flush;
+         << (forced ? " (forced by --from)" : "") << "\n";
+    for (const std::string& note : plan.notes) out_ << tag << ": note: " << note << "\n";
+    out_ << std::flush;
     ChildResult child;
     if (!command.empty()) {
       child = run_child(ctx_.engine, command, dir / "log.txt", out_);
@@ -225,11 +236,11 @@ class Runner {
     record_["status"] = status;
     record_["total_seconds"] =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    write_json(ctx_.out_dir / "run.json", record_);
+    write_json(record_path_, record_);
   }
 
   void summary() {
-    out_ << "run: summary (" << (ctx_.out_dir / "run.json").string() << ")\n";
+    out_ << "run: summary (" << (record_path_).string() << ")\n";
     for (const json& s : record_["stages"]) {
       char line[256];
       std::snprintf(line, sizeof line, "  %-8s %-24s", s["name"].get<std::string>().c_str(),
@@ -255,6 +266,15 @@ class Runner {
                     value("psnr_db"), value("ssim"), value("emd_m"), value("emd_floor_m"),
                     value("render_ms_per_frame"), value("gaussians"));
       out_ << line;
+      if (m.contains("ate_m")) {
+        std::snprintf(line, sizeof line, "run: ATE %.4f m", value("ate_m"));
+        out_ << line;
+        if (m["ate_prior_m"].is_number()) {
+          std::snprintf(line, sizeof line, " (before refinement %.4f m)", value("ate_prior_m"));
+          out_ << line;
+        }
+        out_ << " against gt/poses.txt\n";
+      }
     }
     if (results.contains("report"))
       out_ << "run: report: " << results["report"]["report"].get<std::string>() << "\n";
@@ -264,6 +284,7 @@ class Runner {
   std::ostream& out_;
   StageContext ctx_;
   json record_;
+  fs::path record_path_;  // DIR/run.json
   std::map<std::string, std::string> hashes_;
 };
 

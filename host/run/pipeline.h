@@ -25,6 +25,8 @@ struct RunOptions {
   std::string from, until;  // stage names; "" for the first / last
   RunConfig config;
   std::filesystem::path engine;  // the litgs-engine binary that runs the stages' commands
+  bool shared_stages = false;    // stage folders shared by runs in DIR/stages/ (StageContext::stage_rel)
+  std::string record = "run";    // DIR/<record>.json and DIR/<record>.yaml: this run's record and options
 };
 
 // A stage that failed: the run stopped there; what earlier stages wrote is kept.

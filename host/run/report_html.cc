@@ -96,7 +96,18 @@ std::string summary_table(const json& metrics, const json& eval) {
   if (metrics["peak_device_bytes"].is_number())
     t += row("peak device memory", number(json(metrics["peak_device_bytes"].get<double>() / 1e6), 0, " MB"),
              "training");
-  t += row("trajectories, ATE", "not available", "the refine stage is not built yet");
+  const json& trajectory = eval.value("trajectory", json("not available: eval wrote no trajectories"));
+  if (trajectory.is_object()) {
+    const std::string how = escape_html(trajectory.value("alignment", "")) + ", " +
+                            std::to_string(trajectory.value("pairs", 0)) + " frames, against gt/poses.txt";
+    if (trajectory["ate_prior_m"].is_number())
+      t +=
+          row("ATE before refinement", number(trajectory["ate_prior_m"], 4, " m"), "poses_prior.txt; " + how);
+    t += row(trajectory["ate_prior_m"].is_number() ? "ATE after refinement" : "ATE",
+             number(trajectory["ate_m"], 4, " m"), "poses.txt; " + how);
+  } else {
+    t += row("ATE", "not available", escape_html(trajectory.get<std::string>()));
+  }
   return t + "</table>\n";
 }
 
@@ -155,7 +166,8 @@ body{font:14px sans-serif;margin:0;padding:0 16px;background:#fff;color:#222;wid
 h1{font-size:20px;height:28px;margin:8px 0}
 h2{font-size:16px;margin:18px 0 6px}
 #charts{display:flex;gap:12px;height:300px}
-.chart{width:388px;height:300px;position:relative}
+.chart{width:291px;height:300px;position:relative}
+.none{display:flex;align-items:center;justify-content:center;color:#666;border:1px solid #ccc}
 .view{display:flex;gap:8px;height:196px;align-items:flex-start}
 .vname{width:90px;font-size:12px;overflow-wrap:anywhere}
 figure{margin:0}
@@ -193,7 +205,23 @@ const char* kChartsScript = R"(
        'training time (s)', 'PSNR (dB)', 'loss');
   make('gaussians', [line('Gaussians', d.trace.map(p => ({x:p.iteration, y:p.gaussians})), '#2ca02c')],
        'iteration', 'Gaussians');
-  document.body.setAttribute('data-charts', '3');
+  let drawn = 3;
+  if (d.trajectory) {  // top view, the same metres per pixel on both axes (about: the chart area is near square)
+    const t = d.trajectory.top_view, all = t.truth.concat(t.prior, t.estimate);
+    const lo = k => Math.min(...all.map(p => p[k])), hi = k => Math.max(...all.map(p => p[k]));
+    const half = 0.55 * Math.max(hi(0) - lo(0), hi(1) - lo(1), 1e-6);
+    const mid = k => (lo(k) + hi(k)) / 2, xy = v => v.map(p => ({x:p[0], y:p[1]}));
+    const sets = [Object.assign(line('truth', xy(t.truth), '#9467bd'), {borderWidth:6, pointRadius:0, order:3})];
+    if (t.prior.length) sets.push(Object.assign(line('prior', xy(t.prior), '#ff7f0e'), {pointRadius:2, order:2}));
+    sets.push(Object.assign(line(t.prior.length ? 'refined' : 'estimate', xy(t.estimate), '#17becf'),
+                            {pointRadius:2, order:1}));
+    const scales = {x: Object.assign(axis('m (top view)'), {min:mid(0) - half, max:mid(0) + half}),
+                    y: Object.assign(axis('m'), {min:mid(1) - half, max:mid(1) + half})};
+    new Chart(document.getElementById('trajectory'), {type:'line', data:{datasets:sets},
+      options:Object.assign({scales:scales}, common)});
+    drawn = 4;
+  }
+  document.body.setAttribute('data-charts', String(drawn));
 })();
 )";
 
@@ -260,7 +288,10 @@ std::string report_html(const fs::path& run_dir, unsigned max_views) {
   json evaluations = json::array();
   for (const json& e : metrics.value("evaluations", json::array()))
     evaluations.push_back({{"iteration", e.at("iteration")}, {"psnr_db", e.at("psnr_db")}});
-  const json data = {{"trace", trace}, {"evaluations", evaluations}};
+  const json trajectory = eval.value("trajectory", json());
+  const json data = {{"trace", trace},
+                     {"evaluations", evaluations},
+                     {"trajectory", trajectory.is_object() ? trajectory : json(nullptr)}};
 
   std::string h =
       "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>LIT-GS run report</title>\n<style>";
@@ -270,7 +301,13 @@ std::string report_html(const fs::path& run_dir, unsigned max_views) {
   h += "\n</script>\n</head><body>\n<h1>LIT-GS run: " +
        escape_html(run.is_object() ? run.value("input", "") : run_dir.string()) + "</h1>\n";
   h += "<div id=charts><div class=chart><canvas id=psnr_iter></canvas></div><div class=chart><canvas "
-       "id=psnr_time></canvas></div><div class=chart><canvas id=gaussians></canvas></div></div>\n";
+       "id=psnr_time></canvas></div><div class=chart><canvas id=gaussians></canvas></div>";
+  h += trajectory.is_object()
+           ? "<div class=chart><canvas id=trajectory></canvas></div>"
+           : "<div class='chart none'>trajectories: " +
+                 escape_html(trajectory.is_string() ? trajectory.get<std::string>() : "not available") +
+                 "</div>";
+  h += "</div>\n";
   h += "<h2>Held-out views</h2>\n" + views_html(eval, run_dir / "eval", max_views);
   h += "<h2>Summary</h2>\n" + summary_table(metrics, eval);
   h += "<h2>Stages</h2>\n" + stages_table(run);

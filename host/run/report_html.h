@@ -1,6 +1,7 @@
 // DIR/report.html of a run: one self-contained file (Chart.js from Debian's libjs-chart.js inlined, pictures
 // as PNG data URIs; nothing is fetched at view time). Sections: the charts (held-out PSNR and training loss
-// against iterations and seconds, Gaussians over training), the held-out views (render beside the real
+// against iterations and seconds, Gaussians over training, the trajectories' top view with truth, prior and
+// refined poses where the scene has ground truth), the held-out views (render beside the real
 // frame, error map, false colour, rendered depth), the summary of stages and metrics, the per-view table.
 #pragma once
 

@@ -84,7 +84,8 @@ RunConfig read_run_config(const std::filesystem::path& path) {
   }
   RunConfig config;
   if (root.IsNull()) return config;  // an empty file: every default
-  if (!root.IsMap()) throw io::IoError(path, 0, "expected sections (import, train, eval, report)");
+  if (!root.IsMap())
+    throw io::IoError(path, 0, "expected sections (import, map, match, refine, train, eval, report)");
   std::set<std::string> sections, known;
   for_each_field(config, [&](const char* section, const char* key, auto&, const char*) {
     sections.insert(section);
@@ -97,8 +98,9 @@ RunConfig read_run_config(const std::filesystem::path& path) {
     if (!seen_sections.insert(section).second)
       throw io::IoError(path, line, "section '" + section + "' given twice");
     if (!sections.count(section))
-      throw io::IoError(path, line,
-                        "unknown section '" + section + "' (sections: import, train, eval, report)");
+      throw io::IoError(
+          path, line,
+          "unknown section '" + section + "' (sections: import, map, match, refine, train, eval, report)");
     if (s.second.IsNull()) continue;
     if (!s.second.IsMap()) throw io::IoError(path, line, "section '" + section + "' must hold keys");
     std::set<std::string> seen;

@@ -23,6 +23,30 @@ struct RunConfig {
     uint32_t synth_seed = 0;
     std::vector<std::string> extra_args;  // passed to `litgs-engine import KIND` (or synth) as they are
   } import;
+  struct Map {
+    std::string build = "auto";  // auto (scans and no map) | always (from the scans, replacing it) | never
+    double voxel = 0.1;
+    bool deskew = true;
+    std::vector<std::string> extra_args;  // passed to `litgs-engine map` as they are
+  } map;
+  struct Match {
+    bool enabled = true;
+    std::string features = "sift";  // orb | sift | akaze
+    bool clahe = true;
+    std::string pairs = "covisible";
+    uint32_t max_keypoints = 3000;
+    uint32_t threads = 0;                 // 0: all cores
+    std::vector<std::string> extra_args;  // passed to `litgs-engine match` as they are
+  } match;
+  struct Refine {
+    bool enabled = true;
+    std::string tracks = "synthetic";  // what `refine --tracks` accepts (synthetic: needs gt/, a synth scene)
+    bool anchors = true;
+    bool planes = true;  // the LiDAR point-to-plane term (off by itself where the scene has no LiDAR map)
+    uint32_t rounds = 3;
+    uint32_t threads = 1;
+    std::vector<std::string> extra_args;  // passed to `litgs-engine refine` as they are
+  } refine;
   struct Train {
     uint32_t iterations = 2000;
     double downscale = 1.0;
@@ -30,7 +54,7 @@ struct RunConfig {
     uint32_t max_gaussians = 20000;  // the MCMC budget (adc: a cap)
     double mcmc_growth = 0.3;
     double lambda_geo = 0.6;
-    std::string init = "auto";  // auto (LiDAR map, else random) | random | a .ply/.pcd file
+    std::string init = "auto";  // auto (LiDAR map, else random) | random | sfm | refined | a .ply/.pcd file
     uint32_t holdout_every = 8;
     std::string intensity = "auto";
     std::string poses = "estimated";
@@ -66,13 +90,36 @@ void for_each_field(Config& c, F&& f) {
   f("import", "synth_seed", c.import.synth_seed, "synth inputs: seed");
   f("import", "extra_args", c.import.extra_args,
     "more flags for `litgs-engine import KIND` (or synth), as is");
+  f("map", "build", c.map.build,
+    "auto (when the scene has scans and no map) | always (from the scans, replacing the map) | never");
+  f("map", "voxel", c.map.voxel, "voxel edge in metres (points averaged per voxel)");
+  f("map", "deskew", c.map.deskew, "deskew scans with their per-point time field");
+  f("map", "extra_args", c.map.extra_args, "more flags for `litgs-engine map`, as is");
+  f("match", "enabled", c.match.enabled, "run the thermal front end (writes the scene's sfm/)");
+  f("match", "features", c.match.features, "orb | sift | akaze");
+  f("match", "clahe", c.match.clahe, "CLAHE before detection");
+  f("match", "pairs", c.match.pairs,
+    "covisible[:N] | sequential:N | exhaustive (see `litgs-engine match --help`)");
+  f("match", "max_keypoints", c.match.max_keypoints, "keypoint budget per image");
+  f("match", "threads", c.match.threads, "worker threads (0: all cores)");
+  f("match", "extra_args", c.match.extra_args, "more flags for `litgs-engine match`, as is");
+  f("refine", "enabled", c.refine.enabled, "refine the poses (poses.txt; the input kept as poses_prior.txt)");
+  f("refine", "tracks", c.refine.tracks,
+    "track source, as `refine --tracks` (synthetic: from a synth scene's ground truth)");
+  f("refine", "anchors", c.refine.anchors, "anchor weights and priors");
+  f("refine", "planes", c.refine.planes, "LiDAR point-to-plane term (off where the scene has no LiDAR map)");
+  f("refine", "rounds", c.refine.rounds, "rounds of association, solve and rejection");
+  f("refine", "threads", c.refine.threads, "Ceres threads");
+  f("refine", "extra_args", c.refine.extra_args, "more flags for `litgs-engine refine`, as is");
   f("train", "iterations", c.train.iterations, "training iterations");
   f("train", "downscale", c.train.downscale, "divide image size and intrinsics by this");
   f("train", "strategy", c.train.strategy, "mcmc (fixed budget; measured better and faster on DUNR) | adc");
   f("train", "max_gaussians", c.train.max_gaussians, "MCMC budget (adc: cap)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
-  f("train", "init", c.train.init, "auto (LiDAR map, else random) | random | a .ply/.pcd file");
+  f("train", "init", c.train.init,
+    "auto (LiDAR map, else random) | random | sfm (match's points) | refined (refine's points) | a .ply/.pcd "
+    "file");
   f("train", "holdout_every", c.train.holdout_every, "hold out every Nth frame for evaluation");
   f("train", "intensity", c.train.intensity, "auto | percentile | linear");
   f("train", "poses", c.train.poses, "estimated (poses.txt) | truth (gt/poses.txt)");

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,23 +23,44 @@ struct StageContext {
   std::filesystem::path engine;   // the litgs-engine binary the stages' commands run
   RunConfig config;
   nlohmann::json results = nlohmann::json::object();  // {stage: its result} of the stages done so far
-  std::filesystem::path stage_dir(const std::string& stage) const { return out_dir / stage; }
+  // Stages' folders are DIR/<stage>, or with shared_stages (ablate: runs that share what they can)
+  // DIR/stages/<stage>-<hash of the INPUT and the options of this stage and those before it>, so runs whose
+  // options agree up to a stage find it done.
+  bool shared_stages = false;
+  std::filesystem::path stage_rel(const std::string& stage) const;  // relative to DIR
+  std::filesystem::path stage_dir(const std::string& stage) const { return out_dir / stage_rel(stage); }
+  // The scene the next stage works on: the last "scene" among the results (import's, or the copy that map,
+  // match or refine changed).
+  std::filesystem::path scene() const;
+};
+
+// A stage that changes the scene works on its own copy, DIR/<stage>/scene: the files it rewrites are copied,
+// the files it writes anew are left out, every other file is hard-linked (copied where links fail), so the
+// previous stage's scene and the user's INPUT are never modified.
+struct SceneCopy {
+  std::filesystem::path from;      // the previous scene
+  std::vector<std::string> copy;   // relative files or folders copied byte for byte
+  std::vector<std::string> fresh;  // relative files or folders not carried over (the stage writes them)
 };
 
 // One stage's work as planned before it runs.
 struct StagePlan {
   std::vector<std::filesystem::path> inputs;          // files or folders whose content decides a rerun
   nlohmann::json options = nlohmann::json::object();  // the options that decide a rerun
-  std::vector<std::string> command;            // argv[1..] of `engine`; empty: nothing to run (result only)
-  std::vector<std::filesystem::path> outputs;  // files or folders, relative to DIR, complete when it ends
+  std::vector<std::string> command;  // argv[1..] of `engine`; empty: nothing to run (result only)
+  std::vector<std::filesystem::path>
+      outputs;             // files or folders, relative to DIR (stage_rel), complete when it ends
   bool resumable = false;  // the command continues from its own checkpoints (train): not wiped on rerun
   std::vector<std::string> resume_args;  // added to the command when it continues
+  std::filesystem::path resume_from;     // relative to DIR: a folder that must hold a checkpoint to continue
+  std::string skip_reason;               // non-empty: nothing to do, reported as "skipped: REASON"
+  std::vector<std::string> notes;        // printed with the stage's progress line and kept in run.json
+  std::optional<SceneCopy> scene_copy;   // made in DIR/<stage>/scene before the command runs
 };
 
 struct Stage {
   std::string name;
-  std::string what;   // one line for the progress display
-  bool built = true;  // false: reported as "skipped: not built yet", never run
+  std::string what;  // one line for the progress display
   std::function<StagePlan(const StageContext&)> plan;
   // After the command succeeded (or when the stage is skipped as up to date): the stage's result for the
   // stages after it and its metrics for run.json, e.g. {"scene": path, "metrics": {...}}.
@@ -48,14 +70,30 @@ struct Stage {
 // A number as a command-line argument, without losing digits (std::to_string keeps 6 decimals).
 std::string number_arg(double value);
 
+// run.yaml options as command-line flags. Each spec is "key" (flag --key with '_' as '-') or "key=--flag";
+// a bool adds its flag when true, or, with a flag written "!--flag", when false; a list of strings adds
+// the flag and then each item; numbers keep every digit.
+std::vector<std::string> option_flags(const nlohmann::json& section,
+                                      std::initializer_list<const char*> specs);
+
+// A stage's JSON output (io::IoError naming the file when it is missing or malformed), and the listed keys
+// of an object that it has (a stage's metrics).
+nlohmann::json read_stage_json(const std::filesystem::path& path);
+nlohmann::json pick(const nlohmann::json& object, std::initializer_list<const char*> keys);
+
+// Makes `to` (emptied first) a copy of copy.from as SceneCopy says. io::IoError naming a file that fails.
+void make_scene_copy(const SceneCopy& copy, const std::filesystem::path& to);
+
 // The stages in the order they run (stage_table.cc).
 const std::vector<Stage>& stage_table();
 
 // The stage adapters, one file each.
 Stage import_stage();
+Stage map_stage();
+Stage match_stage();
+Stage refine_stage();
 Stage train_stage();
 Stage eval_stage();
 Stage report_stage();
-Stage not_built_stage(const std::string& name, const std::string& what);
 
 }  // namespace litgs::host::run

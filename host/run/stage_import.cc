@@ -96,7 +96,7 @@ StagePlan plan(const StageContext& c) {
       throw std::invalid_argument(c.input.string() + ": unknown kind of input: " + input_kind_help());
   }
   p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
-  p.outputs = {"import/scene"};
+  p.outputs = {c.stage_rel("import") / "scene"};
   return p;
 }
 
@@ -111,7 +111,7 @@ nlohmann::json result(const StageContext& c) {
 }  // namespace
 
 Stage import_stage() {
-  return {"import", "INPUT to a scene directory", true, plan, result};
+  return {"import", "INPUT to a scene directory", plan, result};
 }
 
 }  // namespace litgs::host::run

@@ -27,7 +27,7 @@ nlohmann::json result(const StageContext& c) {
 }  // namespace
 
 Stage report_stage() {
-  return {"report", "DIR/report.html", true, plan, result};
+  return {"report", "DIR/report.html", plan, result};
 }
 
 }  // namespace litgs::host::run

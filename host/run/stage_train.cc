@@ -1,5 +1,5 @@
 // train: the Gaussian map (`litgs-engine train`), resumed from its checkpoints after an interruption.
-#include <fstream>
+#include <stdexcept>
 
 #include "host/run/stage.h"
 
@@ -8,70 +8,59 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// train.init as `train --init` flags: "sfm" is the front end's points (the scene's sfm/, from match),
+// "refined" the refine stage's (refine/points.pcd, scene frame).
+std::vector<std::string> init_flags(const StageContext& c, std::vector<std::filesystem::path>& inputs) {
+  const std::string& init = c.config.train.init;
+  if (init == "auto" || init == "random" || init == "sfm") return {"--init", init};  // sfm: match's points
+  if (init == "refined") {
+    const fs::path points = c.scene() / "refine" / "points.pcd";
+    if (!c.results.contains("refine") || !c.results["refine"].contains("scene"))
+      throw std::invalid_argument("train.init is refined but the refine stage did not run (" +
+                                  c.results.value("refine", nlohmann::json::object()).value("skipped", "") +
+                                  ")");
+    return {"--init", points.string(), "--init-frame", "scene"};
+  }
+  inputs.push_back(init);
+  return {"--init", init};
+}
+
 StagePlan plan(const StageContext& c) {
   const RunConfig::Train& o = c.config.train;
-  const std::string scene = c.results.at("import").at("scene").get<std::string>();
+  const std::string scene = c.scene().string();
   const fs::path dir = c.stage_dir("train");
   StagePlan p;
   p.inputs = {scene};
-  if (o.init != "auto" && o.init != "random") p.inputs.push_back(o.init);
   p.options = section_json(c.config, "train");
-  p.command = {"train",
-               scene,
-               "--out",
-               dir.string(),
-               "--iterations",
-               std::to_string(o.iterations),
-               "--downscale",
-               number_arg(o.downscale),
-               "--strategy",
-               o.strategy,
-               "--max-gaussians",
-               std::to_string(o.max_gaussians),
-               "--mcmc-growth",
-               number_arg(o.mcmc_growth),
-               "--lambda-geo",
-               number_arg(o.lambda_geo),
-               "--init",
-               o.init,
-               "--holdout-every",
-               std::to_string(o.holdout_every),
-               "--intensity",
-               o.intensity,
-               "--poses",
-               o.poses,
-               "--seed",
-               std::to_string(o.seed),
-               "--eval-every",
-               std::to_string(o.eval_every),
-               "--checkpoint-every",
-               std::to_string(o.checkpoint_every),
-               "--progress-every",
-               std::to_string(o.progress_every),
-               "--trace",
-               (dir / "trace.jsonl").string()};
-  p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
-  p.outputs = {"train/point_cloud.ply", "train/metrics.json", "train/trace.jsonl"};
+  p.command = {"train", scene, "--out", dir.string()};
+  for (const auto& flags :
+       {option_flags(p.options, {"iterations", "downscale", "strategy", "max_gaussians", "mcmc_growth",
+                                 "lambda_geo", "holdout_every", "intensity", "poses", "seed", "eval_every",
+                                 "checkpoint_every", "progress_every"}),
+        init_flags(c, p.inputs), std::vector<std::string>{"--trace", (dir / "trace.jsonl").string()},
+        o.extra_args})
+    p.command.insert(p.command.end(), flags.begin(), flags.end());
+  const fs::path rel = c.stage_rel("train");
+  p.outputs = {rel / "point_cloud.ply", rel / "metrics.json", rel / "trace.jsonl"};
   p.resumable = true;
   p.resume_args = {"--resume"};
+  p.resume_from = rel / "checkpoints";
   return p;
 }
 
 nlohmann::json result(const StageContext& c) {
   const fs::path dir = c.stage_dir("train");
-  std::ifstream in(dir / "metrics.json");
-  const nlohmann::json m = nlohmann::json::parse(in);
-  nlohmann::json metrics = nlohmann::json::object();
-  for (const char* key : {"iterations", "wall_s", "ms_per_iteration", "gaussians", "peak_device_bytes",
-                          "heldout_psnr", "heldout_ssim", "heldout_depth_plane_rmse_m"})
-    if (m.contains(key)) metrics[key] = m[key];
+  const nlohmann::json metrics =
+      pick(read_stage_json(dir / "metrics.json"),
+           {"iterations", "wall_s", "ms_per_iteration", "gaussians", "peak_device_bytes", "heldout_psnr",
+            "heldout_ssim", "heldout_depth_plane_rmse_m"});
   return {{"model", (dir / "point_cloud.ply").string()}, {"metrics", metrics}};
 }
 
 }  // namespace
 
 Stage train_stage() {
-  return {"train", "Gaussian map on the Vulkan device", true, plan, result};
+  return {"train", "Gaussian map on the Vulkan device", plan, result};
 }
 
 }  // namespace litgs::host::run

@@ -36,12 +36,16 @@ inline nlohmann::json read_json_file(const std::filesystem::path& path) {
 }
 
 // The status run.json gives `stage` ("" when the stage is not listed).
-inline std::string stage_status(const std::filesystem::path& dir, const std::string& stage) {
-  const nlohmann::json run = read_json_file(dir / "run.json");
+inline std::string stage_status(const std::filesystem::path& dir, const std::string& record,
+                                const std::string& stage) {
+  const nlohmann::json run = read_json_file(dir / (record + ".json"));
   if (!run.is_object()) return "";
   for (const auto& s : run["stages"])
     if (s["name"] == stage) return s.value("status", "");
   return "";
+}
+inline std::string stage_status(const std::filesystem::path& dir, const std::string& stage) {
+  return stage_status(dir, "run", stage);
 }
 
 }  // namespace litgs::testing

@@ -1,7 +1,8 @@
 // DIR/report.html in headless Chromium (Debian's chromium): the page runs without console messages, draws its
-// three charts, and the screenshot's pixels show the charts (their line colours in the chart band) and the
-// pictures (false-colour and gray pixels in the views band). Controls show each check can fail: a page
-// with a script error is caught, and the report without its charts has no chart pixels.
+// four charts (the fourth: the trajectories' top view), and the screenshot's pixels show the charts (their
+// line colours in the chart band) and the pictures (false-colour and gray pixels in the views band). Controls
+// show each check can fail: a page with a script error is caught, and the report without its charts has no
+// chart pixels.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -104,7 +105,8 @@ TEST_F(RunReport, LoadsWithoutConsoleMessagesAndDrawsItsCharts) {
   const Browser b = chromium(report_, "--dump-dom");
   ASSERT_EQ(b.status, 0) << b.err;
   EXPECT_EQ(console_lines(b.err), std::vector<std::string>{}) << "console messages while loading the report";
-  EXPECT_NE(b.out.find("data-charts=\"3\""), std::string::npos) << "the chart script did not finish";
+  EXPECT_NE(b.out.find("data-charts=\"4\""), std::string::npos)
+      << "the chart script did not finish (or drew no trajectories)";
   // Self-contained: no address outside the file.
   const std::string html = slurp(report_);
   EXPECT_EQ(html.find("src=\"http"), std::string::npos);
@@ -133,6 +135,24 @@ TEST_F(RunReport, ScreenshotShowsChartsAndPictures) {
   EXPECT_GT(count_colour(img, 40, 340, red), 600u);
   EXPECT_GT(count_colour(img, 40, 340, blue), 600u);
   EXPECT_GT(count_colour(img, 40, 340, green), 600u);
+  // The trajectories' top view (the fourth chart, x >= 900): truth drawn 6 px wide under the refined poses
+  // (2 px), so both show; the prior mostly lies under them at this scale (millimetres of ATE on a metres
+  // wide chart): its legend box (40x12) at least.
+  const auto in_trajectory_chart = [&](std::array<int, 3> rgb) {
+    size_t n = 0;
+    for (int y = 40; y < 340; ++y)
+      for (int x = 900; x < img.width; ++x) {
+        bool close = true;
+        for (int c = 0; c < 3; ++c) close = close && std::abs(int{img.at(x, y, c)} - rgb[c]) <= 24;
+        n += close;
+      }
+    return n;
+  };
+  const std::array<int, 3> purple = {0x94, 0x67, 0xbd}, orange = {0xff, 0x7f, 0x0e},
+                           cyan = {0x17, 0xbe, 0xcf};
+  EXPECT_GT(in_trajectory_chart(purple), 600u) << "truth trajectory missing";
+  EXPECT_GT(in_trajectory_chart(cyan), 600u) << "refined trajectory missing";
+  EXPECT_GT(in_trajectory_chart(orange), 300u) << "prior trajectory's legend missing";
   // The pictures: five 160-row images per view; the error, false-colour and depth pictures are strongly
   // coloured, the render and the frame gray.
   const auto [colour, gray] = colour_and_gray(img, 380, 380 + 196);
@@ -142,15 +162,17 @@ TEST_F(RunReport, ScreenshotShowsChartsAndPictures) {
   // Control: the same report with the charts' construction taken out has no chart pixels (the check sees
   // the charts, not the rest of the page).
   std::string html = slurp(report_);
-  const size_t at = html.find("new Chart(");
-  ASSERT_NE(at, std::string::npos);
-  html.replace(at, 10, "void(");
+  size_t replaced = 0;
+  for (size_t at = 0; (at = html.find("new Chart(document", at)) != std::string::npos; ++replaced)
+    html.replace(at, 10, "void(");
+  ASSERT_EQ(replaced, 2u);  // the three curves' charts through one function, and the trajectories
   const fs::path without = write_text(kRoot / "report-without-charts.html", html);
   const fs::path off = kRoot / "report-shot-without-charts.png";
   fs::remove(off);
   ASSERT_EQ(chromium(without, "--screenshot=" + off.string()).status, 0);
   const io::Image no_charts = io::read_image(off);
   EXPECT_LT(count_colour(no_charts, 40, 340, red) + count_colour(no_charts, 40, 340, blue), 50u);
+  EXPECT_LT(count_colour(no_charts, 40, 340, purple) + count_colour(no_charts, 40, 340, cyan), 50u);
 }
 
 }  // namespace

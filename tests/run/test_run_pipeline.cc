@@ -2,9 +2,12 @@
 // inputs the issue names (unknown INPUT, a failing stage, a changed input, an interrupted stage).
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <map>
 #include <thread>
 
 #include "run_test_support.h"
@@ -28,18 +31,24 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
   const fs::path config = write_text(kRoot / "e2e.yaml", small_run_yaml());
   CommandResult r = run_engine(run_args("synth:facade", dir, config));
   ASSERT_EQ(r.status, 0) << r.output;
-  for (const char* stage : {"map", "match", "refine"}) {
-    EXPECT_EQ(stage_status(dir, stage), "skipped: not built yet");
-    EXPECT_NE(r.output.find(std::string("] ") + stage + ": skipped: not built yet"), std::string::npos)
-        << r.output;
-    EXPECT_FALSE(fs::exists(dir / stage)) << "a stage that is not built wrote something";
-  }
-  for (const char* stage : {"import", "train", "eval", "report"}) {
+  // The synthetic scene comes with its LiDAR map: map has nothing to do and says why.
+  EXPECT_EQ(stage_status(dir, "map"),
+            "skipped: scene has a LiDAR map already (map.build: always rebuilds it from the scans)");
+  EXPECT_FALSE(fs::exists(dir / "map"));
+  for (const char* stage : {"import", "match", "refine", "train", "eval", "report"}) {
     EXPECT_EQ(stage_status(dir, stage), "done") << stage;
     EXPECT_TRUE(fs::exists(dir / stage / "manifest.json")) << stage;
   }
   const nlohmann::json run = read_json_file(dir / "run.json");
   EXPECT_EQ(run["status"], "done");
+  // train and eval used the refined scene.
+  EXPECT_TRUE(fs::exists(dir / "refine" / "scene" / "poses_prior.txt"));
+  EXPECT_NE(read_json_file(dir / "train" / "manifest.json")["command"].dump().find(
+                (dir / "refine" / "scene").string()),
+            std::string::npos);
+  EXPECT_NE(read_json_file(dir / "eval" / "manifest.json")["command"].dump().find(
+                (dir / "refine" / "scene").string()),
+            std::string::npos);
   for (const auto& s : run["stages"])
     if (s["status"] == "done") {
       EXPECT_GT(s["seconds"].get<double>(), 0.0) << s;
@@ -47,6 +56,13 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
     }
   const nlohmann::json eval = read_json_file(dir / "eval" / "eval.json");
   EXPECT_GT(eval["psnr_db"].get<double>(), 5.0);
+  // ATE before and after refinement: eval measures it with refine's Umeyama ATE at the same frames.
+  const nlohmann::json refined = read_json_file(dir / "refine" / "scene" / "refine.json");
+  ASSERT_TRUE(eval["trajectory"].is_object()) << eval["trajectory"];
+  EXPECT_NEAR(eval["trajectory"]["ate_m"].get<double>(), refined["ate_after_m"].get<double>(), 1e-12);
+  EXPECT_NEAR(eval["trajectory"]["ate_prior_m"].get<double>(), refined["ate_before_m"].get<double>(), 1e-12);
+  EXPECT_EQ(eval["trajectory"]["top_view"]["truth"].size(), 16u);
+  EXPECT_NE(r.output.find("run: ATE "), std::string::npos) << r.output;
   EXPECT_EQ(eval["views"].size(), eval["heldout_views"].get<size_t>());
   EXPECT_EQ(read_json_file(dir / "train" / "metrics.json")["heldout_views"], eval["heldout_views"]);
   EXPECT_NEAR(read_json_file(dir / "train" / "metrics.json")["heldout_psnr"].get<double>(),
@@ -57,13 +73,120 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
   // A rerun skips everything; --from eval reruns eval and report only.
   r = run_engine(run_args("synth:facade", dir, config));
   ASSERT_EQ(r.status, 0) << r.output;
-  for (const char* stage : {"import", "train", "eval", "report"})
+  for (const char* stage : {"import", "match", "refine", "train", "eval", "report"})
     EXPECT_EQ(stage_status(dir, stage), "up to date");
   r = run_engine(run_args("synth:facade", dir, config, "--from eval"));
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(stage_status(dir, "train"), "up to date");
   EXPECT_EQ(stage_status(dir, "eval"), "done");
   EXPECT_EQ(stage_status(dir, "report"), "done");
+}
+
+std::map<std::string, std::string> file_contents(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) {
+      std::ifstream in(e.path(), std::ios::binary);
+      files[fs::relative(e.path(), dir).string()] = {std::istreambuf_iterator<char>(in), {}};
+    }
+  return files;
+}
+
+// map, match and refine each change their own copy of the scene; the user's scene directory stays as it was.
+TEST(RunStages, SceneStagesWorkOnCopiesAndLeaveTheInputAlone) {
+  const fs::path dir = kRoot / "copies", scene = kRoot / "copies-scene";
+  fs::remove_all(dir);
+  fs::remove_all(scene);
+  ASSERT_EQ(
+      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
+      0);
+  const auto before = file_contents(scene);
+  const fs::path config = write_text(kRoot / "copies.yaml", small_run_yaml() + "map:\n  build: always\n");
+  const CommandResult r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  for (const char* stage : {"map", "match", "refine"}) EXPECT_EQ(stage_status(dir, stage), "done") << stage;
+  EXPECT_EQ(stage_status(dir, "import"), "done");  // a scene directory: nothing to run, used in place
+  EXPECT_FALSE(fs::exists(dir / "import" / "scene"));
+  EXPECT_EQ(file_contents(scene), before) << "a stage modified the INPUT";
+  const fs::path refined = dir / "refine" / "scene";
+  EXPECT_TRUE(fs::exists(dir / "map" / "scene" / "lidar" / "map.pcd"));
+  EXPECT_TRUE(fs::exists(dir / "match" / "scene" / "sfm" / "frontend.json"));
+  EXPECT_TRUE(fs::exists(refined / "sfm" / "frontend.json")) << "refine's copy lost match's output";
+  EXPECT_EQ(file_contents(refined).at("poses_prior.txt"), before.at("poses.txt"));
+  EXPECT_NE(file_contents(refined).at("poses.txt"), before.at("poses.txt")) << "poses not refined";
+  const std::string frame =
+      "thermal/" + fs::directory_iterator(scene / "thermal")->path().filename().string();
+  EXPECT_TRUE(fs::equivalent(scene / frame, refined / frame)) << "unchanged files are hard links";
+  const nlohmann::json run = read_json_file(dir / "run.json");
+  EXPECT_TRUE(run["stages"][3]["metrics"]["ate_after_m"].is_number()) << run["stages"][3];
+}
+
+std::string init_refined(std::string yaml) {
+  return yaml.replace(yaml.find("init: random"), 12, "init: refined");
+}
+
+// A stage with nothing to do says why: no scans, no ground truth for synthetic tracks; refine without a
+// LiDAR map runs without the plane term.
+TEST(RunStages, NothingToDoSaysWhy) {
+  const fs::path dir = kRoot / "why", scene = kRoot / "why-scene";
+  fs::remove_all(dir);
+  fs::remove_all(scene);
+  ASSERT_EQ(
+      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
+      0);
+  // No LiDAR at all, as a photogrammetry import.
+  fs::remove_all(scene / "lidar");
+  std::ifstream in(scene / "scene.yaml");
+  std::string yaml{std::istreambuf_iterator<char>(in), {}};
+  const size_t at = yaml.find("lidar_map: true");
+  ASSERT_NE(at, std::string::npos);
+  write_text(scene / "scene.yaml", yaml.replace(at, 15, "lidar_map: false"));
+  const fs::path config = write_text(kRoot / "why.yaml", small_run_yaml());
+  CommandResult r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "map"), "skipped: scene has no scans (lidar/scans/)");
+  EXPECT_NE(r.output.find("map: skipped: scene has no scans"), std::string::npos) << r.output;
+  EXPECT_EQ(stage_status(dir, "refine"), "done");
+  EXPECT_NE(r.output.find("refine: note: the scene has no LiDAR map: refine runs without the plane term"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(read_json_file(dir / "refine" / "manifest.json")["command"].dump().find("--no-planes"),
+            std::string::npos);
+  // Without ground truth the synthetic tracks cannot be made: refine is skipped, and its old folder goes.
+  fs::remove_all(scene / "gt");
+  r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "refine"),
+            "skipped: refine.tracks is synthetic and the scene has no gt/poses.txt to make them from");
+  EXPECT_FALSE(fs::exists(dir / "refine"));
+  // Training from refine's points needs refine: the run stops at train and says why.
+  const fs::path refined_init = write_text(kRoot / "why-refined.yaml", init_refined(small_run_yaml()));
+  r = run_engine(run_args(scene.string(), dir, refined_init, "--until train"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("stage 'train' failed: train.init is refined but the refine stage did not run "
+                          "(refine.tracks is synthetic and the scene has no gt/poses.txt"),
+            std::string::npos)
+      << r.output;
+}
+
+// train.init: refined starts the Gaussians from refine's points (scene frame).
+TEST(RunStages, TrainStartsFromRefinedPoints) {
+  const fs::path dir = kRoot / "refined-init";
+  fs::remove_all(dir);
+  const fs::path config = write_text(kRoot / "refined-init.yaml", init_refined(small_run_yaml("", 20)));
+  const CommandResult r = run_engine(run_args("synth:facade", dir, config, "--until train"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const size_t at =
+      r.output.find(" Gaussians from " + (dir / "refine" / "scene" / "refine" / "points.pcd").string());
+  ASSERT_NE(at, std::string::npos) << r.output;
+  // As many Gaussians as refine wrote points (the PCD header's POINTS line).
+  const size_t init = r.output.rfind("init ", at);
+  std::ifstream pcd(dir / "refine" / "scene" / "refine" / "points.pcd");
+  size_t points = 0;
+  for (std::string line; std::getline(pcd, line) && line.rfind("DATA", 0) != 0;)
+    if (line.rfind("POINTS ", 0) == 0) points = std::stoul(line.substr(7));
+  EXPECT_GT(points, 0u);
+  EXPECT_EQ(std::stoul(r.output.substr(init + 5, at - init - 5)), points) << r.output;
 }
 
 TEST(RunBadInput, UnknownInputKind) {
@@ -165,6 +288,86 @@ TEST(RunBadInput, InterruptedStageIsNotTakenAsDone) {
   EXPECT_EQ(stage_status(dir, "train"), "up to date");
   EXPECT_EQ(stage_status(dir, "eval"), "done");
   EXPECT_TRUE(read_json_file(eval_json).is_object());
+}
+
+// `litgs-engine ARGS` with every file it (and its stages) write limited to `max_file_bytes`: writes past
+// that fail with EFBIG (SIGXFSZ ignored, as the limit and the disposition pass to the stages' children), as
+// on a full disk, without needing one.
+CommandResult run_engine_with_file_limit(const std::string& args, rlim_t max_file_bytes) {
+  const fs::path log = kRoot / "file-limit.log";
+  fs::remove(log);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const rlimit limit{max_file_bytes, max_file_bytes};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    ::signal(SIGXFSZ, SIG_IGN);
+    const std::string command =
+        std::string(LITGS_ENGINE_BINARY) + " " + args + " > " + log.string() + " 2>&1";
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int status = -1;
+  ::waitpid(pid, &status, 0);
+  std::ifstream in(log);
+  return {status, std::string{std::istreambuf_iterator<char>(in), {}}};
+}
+
+TEST(RunBadInput, FullDiskFailsTheStageWithoutAManifestAndARerunRedoesIt) {
+  const fs::path dir = kRoot / "full-disk";
+  fs::remove_all(dir);
+  const fs::path config = write_text(kRoot / "full-disk.yaml", small_run_yaml());
+  CommandResult r = run_engine(run_args("synth:facade", dir, config, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  // 600 kB per file: run.json and the manifests fit, train's checkpoint (about 1 MB) does not.
+  r = run_engine_with_file_limit(run_args("synth:facade", dir, config), 600'000);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("stage 'train' failed: exit status 1: litgs-engine: error: " +
+                          (dir / "train" / "checkpoints").string()),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("write failed (disk full?)"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "train" / "manifest.json"));
+  EXPECT_TRUE(fs::is_empty(dir / "train" / "checkpoints")) << "a half-written checkpoint was left";
+  EXPECT_EQ(stage_status(dir, "train"), "failed");
+  EXPECT_EQ(stage_status(dir, "refine"), "up to date");
+  // With space again: train runs afresh (there is no checkpoint to continue from), then eval and report.
+  r = run_engine(run_args("synth:facade", dir, config));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.find("resuming"), std::string::npos) << r.output;
+  for (const char* stage : {"train", "eval", "report"}) EXPECT_EQ(stage_status(dir, stage), "done") << stage;
+  EXPECT_EQ(read_json_file(dir / "train" / "metrics.json")["iterations"], 40);
+}
+
+// ablate: the variants share the stages their options agree on, and the table holds what the runs measured.
+TEST(RunAblate, RefineStudySharesStagesAndWritesItsTable) {
+  const fs::path dir = kRoot / "ablate";
+  fs::remove_all(dir);
+  const fs::path config = write_text(kRoot / "ablate.yaml", small_run_yaml());
+  const CommandResult r =
+      run_engine("ablate synth:facade --out " + dir.string() + " --study refine --config " + config.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  size_t imports = 0, refines = 0, trains = 0;
+  for (const auto& e : fs::directory_iterator(dir / "stages")) {
+    const std::string name = e.path().filename().string();
+    imports += name.rfind("import-", 0) == 0;
+    refines += name.rfind("refine-", 0) == 0;
+    trains += name.rfind("train-", 0) == 0;
+  }
+  EXPECT_EQ(imports, 1u) << "the two runs did not share import";
+  EXPECT_EQ(refines, 1u) << "only the run with refinement has a refine folder";
+  EXPECT_EQ(trains, 2u);
+  for (const char* stage : {"import", "match"})
+    EXPECT_EQ(stage_status(dir / "runs", "refine-on", stage), "up to date") << stage;
+  EXPECT_EQ(stage_status(dir / "runs", "refine-off", "refine"), "skipped: refine.enabled is false");
+  std::ifstream in(dir / "ablation.md");
+  const std::string md{std::istreambuf_iterator<char>(in), {}};
+  EXPECT_NE(md.find("| pose refinement | ATE (m) | PSNR (dB) |"), std::string::npos) << md;
+  const nlohmann::json on = read_json_file(dir / "runs" / "refine-on.json");
+  char row[64];
+  std::snprintf(row, sizeof row, "| yes | %.4f | %.2f |", on["stages"][5]["metrics"]["ate_m"].get<double>(),
+                on["stages"][5]["metrics"]["psnr_db"].get<double>());
+  EXPECT_NE(md.find(row), std::string::npos) << row << "\n" << md;
+  EXPECT_NE(md.find("Made by `litgs-engine ablate synth:facade"), std::string::npos);
 }
 
 }  // namespace

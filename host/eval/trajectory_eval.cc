@@ -1,0 +1,103 @@
+#include "host/eval/trajectory_eval.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <stdexcept>
+
+#include "io/scene.h"
+#include "io/tum.h"
+
+namespace litgs::host {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Position at time t, linear between the poses around it; nullopt outside the trajectory.
+std::optional<Eigen::Vector3d> position_at(const std::vector<io::TumPose>& poses, double t) {
+  const auto after = std::lower_bound(poses.begin(), poses.end(), t,
+                                      [](const io::TumPose& p, double time) { return p.t_s < time; });
+  if (after == poses.end()) return std::nullopt;
+  if (after->t_s == t) return after->p_world;
+  if (after == poses.begin()) return std::nullopt;
+  const io::TumPose& before = *(after - 1);
+  const double w = (t - before.t_s) / (after->t_s - before.t_s);
+  return ((1 - w) * before.p_world + w * after->p_world).eval();
+}
+
+// The trajectory at the given times (positions only: ATE uses nothing else).
+std::vector<io::TumPose> at_times(const std::vector<io::TumPose>& poses, const std::vector<double>& times) {
+  std::vector<io::TumPose> out;
+  for (double t : times)
+    if (const auto p = position_at(poses, t)) {
+      io::TumPose pose;  // the rotation stays identity: unused
+      pose.t_s = t;
+      pose.p_world = *p;
+      out.push_back(pose);
+    }
+  return out;
+}
+
+std::vector<Eigen::Vector2d> top_view(const std::vector<io::TumPose>& poses, const refine::Similarity& align,
+                                      const Eigen::Vector3d& centre,
+                                      const Eigen::Matrix<double, 3, 2>& axes) {
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& p : poses) out.push_back(axes.transpose() * (align.apply(p.p_world) - centre));
+  return out;
+}
+
+}  // namespace
+
+std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, std::string* why_not) {
+  io::SceneReadOptions ro;
+  ro.check_images = false;
+  ro.load_map = false;
+  const io::Scene scene = io::read_scene(dir, ro);
+  if (!scene.gt || scene.gt->poses.size() < 3) {
+    if (why_not) *why_not = "the scene has no gt/poses.txt (ground truth)";
+    return std::nullopt;
+  }
+  std::vector<double> times;
+  for (const auto& f : scene.frames) times.push_back(f.t_s);
+  const std::vector<io::TumPose> truth = at_times(scene.gt->poses, times);
+  constexpr double kSameTime = 1e-9;  // all three are sampled at the same frame times
+  TrajectoryEvaluation r;
+  const std::vector<io::TumPose> estimate = at_times(scene.poses, times);
+  r.estimate = refine::absolute_trajectory_error(estimate, truth, refine::AteAlignment::kSE3, kSameTime);
+  std::vector<io::TumPose> prior;
+  if (fs::exists(dir / "poses_prior.txt")) {
+    prior = at_times(io::read_tum(dir / "poses_prior.txt"), times);
+    r.prior = refine::absolute_trajectory_error(prior, truth, refine::AteAlignment::kSE3, kSameTime);
+  }
+  // The top view: the plane of the truth's two largest principal axes (for a ground or facade survey, the
+  // horizontal plane).
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& p : truth) centre += p.p_world / static_cast<double>(truth.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& p : truth) scatter += (p.p_world - centre) * (p.p_world - centre).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);  // eigenvalues ascending
+  Eigen::Matrix<double, 3, 2> axes;
+  axes.col(0) = eig.eigenvectors().col(2);
+  axes.col(1) = eig.eigenvectors().col(1);
+  r.truth_top = top_view(truth, {}, centre, axes);
+  r.estimate_top = top_view(estimate, r.estimate.alignment, centre, axes);
+  if (r.prior) r.prior_top = top_view(prior, r.prior->alignment, centre, axes);
+  return r;
+}
+
+nlohmann::json to_json(const TrajectoryEvaluation& t) {
+  const auto points = [](const std::vector<Eigen::Vector2d>& v) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const auto& p : v) a.push_back({p.x(), p.y()});
+    return a;
+  };
+  return {{"ate_m", t.estimate.rmse_m},
+          {"ate_prior_m", t.prior ? nlohmann::json(t.prior->rmse_m) : nlohmann::json(nullptr)},
+          {"pairs", t.estimate.pairs},
+          {"alignment", "SE(3) Umeyama, positions at the frame times"},
+          {"top_view",
+           {{"truth", points(t.truth_top)},
+            {"prior", points(t.prior_top)},
+            {"estimate", points(t.estimate_top)}}}};
+}
+
+}  // namespace litgs::host

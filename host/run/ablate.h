@@ -1,0 +1,52 @@
+// `litgs-engine ablate`: the method's ablations as sets of runs of the pipeline (host/run/pipeline.h) that
+// share every stage whose options agree (RunOptions::shared_stages), written as Markdown tables.
+//   refine    with and without pose refinement (Table II): ATE, PSNR, SSIM, depth-to-plane RMSE, seconds
+//   lambda    lambda_geo 0, 0.2, 0.4, 0.6, 0.8: PSNR, SSIM, depth and centres to planes, EMD
+//   features  ORB, SIFT, AKAZE, each with and without CLAHE (Table III): inlier ratio, verified pairs,
+//             points; ATE, plane residual and PSNR where refine uses the front end's tracks
+//   strategy  ADC and MCMC at 1/4, 1/2 and 1 times train.max_gaussians: Gaussians, PSNR, SSIM, seconds
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "host/run/run_config.h"
+
+namespace litgs::host::run {
+
+struct AblationVariant {
+  std::string name;                // a file name: DIR/runs/<study>-<name>.json
+  std::vector<std::string> cells;  // the table's first columns (what varies)
+  std::function<void(RunConfig&)> apply;
+  std::string until = "eval";
+};
+
+struct AblationStudy {
+  std::string name;
+  std::vector<std::string> varied;  // headers of the first columns
+  std::vector<AblationVariant> variants;
+  // The measured columns: header and how to read the cell from a run's record (run.json's content).
+  std::vector<std::pair<std::string, std::function<std::string(const nlohmann::json&)>>> measured;
+  std::string note;  // printed under the table
+};
+
+// The studies `name` names (refine, lambda, features, strategy, or all), built on `base`.
+// std::invalid_argument for another name.
+std::vector<AblationStudy> ablation_studies(const std::string& name, const RunConfig& base);
+
+struct AblateOptions {
+  std::string input;
+  std::filesystem::path out_dir;
+  std::string study = "all";
+  RunConfig config;
+  std::filesystem::path engine;
+};
+
+// Runs every variant (sharing stages), writes DIR/ablation.md (the tables, with the command) and
+// DIR/ablation.json (every run's record), and returns the Markdown. A failing run stops it (StageFailed).
+std::string run_ablation(const AblateOptions& options, const std::string& command_line, std::ostream& out);
+
+}  // namespace litgs::host::run

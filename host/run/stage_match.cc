@@ -1,0 +1,43 @@
+// match: the thermal front end (`litgs-engine match`) on DIR/match/scene, which gets a fresh sfm/.
+#include "host/run/stage.h"
+
+namespace litgs::host::run {
+namespace {
+
+namespace fs = std::filesystem;
+
+StagePlan plan(const StageContext& c) {
+  const RunConfig::Match& o = c.config.match;
+  const fs::path scene = c.scene(), copy = c.stage_dir("match") / "scene";
+  StagePlan p;
+  p.options = section_json(c.config, "match");
+  if (!o.enabled) {
+    p.skip_reason = "match.enabled is false";
+    return p;
+  }
+  p.inputs = {scene};
+  p.scene_copy = SceneCopy{scene, {}, {"sfm"}};
+  p.command = {"match", copy.string()};
+  const auto flags =
+      option_flags(p.options, {"features", "clahe=!--no-clahe", "pairs", "max_keypoints", "threads"});
+  p.command.insert(p.command.end(), flags.begin(), flags.end());
+  p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
+  p.outputs = {c.stage_rel("match") / "scene"};
+  return p;
+}
+
+nlohmann::json result(const StageContext& c) {
+  const fs::path scene = c.stage_dir("match") / "scene";
+  const nlohmann::json summary = read_stage_json(scene / "sfm" / "frontend.json").at("summary");
+  return {{"scene", scene.string()},
+          {"metrics", pick(summary, {"inlier_ratio", "pairs_tried", "pairs_verified", "tracks", "points",
+                                     "mean_track_length", "mean_reprojection_error_px"})}};
+}
+
+}  // namespace
+
+Stage match_stage() {
+  return {"match", "thermal front end: contrast, features, verified matches, tracks", plan, result};
+}
+
+}  // namespace litgs::host::run

@@ -1,0 +1,54 @@
+// refine: LiDAR-plane bundle adjustment of the poses (`litgs-engine refine`) on DIR/refine/scene, whose
+// poses.txt becomes the refined trajectory (the input kept as poses_prior.txt) for train and eval.
+#include "host/run/stage.h"
+
+namespace litgs::host::run {
+namespace {
+
+namespace fs = std::filesystem;
+
+StagePlan plan(const StageContext& c) {
+  const RunConfig::Refine& o = c.config.refine;
+  const fs::path scene = c.scene(), copy = c.stage_dir("refine") / "scene";
+  StagePlan p;
+  p.options = section_json(c.config, "refine");
+  if (!o.enabled) {
+    p.skip_reason = "refine.enabled is false";
+  } else if (o.tracks == "synthetic" && !fs::exists(scene / "gt" / "poses.txt")) {
+    p.skip_reason = "refine.tracks is synthetic and the scene has no gt/poses.txt to make them from";
+  } else if (o.tracks == "sfm" && !fs::is_directory(scene / "sfm")) {
+    p.skip_reason = "refine.tracks is sfm and the scene has no sfm/ (match did not run)";
+  }
+  if (!p.skip_reason.empty()) return p;
+  p.inputs = {scene};
+  p.scene_copy = SceneCopy{scene, {"poses.txt", "poses_prior.txt"}, {"refine", "refine.json"}};
+  nlohmann::json flags_from = p.options;
+  if (o.planes && !fs::exists(scene / "lidar" / "map.pcd")) {
+    flags_from["planes"] = false;
+    p.notes.push_back("the scene has no LiDAR map: refine runs without the plane term");
+  }
+  p.command = {"refine", copy.string()};
+  const auto flags = option_flags(
+      flags_from, {"tracks", "anchors=!--no-anchors", "planes=!--no-planes", "rounds", "threads"});
+  p.command.insert(p.command.end(), flags.begin(), flags.end());
+  p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
+  p.outputs = {c.stage_rel("refine") / "scene"};
+  return p;
+}
+
+nlohmann::json result(const StageContext& c) {
+  const fs::path scene = c.stage_dir("refine") / "scene";
+  const nlohmann::json r = read_stage_json(scene / "refine.json");
+  nlohmann::json metrics = pick(r, {"status", "frames", "points", "ate_before_m", "ate_after_m", "seconds"});
+  metrics["reprojection_rms_px"] = {r["before"]["reprojection_rms_px"], r["after"]["reprojection_rms_px"]};
+  metrics["plane_rms_m"] = {r["before"]["plane_rms_m"], r["after"]["plane_rms_m"]};
+  return {{"scene", scene.string()}, {"metrics", metrics}};
+}
+
+}  // namespace
+
+Stage refine_stage() {
+  return {"refine", "poses refined by LiDAR-plane bundle adjustment", plan, result};
+}
+
+}  // namespace litgs::host::run

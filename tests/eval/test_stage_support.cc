@@ -1,0 +1,101 @@
+// The stage adapters' shared parts: run.yaml options as flags, and the scene copies of map, match, refine.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "host/run/ablate.h"
+#include "host/run/stage.h"
+
+namespace litgs::host::run {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(StageFlags, EveryKindOfValue) {
+  const nlohmann::json section = {{"max_keypoints", 3000}, {"lambda_geo", 0.1}, {"features", "orb"},
+                                  {"clahe", false},        {"deskew", true},    {"geometry", true},
+                                  {"extra", {"--a", "b"}}};
+  const std::vector<std::string> expected = {"--max-keypoints", "3000", "--lambda",   "0.10000000000000001",
+                                             "--features",      "orb",  "--no-clahe", "--deskew",
+                                             "--extra",         "--a",  "b"};
+  EXPECT_EQ(option_flags(section, {"max_keypoints", "lambda_geo=--lambda", "features", "clahe=!--no-clahe",
+                                   "deskew", "geometry=!--no-geometry", "extra"}),
+            expected);
+  EXPECT_THROW(option_flags(section, {"missing"}), nlohmann::json::out_of_range);
+}
+
+class SceneCopyTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    root_ = fs::temp_directory_path() / ("litgs-scene-copy-" + std::to_string(::getpid()));
+    fs::remove_all(root_);
+    for (const char* f : {"scene.yaml", "poses.txt", "thermal/1.png", "lidar/map.pcd", "sfm/tracks.txt"}) {
+      fs::create_directories((root_ / "in" / f).parent_path());
+      std::ofstream(root_ / "in" / f) << f;
+    }
+  }
+  void TearDown() override { fs::remove_all(root_); }
+  static nlink_t links(const fs::path& p) {
+    struct stat s {};
+    return ::stat(p.c_str(), &s) == 0 ? s.st_nlink : 0;
+  }
+  static std::string text(const fs::path& p) {
+    std::ifstream in(p);
+    return {std::istreambuf_iterator<char>(in), {}};
+  }
+  fs::path root_;
+};
+
+TEST_F(SceneCopyTest, CopiesLinksAndLeavesOutAsAsked) {
+  const fs::path in = root_ / "in", out = root_ / "out";
+  fs::create_directories(out);
+  std::ofstream(out / "stale.txt") << "from an earlier run";
+  make_scene_copy({in, {"poses.txt", "lidar"}, {"sfm"}}, out);
+  EXPECT_FALSE(fs::exists(out / "stale.txt")) << "the copy mixed with what was there";
+  EXPECT_FALSE(fs::exists(out / "sfm"));
+  EXPECT_EQ(links(out / "thermal/1.png"), 2u) << "not hard-linked";
+  EXPECT_EQ(links(out / "scene.yaml"), 2u);
+  EXPECT_EQ(links(out / "poses.txt"), 1u) << "a file the stage changes must be a copy";
+  EXPECT_EQ(links(out / "lidar/map.pcd"), 1u) << "a folder in `copy` is copied whole";
+  // Changing the copy leaves the input alone.
+  std::ofstream(out / "poses.txt") << "refined";
+  std::ofstream(out / "lidar/map.pcd") << "rebuilt";
+  EXPECT_EQ(text(in / "poses.txt"), "poses.txt");
+  EXPECT_EQ(text(in / "lidar/map.pcd"), "lidar/map.pcd");
+}
+
+TEST_F(SceneCopyTest, MissingSceneIsAnError) {
+  EXPECT_THROW(make_scene_copy({root_ / "absent", {}, {}}, root_ / "out"), fs::filesystem_error);
+}
+
+}  // namespace
+}  // namespace litgs::host::run
+
+namespace litgs::host::run {
+namespace {
+
+TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
+  RunConfig base;
+  base.train.max_gaussians = 8000;
+  const auto all = ablation_studies("all", base);
+  ASSERT_EQ(all.size(), 4u);
+  EXPECT_EQ(all[0].variants.size(), 2u);  // refine off, on
+  EXPECT_EQ(all[1].variants.size(), 5u);  // lambda_geo 0 .. 0.8
+  EXPECT_EQ(all[2].variants.size(), 6u);  // 3 feature types x CLAHE
+  ASSERT_EQ(all[3].variants.size(), 6u);  // adc, mcmc x 3 budgets
+  RunConfig c = base;
+  all[3].variants[0].apply(c);
+  EXPECT_EQ(c.train.strategy, "adc");
+  EXPECT_EQ(c.train.max_gaussians, 2000u);
+  // Synthetic tracks: refine and train do not depend on the features, so the study stops after match.
+  EXPECT_EQ(all[2].variants[0].until, "match");
+  base.refine.tracks = "sfm";
+  EXPECT_EQ(ablation_studies("features", base)[0].variants[0].until, "eval");
+  EXPECT_THROW(ablation_studies("colour", base), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace litgs::host::run
