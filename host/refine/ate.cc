@@ -59,4 +59,17 @@ AteResult absolute_trajectory_error(const std::vector<io::TumPose>& estimate,
   return r;
 }
 
+std::vector<io::TumPose> as_tum_poses(const std::vector<CameraPose>& poses) {
+  std::vector<io::TumPose> out;
+  out.reserve(poses.size());
+  for (const auto& c : poses) {
+    io::TumPose p;
+    p.t_s = c.t_s;
+    p.p_world = c.p;
+    p.q_world_body = c.q;
+    out.push_back(p);
+  }
+  return out;
+}
+
 }  // namespace litgs::host::refine

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "host/refine/ba_types.h"
 #include "io/tum.h"
 
 namespace litgs::host::refine {
@@ -35,5 +36,8 @@ struct AteResult {
 AteResult absolute_trajectory_error(const std::vector<io::TumPose>& estimate,
                                     const std::vector<io::TumPose>& truth, AteAlignment alignment,
                                     double max_dt_s = 0.01);
+
+// Camera poses as TUM poses (time, position, rotation; no change of frame).
+std::vector<io::TumPose> as_tum_poses(const std::vector<CameraPose>& poses);
 
 }  // namespace litgs::host::refine

@@ -58,16 +58,9 @@ std::vector<CameraPose> camera_poses_at(const std::vector<io::TumPose>& poses,
 
 std::vector<io::TumPose> to_tum(const std::vector<CameraPose>& poses, const io::SceneConfig& config) {
   const Eigen::Matrix4d T_cam_body = body_from_camera(config).inverse();
-  std::vector<io::TumPose> out;
-  for (const auto& c : poses) {
-    const CameraPose b = from_matrix(c.t_s, to_matrix(c) * T_cam_body);
-    io::TumPose p;
-    p.t_s = c.t_s;
-    p.p_world = b.p;
-    p.q_world_body = b.q;
-    out.push_back(p);
-  }
-  return out;
+  std::vector<CameraPose> body;
+  for (const auto& c : poses) body.push_back(from_matrix(c.t_s, to_matrix(c) * T_cam_body));
+  return as_tum_poses(body);
 }
 
 // "synthetic: litgs-engine synth --preset NAME --seed S ..." -> the preset's world.

@@ -6,24 +6,9 @@
 #include "host/synth/rng.h"
 
 namespace litgs::host::refine::testing {
-namespace {
-
-std::vector<io::TumPose> tum(const std::vector<CameraPose>& poses) {
-  std::vector<io::TumPose> out;
-  for (const auto& c : poses) {
-    io::TumPose p;
-    p.t_s = c.t_s;
-    p.p_world = c.p;
-    p.q_world_body = c.q;
-    out.push_back(p);
-  }
-  return out;
-}
-
-}  // namespace
 
 double ate(const std::vector<CameraPose>& poses, const std::vector<CameraPose>& truth) {
-  return absolute_trajectory_error(tum(poses), tum(truth), AteAlignment::kSE3).rmse_m;
+  return absolute_trajectory_error(as_tum_poses(poses), as_tum_poses(truth), AteAlignment::kSE3).rmse_m;
 }
 
 void make_test_scene(TestScene& s, const TestSceneOptions& o) {
