@@ -23,6 +23,7 @@
 #include "io/sfm_files.h"
 #include "tools/commands.h"
 #include "tools/data_flags.h"
+#include "tools/train_budget.h"
 
 namespace litgs::tools {
 namespace {
@@ -38,6 +39,7 @@ struct TrainCliOptions {
   double init_flatness = 0.1;
   DataFlags data_flags;  // --intensity, --poses
   std::string trace;     // JSON lines appended at every progress report (the report's curves)
+  std::string max_gaussians = "2000000";  // a count, or auto (tools/train_budget.h)
   host::TrainingDataOptions data;
   host::TrainOptions train;
 };
@@ -142,6 +144,15 @@ void run_train(TrainCliOptions o) {
     model = host::init_from_points(file.positions, data, init, file.covariances);
     init_what = o.init + (file.covariances.empty() ? "" : " (with covariances)");
   }
+
+  BudgetInputs budget;
+  budget.data = &data;
+  budget.map_points = &map_points;
+  budget.initial = &model;
+  budget.initial_is_random = o.init == "random" || (o.init == "auto" && map_points.empty());
+  budget.resume = o.train.resume;
+  o.train.max_gaussians = resolve_max_gaussians(o.max_gaussians, budget, o.out);
+  o.train.check();
 
   engine::Context context;
   const bool tty = ::isatty(STDOUT_FILENO);
@@ -253,7 +264,9 @@ void add_train_command(CLI::App& app) {
       "--recentred-output", o->train.recentred_output,
       "Write point_cloud.ply in the scene's recentred frame (poses.txt's) instead of the original world "
       "frame (scene + world_offset_m)");
-  cmd->add_option("--max-gaussians", o->train.max_gaussians, "Cap of the model size (the MCMC budget)")
+  cmd->add_option("--max-gaussians", o->max_gaussians,
+                  "Cap of the model size (the MCMC budget): a count, or auto (derived from the surface the "
+                  "training views see at their resolution: the LiDAR map, else the initialization's points)")
       ->capture_default_str();
   cmd->add_option("--strategy", o->train.strategy,
                   "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")

@@ -95,22 +95,34 @@ AblationStudy features_study(const RunConfig& base) {
   return s;
 }
 
+// The budgets the strategy study compares: 1/4, 1/2 and 1 times a fixed train.max_gaussians; with auto, the
+// derived budget beside fixed ones spanning the README's DUNR sweep (5k to 80k).
+std::vector<std::string> compared_budgets(const std::string& base) {
+  if (base == "auto") return {"5000", "20000", "80000", "auto"};
+  const bool count = !base.empty() && base.find_first_not_of("0123456789") == std::string::npos &&
+                     base.size() <= 9 && std::stoul(base) >= 4;
+  if (!count)
+    throw std::invalid_argument("train.max_gaussians must be a count (at least 4) or auto, not '" + base +
+                                "'");
+  const unsigned long b = std::stoul(base);
+  return {std::to_string(b / 4), std::to_string(b / 2), base};
+}
+
 AblationStudy strategy_study(const RunConfig& base) {
   AblationStudy s{"strategy", {"strategy", "budget"}, {}, {}, ""};
   for (const char* strategy : {"adc", "mcmc"})
-    for (const uint32_t divisor : {4u, 2u, 1u}) {
-      const uint32_t budget = base.train.max_gaussians / divisor;
-      s.variants.push_back({std::string(strategy) + "-" + std::to_string(budget),
-                            {strategy, std::to_string(budget)},
-                            [strategy, budget](RunConfig& c) {
-                              c.train.strategy = strategy;
-                              c.train.max_gaussians = budget;
-                            }});
-    }
+    for (const std::string& budget : compared_budgets(base.train.max_gaussians))
+      s.variants.push_back(
+          {std::string(strategy) + "-" + budget, {strategy, budget}, [strategy, budget](RunConfig& c) {
+             c.train.strategy = strategy;
+             c.train.max_gaussians = budget;
+           }});
   s.measured = {column("Gaussians", "train", "gaussians", 0), column("PSNR (dB)", "eval", "psnr_db", 2),
                 column("SSIM", "eval", "ssim", 4), column("training (s)", "train", "wall_s", 1),
                 column("ms/iteration", "train", "ms_per_iteration", 1)};
-  s.note = "budget: MCMC's fixed number of Gaussians; ADC's cap.";
+  s.note =
+      "budget: MCMC's fixed number of Gaussians; ADC's cap; auto: derived from the scene (`train "
+      "--max-gaussians auto`).";
   return s;
 }
 

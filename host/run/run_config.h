@@ -50,8 +50,8 @@ struct RunConfig {
   struct Train {
     uint32_t iterations = 2000;
     double downscale = 1.0;
-    std::string strategy = "mcmc";   // mcmc: measured faster and better than adc on DUNR (README)
-    uint32_t max_gaussians = 20000;  // the MCMC budget (adc: a cap)
+    std::string strategy = "mcmc";        // mcmc: measured faster and better than adc on DUNR (README)
+    std::string max_gaussians = "20000";  // the MCMC budget (adc: a cap): a count, or auto (from the scene)
     double mcmc_growth = 0.3;
     double lambda_geo = 0.6;
     std::string init = "auto";  // auto (LiDAR map, else random) | random | sfm | refined | a .ply/.pcd file
@@ -114,7 +114,8 @@ void for_each_field(Config& c, F&& f) {
   f("train", "iterations", c.train.iterations, "training iterations");
   f("train", "downscale", c.train.downscale, "divide image size and intrinsics by this");
   f("train", "strategy", c.train.strategy, "mcmc (fixed budget; measured better and faster on DUNR) | adc");
-  f("train", "max_gaussians", c.train.max_gaussians, "MCMC budget (adc: cap)");
+  f("train", "max_gaussians", c.train.max_gaussians,
+    "MCMC budget (adc: cap): a count, or auto (derived from the surface the training views see)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
   f("train", "init", c.train.init,

@@ -4,10 +4,10 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <nanoflann.hpp>
 #include <random>
 #include <stdexcept>
 
+#include "host/train/point_kdtree.h"
 #include "io/pcd.h"
 #include "io/ply_points.h"
 
@@ -15,18 +15,6 @@ namespace litgs::host {
 namespace {
 
 constexpr double kShC0 = 0.28209479177387814;
-
-struct CloudAdaptor {
-  const std::vector<Eigen::Vector3d>& pts;
-  size_t kdtree_get_point_count() const { return pts.size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return pts[i][static_cast<int>(dim)]; }
-  template <class B>
-  bool kdtree_get_bbox(B&) const {
-    return false;
-  }
-};
-using KdTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor>, CloudAdaptor, 3>;
 
 // Intensity of the nearest training view that sees p, or -1.
 double sample_views(const Eigen::Vector3d& p, const TrainingData& data) {
@@ -133,8 +121,8 @@ std::vector<double> neighbour_scales(const std::vector<Eigen::Vector3d>& points,
   o.check();
   std::vector<double> scales(points.size(), std::max(o.min_scale_m, isolated_scale_m));
   if (points.size() < 2) return scales;
-  CloudAdaptor adaptor{points};
-  KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  PointCloudAdaptor adaptor{points};
+  PointKdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
   tree.buildIndex();
   const size_t k = std::min<size_t>(o.neighbours + 1, points.size());
   std::vector<uint32_t> idx(k);

@@ -7,21 +7,9 @@
 #include <nanoflann.hpp>
 #include <stdexcept>
 
+#include "host/train/point_kdtree.h"
+
 namespace litgs::host {
-namespace {
-
-struct Adaptor {
-  const std::vector<Eigen::Vector3d>& pts;
-  size_t kdtree_get_point_count() const { return pts.size(); }
-  double kdtree_get_pt(size_t i, size_t d) const { return pts[i][static_cast<int>(d)]; }
-  template <class B>
-  bool kdtree_get_bbox(B&) const {
-    return false;
-  }
-};
-using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Adaptor>, Adaptor, 3>;
-
-}  // namespace
 
 void PlaneFitOptions::check() const {
   if (neighbours < 3) throw std::invalid_argument("PlaneFitOptions.neighbours must be >= 3");
@@ -45,8 +33,8 @@ PlanarMap fit_planes(const std::vector<Eigen::Vector3d>& points, const PlaneFitO
   map.planar.assign(points.size(), 0);
   map.flatness.assign(points.size(), std::numeric_limits<float>::quiet_NaN());
   if (points.size() < o.neighbours) return map;
-  Adaptor adaptor{points};
-  Tree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  PointCloudAdaptor adaptor{points};
+  PointKdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
   tree.buildIndex();
   std::vector<uint32_t> idx(o.neighbours);
   std::vector<double> d2(o.neighbours);
@@ -83,8 +71,8 @@ void assign_surfel_radii(PlanarMap& map, uint32_t neighbours, double coverage) {
   std::vector<Eigen::Vector3d> pts;
   pts.reserve(map.points.size());
   for (const auto& p : map.points) pts.push_back(p.cast<double>());
-  Adaptor adaptor{pts};
-  Tree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  PointCloudAdaptor adaptor{pts};
+  PointKdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
   tree.buildIndex();
   std::vector<uint32_t> idx(neighbours + 1);
   std::vector<double> d2(neighbours + 1);

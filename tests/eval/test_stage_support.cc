@@ -79,7 +79,7 @@ namespace {
 
 TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
   RunConfig base;
-  base.train.max_gaussians = 8000;
+  base.train.max_gaussians = "8000";
   const auto all = ablation_studies("all", base);
   ASSERT_EQ(all.size(), 4u);
   EXPECT_EQ(all[0].variants.size(), 2u);  // refine off, on
@@ -89,12 +89,25 @@ TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
   RunConfig c = base;
   all[3].variants[0].apply(c);
   EXPECT_EQ(c.train.strategy, "adc");
-  EXPECT_EQ(c.train.max_gaussians, 2000u);
+  EXPECT_EQ(c.train.max_gaussians, "2000");
   // Synthetic tracks: refine and train do not depend on the features, so the study stops after match.
   EXPECT_EQ(all[2].variants[0].until, "match");
   base.refine.tracks = "sfm";
   EXPECT_EQ(ablation_studies("features", base)[0].variants[0].until, "eval");
   EXPECT_THROW(ablation_studies("colour", base), std::invalid_argument);
+}
+
+TEST(AblationStudies, TheStrategyStudyComparesADerivedBudgetWithFixedOnes) {
+  RunConfig base;
+  base.train.max_gaussians = "auto";
+  const auto study = ablation_studies("strategy", base);
+  ASSERT_EQ(study.at(0).variants.size(), 8u);  // adc, mcmc x 5k, 20k, 80k, auto
+  RunConfig c = base;
+  study[0].variants.back().apply(c);
+  EXPECT_EQ(c.train.strategy, "mcmc");
+  EXPECT_EQ(c.train.max_gaussians, "auto");
+  base.train.max_gaussians = "many";
+  EXPECT_THROW(ablation_studies("strategy", base), std::invalid_argument);
 }
 
 }  // namespace

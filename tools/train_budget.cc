@@ -1,0 +1,85 @@
+#include "tools/train_budget.h"
+
+#include <cctype>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+
+#include "host/train/scene_budget.h"
+#include "io/atomic_file.h"
+
+namespace litgs::tools {
+namespace {
+
+uint32_t parse_count(const std::string& flag) {
+  const bool digits = !flag.empty() && flag.size() <= 10 &&
+                      std::all_of(flag.begin(), flag.end(), [](unsigned char c) { return std::isdigit(c); });
+  const unsigned long long n = digits ? std::stoull(flag) : 0;
+  if (n == 0 || n > UINT32_MAX)
+    throw std::invalid_argument("--max-gaussians must be a positive integer or auto, not '" + flag + "'");
+  return static_cast<uint32_t>(n);
+}
+
+uint32_t budget_of_earlier_run(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in)
+    throw std::invalid_argument("--max-gaussians auto --resume: " + file.string() +
+                                " is missing (the run being resumed did not derive its budget)");
+  try {
+    return nlohmann::json::parse(in).at("gaussians").get<uint32_t>();
+  } catch (const nlohmann::json::exception& e) {
+    throw std::invalid_argument(file.string() + ": not a budget record (" + e.what() + ")");
+  }
+}
+
+}  // namespace
+
+uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
+                               const std::filesystem::path& out) {
+  if (flag != "auto") return parse_count(flag);
+  const std::filesystem::path record = out / "budget.json";
+  if (in.resume) return budget_of_earlier_run(record);
+
+  std::vector<Eigen::Vector3d> points;
+  std::string source;
+  if (!in.map_points->empty()) {
+    points = *in.map_points;
+    source = "LiDAR map";
+  } else if (!in.initial_is_random && in.initial->size() > 0) {
+    const std::vector<float>& m = in.initial->means;
+    for (size_t i = 0; i < in.initial->size(); ++i) points.emplace_back(m[3 * i], m[3 * i + 1], m[3 * i + 2]);
+    source = "initialization points";
+  } else {
+    throw std::invalid_argument(
+        "--max-gaussians auto measures the surface from points on it: the scene has no LiDAR map and the "
+        "initialization is random; give --init sfm or a point file, or a number");
+  }
+  std::vector<kernels::SplatCamera> cameras;
+  for (const host::TrainingView& v : in.data->views)
+    if (!v.heldout) cameras.push_back(v.camera);
+
+  const host::SceneBudgetOptions options;
+  const host::SceneBudget b = host::derive_scene_budget(points, cameras, options);
+  std::filesystem::create_directories(out);
+  io::write_file_atomic(record, [&](std::ostream& os) {
+    os << nlohmann::json{{"gaussians", b.gaussians},
+                         {"source", source},
+                         {"points", b.points},
+                         {"points_seen", b.points_seen},
+                         {"surface_m2", b.surface_m2},
+                         {"surface_pixels", b.surface_pixels},
+                         {"pixels_per_gaussian", options.pixels_per_gaussian},
+                         {"median_footprint_m", b.median_footprint_m},
+                         {"training_views", cameras.size()}}
+              .dump(2)
+       << "\n";
+  });
+  std::cout << "train: budget " << b.gaussians << " Gaussians from the scene: " << b.points_seen << " of "
+            << b.points << " " << source << " seen, " << b.surface_m2
+            << " m^2 of surface = " << b.surface_pixels << " pixels at the finest view, "
+            << options.pixels_per_gaussian << " pixels per Gaussian\n";
+  return b.gaussians;
+}
+
+}  // namespace litgs::tools
