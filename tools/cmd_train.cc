@@ -94,6 +94,15 @@ void run_train(TrainCliOptions o) {
   // Ground truth planes (synthetic scenes): evaluation's depth residual.
   const std::unique_ptr<host::PlanarMap> gt_planes = host::true_planar_map(scene);
 
+  // --init auto: the LiDAR map, else the front end's points (SCENE/sfm/, from `match`), else random.
+  const std::filesystem::path sfm_dir = std::filesystem::path(o.scene) / "sfm";
+  std::vector<Eigen::Vector3d> sfm_points;
+  if (!o.train.resume && (o.init == "sfm" || (o.init == "auto" && map_points.empty())) &&
+      io::has_sfm(sfm_dir))
+    for (const io::SfmPoint& p : io::read_sfm(sfm_dir).points) sfm_points.push_back(p.xyz);
+  std::string init_kind = o.init;
+  if (o.init == "auto") init_kind = !map_points.empty() ? "map" : !sfm_points.empty() ? "sfm" : "random";
+
   host::InitOptions init;
   init.sh_degree = o.train.sh_degree;
   kernels::GaussianModel model;
@@ -101,7 +110,7 @@ void run_train(TrainCliOptions o) {
   if (o.train.resume) {
     // The model comes from the checkpoint: --init and its options do not apply.
     init_what = "the newest checkpoint in " + o.out;
-  } else if (o.init == "random" || (o.init == "auto" && map_points.empty())) {
+  } else if (init_kind == "random") {
     model = host::init_random(data, o.random_count, o.train.seed, init);
     init_what = std::to_string(o.random_count) + " random points";
   } else if (init_from_map) {
@@ -125,19 +134,15 @@ void run_train(TrainCliOptions o) {
         host::neighbour_scales(pts, init, data.scene_extent_m * 0.01), normals, planar, o.init_flatness);
     model = host::init_from_points(pts, data, init, covariances);
     init_what = std::to_string(pts.size()) + " LiDAR map points";
-  } else if (o.init == "sfm") {
+  } else if (init_kind == "sfm") {
     // The front end's triangulated points (`match`), already in the scene's recentred frame.
-    const std::filesystem::path sfm_dir = std::filesystem::path(o.scene) / "sfm";
-    if (!io::has_sfm(sfm_dir))
+    if (sfm_points.empty())
       throw std::invalid_argument("--init sfm: " + sfm_dir.string() +
-                                  " holds no front-end results (run `litgs-engine match` first)");
-    const io::SfmData sfm = io::read_sfm(sfm_dir);
-    std::vector<Eigen::Vector3d> pts;
-    for (const io::SfmPoint& p : sfm.points) pts.push_back(p.xyz);
-    if (pts.empty())
-      throw std::invalid_argument("--init sfm: the front end triangulated no point in " + sfm_dir.string());
-    model = host::init_from_points(pts, data, init, {});
-    init_what = std::to_string(pts.size()) + " front-end points (" + sfm_dir.string() + ")";
+                                  (io::has_sfm(sfm_dir)
+                                       ? " holds no triangulated point"
+                                       : " holds no front-end results (run `litgs-engine match` first)"));
+    model = host::init_from_points(sfm_points, data, init, {});
+    init_what = std::to_string(sfm_points.size()) + " front-end points (" + sfm_dir.string() + ")";
   } else {
     const host::InitPoints file =
         host::load_points(o.init, o.init_in_scene_frame ? Eigen::Vector3d::Zero() : data.world_offset_m);
@@ -149,7 +154,7 @@ void run_train(TrainCliOptions o) {
   budget.data = &data;
   budget.map_points = &map_points;
   budget.initial = &model;
-  budget.initial_is_random = o.init == "random" || (o.init == "auto" && map_points.empty());
+  budget.initial_is_random = init_kind == "random";
   budget.resume = o.train.resume;
   o.train.max_gaussians = resolve_max_gaussians(o.max_gaussians, budget, o.out);
   o.train.check();
@@ -239,9 +244,11 @@ void add_train_command(CLI::App& app) {
                 "The LiDAR term moves Gaussians but leaves their opacity to the image");
   cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")
       ->capture_default_str();
-  cmd->add_option("--init", o->init,
-                  "auto (LiDAR map, else random), random, sfm (the front end's points in SCENE/sfm/), or a "
-                  ".ply/.pcd point file")
+  cmd->add_option(
+         "--init", o->init,
+         "auto (the LiDAR map, else the front end's points in SCENE/sfm/, else random), random, sfm (the "
+         "front end's points), or a "
+         ".ply/.pcd point file")
       ->capture_default_str();
   cmd->add_option_function<std::string>(
          "--init-frame", [o](const std::string& frame) { o->init_in_scene_frame = frame == "scene"; },

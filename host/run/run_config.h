@@ -54,7 +54,7 @@ struct RunConfig {
     std::string max_gaussians = "20000";  // the MCMC budget (adc: a cap): a count, or auto (from the scene)
     double mcmc_growth = 0.3;
     double lambda_geo = 0.6;
-    std::string init = "auto";  // auto (LiDAR map, else random) | random | sfm | refined | a .ply/.pcd file
+    std::string init = "auto";  // auto (LiDAR map, else sfm, else random) | random | sfm | refined | a file
     uint32_t holdout_every = 8;
     std::string intensity = "auto";
     std::string poses = "estimated";
@@ -119,7 +119,8 @@ void for_each_field(Config& c, F&& f) {
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
   f("train", "init", c.train.init,
-    "auto (LiDAR map, else random) | random | sfm (match's points) | refined (refine's points) | a .ply/.pcd "
+    "auto (LiDAR map, else match's points, else random) | random | sfm (match's points) | refined (refine's "
+    "points) | a .ply/.pcd "
     "file");
   f("train", "holdout_every", c.train.holdout_every, "hold out every Nth frame for evaluation");
   f("train", "intensity", c.train.intensity, "auto | percentile | linear");
