@@ -11,58 +11,59 @@
 
 namespace litgs::host::run {
 
+// The defaults; each option is documented once, in for_each_field below (run --print-config prints it).
 struct RunConfig {
   struct Import {
-    std::string calib;                      // ROS bag: M2DGR calibration_results.txt (also --calib)
-    std::string images;                     // Metashape/COLMAP: folder of the frames (default: see README)
-    std::vector<std::string> livo2_config;  // FAST-LIVO2: camera and extrinsic YAML file(s)
-    std::string synth_preset = "facade";    // synth:PRESET inputs: the preset (the INPUT's name wins)
-    uint32_t synth_frames = 40;             // synth: frames
-    uint32_t synth_width = 160;             // synth: image size
+    std::string calib;
+    std::string images;
+    std::vector<std::string> livo2_config;
+    std::string synth_preset = "facade";
+    uint32_t synth_frames = 40;
+    uint32_t synth_width = 160;
     uint32_t synth_height = 128;
     uint32_t synth_seed = 0;
-    std::vector<std::string> extra_args;  // passed to `litgs-engine import KIND` (or synth) as they are
+    std::vector<std::string> extra_args;
   } import;
   struct Map {
-    std::string build = "auto";  // auto (scans and no map) | always (from the scans, replacing it) | never
+    std::string build = "auto";
     double voxel = 0.1;
     bool deskew = true;
-    std::vector<std::string> extra_args;  // passed to `litgs-engine map` as they are
+    std::vector<std::string> extra_args;
   } map;
   struct Match {
     bool enabled = true;
-    std::string features = "sift";  // orb | sift | akaze
+    std::string features = "sift";
     bool clahe = true;
     std::string pairs = "covisible";
     uint32_t max_keypoints = 3000;
-    uint32_t threads = 0;                 // 0: all cores
-    std::vector<std::string> extra_args;  // passed to `litgs-engine match` as they are
+    uint32_t threads = 0;
+    std::vector<std::string> extra_args;
   } match;
   struct Refine {
     bool enabled = true;
-    std::string tracks = "synthetic";  // what `refine --tracks` accepts (synthetic: needs gt/, a synth scene)
+    std::string tracks = "synthetic";
     bool anchors = true;
-    bool planes = true;  // the LiDAR point-to-plane term (off by itself where the scene has no LiDAR map)
+    bool planes = true;
     uint32_t rounds = 3;
     uint32_t threads = 1;
-    std::vector<std::string> extra_args;  // passed to `litgs-engine refine` as they are
+    std::vector<std::string> extra_args;
   } refine;
   struct Train {
     uint32_t iterations = 2000;
     double downscale = 1.0;
-    std::string strategy = "mcmc";        // mcmc: measured faster and better than adc on DUNR (README)
-    std::string max_gaussians = "20000";  // the MCMC budget (adc: a cap): a count, or auto (from the scene)
+    std::string strategy = "mcmc";
+    std::string max_gaussians = "20000";
     double mcmc_growth = 0.3;
     double lambda_geo = 0.6;
-    std::string init = "auto";  // auto (LiDAR map, else sfm, else random) | random | sfm | refined | a file
+    std::string init = "auto";
     uint32_t holdout_every = 8;
     std::string intensity = "auto";
     std::string poses = "estimated";
     uint32_t seed = 0;
-    uint32_t eval_every = 250;            // held-out PSNR points of the report's curves
-    uint32_t checkpoint_every = 250;      // what an interruption loses at most
-    uint32_t progress_every = 50;         // progress lines, and the report's loss curve points
-    std::vector<std::string> extra_args;  // passed to `litgs-engine train` as they are
+    uint32_t eval_every = 250;
+    uint32_t checkpoint_every = 250;
+    uint32_t progress_every = 50;
+    std::vector<std::string> extra_args;
   } train;
   struct Eval {
     uint32_t emd_samples = 1000;
@@ -71,7 +72,7 @@ struct RunConfig {
     bool geometry = true;
   } eval;
   struct Report {
-    uint32_t max_views = 4;  // held-out views shown as pictures
+    uint32_t max_views = 4;
   } report;
 };
 

@@ -81,6 +81,13 @@ std::vector<std::string> option_flags(const nlohmann::json& section,
 nlohmann::json read_stage_json(const std::filesystem::path& path);
 nlohmann::json pick(const nlohmann::json& object, std::initializer_list<const char*> keys);
 
+// The plan of a stage that runs `litgs-engine STAGE DIR/<stage>/scene FLAGS... EXTRA...` on its own copy of
+// the current scene (map, match, refine): the scene as input, the copy as `copied` and `fresh` say
+// (SceneCopy), the copy as the output.
+void plan_on_scene_copy(const StageContext& c, const std::string& stage, SceneCopy copy,
+                        const std::vector<std::string>& flags, const std::vector<std::string>& extra_args,
+                        StagePlan& p);
+
 // Makes `to` (emptied first) a copy of copy.from as SceneCopy says. io::IoError naming a file that fails.
 void make_scene_copy(const SceneCopy& copy, const std::filesystem::path& to);
 

@@ -16,7 +16,7 @@ bool has_scans(const fs::path& scene) {
 
 StagePlan plan(const StageContext& c) {
   const RunConfig::Map& o = c.config.map;
-  const fs::path scene = c.scene(), copy = c.stage_dir("map") / "scene";
+  const fs::path scene = c.scene();
   StagePlan p;
   p.options = section_json(c.config, "map");
   if (o.build != "auto" && o.build != "always" && o.build != "never")
@@ -30,14 +30,10 @@ StagePlan plan(const StageContext& c) {
     p.skip_reason = "scene has a LiDAR map already (map.build: always rebuilds it from the scans)";
   }
   if (!p.skip_reason.empty()) return p;
-  p.inputs = {scene};
   // The map is rewritten (with --force), and read_scene wants it while scene.yaml says it is there.
-  p.scene_copy = SceneCopy{scene, {"scene.yaml", "lidar/map.pcd"}, {}};
-  p.command = {"map", copy.string(), "--force"};
-  const auto flags = option_flags(p.options, {"voxel", "deskew=!--no-deskew"});
-  p.command.insert(p.command.end(), flags.begin(), flags.end());
-  p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
-  p.outputs = {c.stage_rel("map") / "scene"};
+  std::vector<std::string> flags = {"--force"};
+  for (const std::string& f : option_flags(p.options, {"voxel", "deskew=!--no-deskew"})) flags.push_back(f);
+  plan_on_scene_copy(c, "map", SceneCopy{scene, {"scene.yaml", "lidar/map.pcd"}, {}}, flags, o.extra_args, p);
   return p;
 }
 

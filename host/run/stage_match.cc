@@ -8,21 +8,17 @@ namespace fs = std::filesystem;
 
 StagePlan plan(const StageContext& c) {
   const RunConfig::Match& o = c.config.match;
-  const fs::path scene = c.scene(), copy = c.stage_dir("match") / "scene";
+  const fs::path scene = c.scene();
   StagePlan p;
   p.options = section_json(c.config, "match");
   if (!o.enabled) {
     p.skip_reason = "match.enabled is false";
     return p;
   }
-  p.inputs = {scene};
-  p.scene_copy = SceneCopy{scene, {}, {"sfm"}};
-  p.command = {"match", copy.string()};
-  const auto flags =
-      option_flags(p.options, {"features", "clahe=!--no-clahe", "pairs", "max_keypoints", "threads"});
-  p.command.insert(p.command.end(), flags.begin(), flags.end());
-  p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
-  p.outputs = {c.stage_rel("match") / "scene"};
+  plan_on_scene_copy(
+      c, "match", SceneCopy{scene, {}, {"sfm"}},
+      option_flags(p.options, {"features", "clahe=!--no-clahe", "pairs", "max_keypoints", "threads"}),
+      o.extra_args, p);
   return p;
 }
 

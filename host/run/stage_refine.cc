@@ -9,7 +9,7 @@ namespace fs = std::filesystem;
 
 StagePlan plan(const StageContext& c) {
   const RunConfig::Refine& o = c.config.refine;
-  const fs::path scene = c.scene(), copy = c.stage_dir("refine") / "scene";
+  const fs::path scene = c.scene();
   StagePlan p;
   p.options = section_json(c.config, "refine");
   if (!o.enabled) {
@@ -20,19 +20,16 @@ StagePlan plan(const StageContext& c) {
     p.skip_reason = "refine.tracks is sfm and the scene has no sfm/ (match did not run)";
   }
   if (!p.skip_reason.empty()) return p;
-  p.inputs = {scene};
-  p.scene_copy = SceneCopy{scene, {"poses.txt", "poses_prior.txt"}, {"refine", "refine.json"}};
   nlohmann::json flags_from = p.options;
   if (o.planes && !fs::exists(scene / "lidar" / "map.pcd")) {
     flags_from["planes"] = false;
     p.notes.push_back("the scene has no LiDAR map: refine runs without the plane term");
   }
-  p.command = {"refine", copy.string()};
-  const auto flags = option_flags(
-      flags_from, {"tracks", "anchors=!--no-anchors", "planes=!--no-planes", "rounds", "threads"});
-  p.command.insert(p.command.end(), flags.begin(), flags.end());
-  p.command.insert(p.command.end(), o.extra_args.begin(), o.extra_args.end());
-  p.outputs = {c.stage_rel("refine") / "scene"};
+  plan_on_scene_copy(
+      c, "refine", SceneCopy{scene, {"poses.txt", "poses_prior.txt"}, {"refine", "refine.json"}},
+      option_flags(flags_from,
+                   {"tracks", "anchors=!--no-anchors", "planes=!--no-planes", "rounds", "threads"}),
+      o.extra_args, p);
   return p;
 }
 

@@ -103,6 +103,17 @@ bool listed(const fs::path& rel, const std::vector<std::string>& prefixes) {
 
 }  // namespace
 
+void plan_on_scene_copy(const StageContext& c, const std::string& stage, SceneCopy copy,
+                        const std::vector<std::string>& flags, const std::vector<std::string>& extra_args,
+                        StagePlan& p) {
+  p.inputs = {copy.from};
+  p.command = {stage, (c.stage_dir(stage) / "scene").string()};
+  p.command.insert(p.command.end(), flags.begin(), flags.end());
+  p.command.insert(p.command.end(), extra_args.begin(), extra_args.end());
+  p.outputs = {c.stage_rel(stage) / "scene"};
+  p.scene_copy = std::move(copy);
+}
+
 void make_scene_copy(const SceneCopy& copy, const fs::path& to) {
   fs::remove_all(to);
   fs::create_directories(to);
