@@ -242,6 +242,10 @@ void add_train_command(CLI::App& app) {
       ->check(CLI::Range(1e-3, 1.0))
       ->capture_default_str();
   cmd->add_option("--random-count", o->random_count, "Gaussians of --init random")->capture_default_str();
+  cmd->add_option("--max-init-points", o->max_init_points,
+                  "LiDAR-map initialization: at most this many map points (a seeded random subset)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   cmd->add_option("--eval-every", o->train.eval_every,
                   "Evaluate held-out views every K iterations (0: at the end)");
   cmd->add_option("--checkpoint-every", o->train.checkpoint_every, "Checkpoint every K iterations (0: none)");
