@@ -1,6 +1,7 @@
 // `litgs-engine ablate`: the method's ablations as sets of runs of the pipeline (host/run/pipeline.h) that
 // share every stage whose options agree (RunOptions::shared_stages), written as Markdown tables.
-//   refine    with and without pose refinement (Table II): ATE, PSNR, SSIM, depth-to-plane RMSE, seconds
+//   refine    training on the input, the refined and the true poses (Table II): ATE, PSNR, SSIM,
+//             depth-to-plane RMSE, seconds of refine and of training
 //   lambda    lambda_geo 0, 0.2, 0.4, 0.6, 0.8: PSNR, SSIM, depth and centres to planes, EMD
 //   features  ORB, SIFT, AKAZE, each with and without CLAHE (Table III): inlier ratio, verified pairs,
 //             points; ATE, plane residual and PSNR where refine uses the front end's tracks

@@ -82,11 +82,22 @@ TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
   base.train.max_gaussians = "8000";
   const auto all = ablation_studies("all", base);
   ASSERT_EQ(all.size(), 4u);
-  EXPECT_EQ(all[0].variants.size(), 2u);  // refine off, on
+  ASSERT_EQ(all[0].variants.size(), 3u);  // input, refined, true poses
   EXPECT_EQ(all[1].variants.size(), 5u);  // lambda_geo 0 .. 0.8
   EXPECT_EQ(all[2].variants.size(), 6u);  // 3 feature types x CLAHE
   ASSERT_EQ(all[3].variants.size(), 6u);  // adc, mcmc x 3 budgets
   RunConfig c = base;
+  all[0].variants[0].apply(c);
+  EXPECT_FALSE(c.refine.enabled);
+  EXPECT_EQ(c.train.poses, "estimated");
+  all[0].variants[1].apply(c);
+  EXPECT_TRUE(c.refine.enabled);
+  EXPECT_EQ(c.train.poses, "estimated");
+  c = base;
+  all[0].variants[2].apply(c);  // true poses: no refinement, gt/poses.txt for training and eval
+  EXPECT_FALSE(c.refine.enabled);
+  EXPECT_EQ(c.train.poses, "truth");
+  c = base;
   all[3].variants[0].apply(c);
   EXPECT_EQ(c.train.strategy, "adc");
   EXPECT_EQ(c.train.max_gaussians, "2000");

@@ -353,20 +353,34 @@ TEST(RunAblate, RefineStudySharesStagesAndWritesItsTable) {
     refines += name.rfind("refine-", 0) == 0;
     trains += name.rfind("train-", 0) == 0;
   }
-  EXPECT_EQ(imports, 1u) << "the two runs did not share import";
+  EXPECT_EQ(imports, 1u) << "the three runs did not share import";
   EXPECT_EQ(refines, 1u) << "only the run with refinement has a refine folder";
-  EXPECT_EQ(trains, 2u);
+  EXPECT_EQ(trains, 3u);
   for (const char* stage : {"import", "match"})
     EXPECT_EQ(stage_status(dir / "runs", "refine-on", stage), "up to date") << stage;
   EXPECT_EQ(stage_status(dir / "runs", "refine-off", "refine"), "skipped: refine.enabled is false");
+  EXPECT_EQ(stage_status(dir / "runs", "refine-truth", "refine"), "skipped: refine.enabled is false");
+  // The true-pose run trains and evaluates its held-out views on gt/poses.txt; the other two on poses.txt.
+  size_t truth_trains = 0, truth_evals = 0;
+  for (const auto& e : fs::directory_iterator(dir / "stages")) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("train-", 0) != 0 && name.rfind("eval-", 0) != 0) continue;
+    const std::string command = read_json_file(e.path() / "manifest.json")["command"].dump();
+    const bool truth = command.find(R"("--poses","truth")") != std::string::npos;
+    (name[0] == 't' ? truth_trains : truth_evals) += truth;
+  }
+  EXPECT_EQ(truth_trains, 1u);
+  EXPECT_EQ(truth_evals, 1u);
   std::ifstream in(dir / "ablation.md");
   const std::string md{std::istreambuf_iterator<char>(in), {}};
-  EXPECT_NE(md.find("| pose refinement | ATE (m) | PSNR (dB) |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| poses | ATE (m) | PSNR (dB) |"), std::string::npos) << md;
   const nlohmann::json on = read_json_file(dir / "runs" / "refine-on.json");
   char row[64];
-  std::snprintf(row, sizeof row, "| yes | %.4f | %.2f |", on["stages"][5]["metrics"]["ate_m"].get<double>(),
+  std::snprintf(row, sizeof row, "| refined | %.4f | %.2f |",
+                on["stages"][5]["metrics"]["ate_m"].get<double>(),
                 on["stages"][5]["metrics"]["psnr_db"].get<double>());
   EXPECT_NE(md.find(row), std::string::npos) << row << "\n" << md;
+  EXPECT_NE(md.find("| true (gt/poses.txt) | 0 (truth) |"), std::string::npos) << md;
   EXPECT_NE(md.find("Made by `litgs-engine ablate synth:facade"), std::string::npos);
 }
 
