@@ -42,14 +42,12 @@ layout(std430, binding = BWD_BINDING_GRAD2D) buffer Grad2d { float grad2d[]; };
 #endif
 layout(std430, binding = BWD_BINDING_STATE) buffer State { float state[]; };
 layout(std430, binding = BWD_BINDING_COUNTERS) buffer Counters { uint counters[]; };
-layout(std430, binding = BWD_BINDING_ENTRIES) readonly buffer Entries { vec4 entries[]; };
 
 #include "splat/footprint.glsl"
 
 // 1: the exact gradient; 0: the expected depth's and the alpha map's gradients skip the opacity.
 layout(constant_id = 2) const uint DEPTH_GRAD_TO_OPACITY = 1u;
 #include "splat/channels.glsl"
-#include "splat/list_entry.glsl"
 
 // The gradient values of one entry for one pixel, as three vectors (no arrays: CPU drivers spill them):
 // g0 = dL/d(mean2d.x, mean2d.y, conic.a, conic.b), g1 = dL/d(conic.c, opacity, depth, -), g2 = dL/d(colour).
@@ -94,13 +92,17 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
   return r;
 }
 
-// Loads list entry `i` (its packed record, pack_list_entries.comp).
+// Loads list entry `i`'s Gaussian.
 void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity, out vec4 color,
                 out float depth) {
-  const uint base = i * ENTRY_VEC4S;
-  mean_extent = entries[base];
-  conic_opacity = entries[base + 1u];
-  entry_unpack_tail(entries[base + 2u], ENTRY_VEC4S > 3u ? entries[base + 3u] : vec4(0.0), color, depth, g);
+  g = isect_gaussian[isect_ids[i]];
+  const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
+  const float opacity = opacities[g];
+  mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
+  conic_opacity = vec4(conic, opacity);
+  color = vec4(0.0);
+  for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
+  depth = depths[g];
 }
 
 // Sums of three vectors over the subgroup, as a butterfly of XOR shuffles: on CPU drivers a shuffle with a

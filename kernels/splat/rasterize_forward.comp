@@ -13,7 +13,6 @@
 #include "splat/splat_view.glsl"
 #include "splat/footprint.glsl"
 #include "splat/channels.glsl"
-#include "splat/list_entry.glsl"
 
 layout(local_size_x = SPLAT_TILE_SIZE, local_size_y = SPLAT_TILE_SIZE) in;
 
@@ -30,10 +29,9 @@ layout(std430, binding = FWD_BINDING_DEPTH) buffer Depth { float depth_out[]; };
 layout(std430, binding = FWD_BINDING_ALPHA) buffer Alpha { float alpha_out[]; };
 layout(std430, binding = FWD_BINDING_LAST) buffer Last { uint last_out[]; };
 layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]; };
-layout(std430, binding = FWD_BINDING_ENTRIES) readonly buffer Entries { vec4 entries[]; };
 
 // Each subgroup walks the tile's list on its own, SUBGROUP-wide chunk by chunk: lane k loads entry k of the
-// chunk (its packed record, pack_list_entries.comp), a ballot keeps the entries whose 1/255 footprint reaches the subgroup's
+// chunk (one vector load per field), a ballot keeps the entries whose 1/255 footprint reaches the subgroup's
 // pixels, and every lane then reads those entries from lane k by shuffle, in list order. No shared memory,
 // no barriers; on CPU drivers a shuffle is a register permute, far cheaper than a load per entry.
 void main() {
@@ -73,11 +71,13 @@ void main() {
     float depth = 0.0;
     bool relevant = false;
     if (entry < end) {
-      const uint base = entry * ENTRY_VEC4S;
-      mean_extent = entries[base];
-      conic_opacity = entries[base + 1u];
-      uint g;
-      entry_unpack_tail(entries[base + 2u], ENTRY_VEC4S > 3u ? entries[base + 3u] : vec4(0.0), color, depth, g);
+      const uint g = isect_gaussian[isect_ids[entry]];
+      const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
+      const float opacity = opacities[g];
+      mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
+      conic_opacity = vec4(conic, opacity);
+      for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
+      depth = depths[g];
       // The bounding box only: the backward's exact ellipse test (footprint_touches_box) costs the forward
       // more than the cheap blends it skips (measured on lavapipe, docs/experiments.md).
       relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);

@@ -28,7 +28,7 @@ uint32_t log2_ceil(uint32_t v) {
 }
 
 uint32_t forward_loops_per_chunk(uint32_t S, uint32_t C) {
-  return 1 + (C + 1) + 5 + (S + 4);  // (C + 1): the record's colour unpacking
+  return 1 + (C + 1) + 5 + (S + 4);
 }
 
 uint32_t backward_loops_per_chunk(uint32_t S, uint32_t C, bool deterministic) {
@@ -94,7 +94,6 @@ struct Rasterizer::Buffers {
   // Per intersection.
   std::unique_ptr<DeviceArray<uint32_t>> tile_keys, isect_ids, isect_gaussian;
   std::unique_ptr<DeviceArray<float>> isect_grads;
-  std::unique_ptr<DeviceArray<float>> entries;  // [M][SPLAT_ENTRY_VEC4S(C)][4] list entries in list order
   // Per pixel and per tile.
   std::unique_ptr<DeviceArray<float>> image, depth, alpha, grad_image, grad_depth, grad_alpha;
   std::unique_ptr<DeviceArray<uint32_t>> last, ranges;
@@ -170,7 +169,6 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   lengths_ = make("splat/tile_list_lengths", LENGTHS_BINDING_COUNT, sizeof(SplatView));
   emit_ = make("splat/emit_intersections", EMIT_BINDING_COUNT, sizeof(SplatView));
   ranges_ = make("splat/tile_ranges", RANGES_BINDING_COUNT, sizeof(SplatView));
-  pack_ = make("splat/pack_list_entries", PACK_BINDING_COUNT, sizeof(SplatView));
   forward_ = make("splat/rasterize_forward", FWD_BINDING_COUNT, sizeof(RasterizeParams));
   const char* backward = options_.deterministic ? "splat/rasterize_backward_deterministic"
                          : uses_float_atomics() ? "splat/rasterize_backward_float_atomics"
@@ -340,7 +338,6 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   grow(ctx, b.tile_keys, m, "splat: tile keys");
   grow(ctx, b.isect_ids, m, "splat: intersection ids");
   grow(ctx, b.isect_gaussian, m, "splat: intersection gaussians");
-  grow(ctx, b.entries, m * 4 * SPLAT_ENTRY_VEC4S(channels_), "splat: list entries");
 
   // 2. Emit intersections in depth order, stable sort by tile, tile ranges, blend in passes over the lists.
   engine::Sequence s2(ctx);
@@ -361,16 +358,6 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
               {{RANGES_BINDING_TILE_KEYS, &b.tile_keys->buffer(), Access::kRead},
                {RANGES_BINDING_RANGES, &b.ranges->buffer(), Access::kReadWrite}},
               ranges_view);
-  s2.dispatch(*pack_, elementwise_groups(*context_, m, "splat/pack_list_entries"),
-              {{PACK_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kRead},
-               {PACK_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
-               {PACK_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
-               {PACK_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
-               {PACK_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
-               {PACK_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
-               {PACK_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
-               {PACK_BINDING_ENTRIES, &b.entries->buffer(), Access::kWrite}},
-              ranges_view);
   for (uint32_t pass = 0; pass < forward_passes_; ++pass)
     s2.dispatch(*forward_, {view.tiles_x, view.tiles_y},
                 {{FWD_BINDING_RANGES, &b.ranges->buffer(), Access::kRead},
@@ -385,8 +372,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
                  {FWD_BINDING_DEPTH, &b.depth->buffer(), Access::kReadWrite},
                  {FWD_BINDING_ALPHA, &b.alpha->buffer(), Access::kReadWrite},
                  {FWD_BINDING_LAST, &b.last->buffer(), Access::kReadWrite},
-                 {FWD_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite},
-                 {FWD_BINDING_ENTRIES, &b.entries->buffer(), Access::kRead}},
+                 {FWD_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
                 pass_params(view, pass, forward_entries_per_pass_));
   s2.submit_and_wait();
   append_profile(s2);
@@ -494,8 +480,7 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
                 {BWD_BINDING_GRAD_ALPHA, &b.grad_alpha->buffer(), Access::kRead},
                 {BWD_BINDING_GRAD2D, &rows, Access::kReadWrite},
                 {BWD_BINDING_STATE, &b.backward_state->buffer(), Access::kReadWrite},
-                {BWD_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite},
-                {BWD_BINDING_ENTRIES, &b.entries->buffer(), Access::kRead}},
+                {BWD_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
                pass_params(view, pass, backward_entries_per_pass_));
   if (options_.deterministic)
     s.dispatch(*reduce_, elementwise_groups(*context_, n, "splat/reduce_isect_grads"),

@@ -142,8 +142,8 @@ class Rasterizer {
   RasterizerOptions options_;
   RadixSort sort_;
   ExclusiveScan scan_;
-  std::unique_ptr<engine::Kernel> project_, gather_, lengths_, emit_, ranges_, pack_, forward_, backward_,
-      reduce_, project_backward_;
+  std::unique_ptr<engine::Kernel> project_, gather_, lengths_, emit_, ranges_, forward_, backward_, reduce_,
+      project_backward_;
   std::unique_ptr<Buffers> buffers_;
   const DeviceGaussians* last_gaussians_ = nullptr;
   SplatCamera last_camera_;

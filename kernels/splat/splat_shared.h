@@ -93,22 +93,6 @@ using uint = uint32_t;
 #define RANGES_BINDING_RANGES 1     // [tiles][2] first, end (out; zero-filled before)
 #define RANGES_BINDING_COUNT 2
 
-// ---- pack_list_entries.comp: one invocation per sorted intersection ----
-// What the per-pixel passes read of each list entry, copied into list order once per forward, so that a
-// subgroup's walk reads consecutive records instead of two index loads and scattered attribute loads (and a
-// log) per entry for each of a tile's subgroups. Record i (list_entry.glsl): vec4 (mean2d, 1/255 extent),
-// vec4 (conic, opacity), then colour[C], depth, Gaussian index (float bits) in SPLAT_ENTRY_VEC4S - 2 vec4.
-#define SPLAT_ENTRY_VEC4S(C) ((C) <= 2 ? 3 : 4)
-#define PACK_BINDING_ISECT_IDS 0       // [M] sorted by tile
-#define PACK_BINDING_ISECT_GAUSSIAN 1  // [M]
-#define PACK_BINDING_MEANS2D 2
-#define PACK_BINDING_CONICS 3
-#define PACK_BINDING_DEPTHS 4
-#define PACK_BINDING_OPACITIES 5
-#define PACK_BINDING_COLORS 6
-#define PACK_BINDING_ENTRIES 7  // [M][SPLAT_ENTRY_VEC4S(C)] vec4 (out)
-#define PACK_BINDING_COUNT 8
-
 // ---- rasterize_forward.comp: one workgroup per tile and pass ----
 // A pass walks the entries [ListSegment.begin, ListSegment.end) of every tile's list. Between passes the
 // per-pixel blend state rides in the output buffers: image = the colour sum so far, depth = the sum of
@@ -128,8 +112,7 @@ using uint = uint32_t;
 #define FWD_BINDING_ALPHA 10     // [H][W] accumulated alpha = 1 - T (out)
 #define FWD_BINDING_LAST 11      // [H][W] number of list entries the pixel walked (out)
 #define FWD_BINDING_COUNTERS 12  // SPLAT_COUNTER_FORWARD_WALKS_CUT (atomic)
-#define FWD_BINDING_ENTRIES 13   // [M] list entries in list order (pack_list_entries.comp)
-#define FWD_BINDING_COUNT 14
+#define FWD_BINDING_COUNT 13
 
 // ---- rasterize_backward.comp: one workgroup per tile and pass ----
 // Passes run from the last list segment to the first. A pixel's running state (transmittance, the colour
@@ -152,8 +135,7 @@ using uint = uint32_t;
 #define BWD_BINDING_GRAD2D 14      // atomic mode: [N][7 + C] float; deterministic: [M][7 + C]
 #define BWD_BINDING_STATE 15       // [2 + C][H][W]: T, depth sum, colour sums (single pass: unused)
 #define BWD_BINDING_COUNTERS 16    // SPLAT_COUNTER_BACKWARD_WALKS_CUT (atomic)
-#define BWD_BINDING_ENTRIES 17     // [M] list entries in list order (pack_list_entries.comp)
-#define BWD_BINDING_COUNT 18
+#define BWD_BINDING_COUNT 17
 
 // ---- reduce_isect_grads.comp (deterministic mode): one invocation per depth-sorted position ----
 #define REDUCE_BINDING_ORDER 0
@@ -213,9 +195,8 @@ static_assert(GATHER_BINDING_COUNT == GATHER_BINDING_COUNTERS + 1);
 static_assert(LENGTHS_BINDING_COUNT == LENGTHS_BINDING_COUNTERS + 1);
 static_assert(EMIT_BINDING_COUNT == EMIT_BINDING_ISECT_GAUSSIAN + 1);
 static_assert(RANGES_BINDING_COUNT == RANGES_BINDING_RANGES + 1);
-static_assert(PACK_BINDING_COUNT == PACK_BINDING_ENTRIES + 1);
-static_assert(FWD_BINDING_COUNT == FWD_BINDING_ENTRIES + 1);
-static_assert(BWD_BINDING_COUNT == BWD_BINDING_ENTRIES + 1);
+static_assert(FWD_BINDING_COUNT == FWD_BINDING_COUNTERS + 1);
+static_assert(BWD_BINDING_COUNT == BWD_BINDING_COUNTERS + 1);
 static_assert(REDUCE_BINDING_COUNT == REDUCE_BINDING_GRAD2D + 1);
 static_assert(PBWD_BINDING_COUNT == PBWD_BINDING_GRAD_MEANS2D + 1);
 }  // namespace litgs::kernels
