@@ -92,14 +92,17 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
   return r;
 }
 
-// Loads list entry `i`'s Gaussian.
-void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity, out vec4 color,
-                out float depth) {
+// Loads list entry `i`'s Gaussian: its footprint (colour and depth: load_entry_shading, for kept entries only,
+// as a per-lane load is the main cost on lavapipe).
+void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity) {
   g = isect_gaussian[isect_ids[i]];
   const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
   const float opacity = opacities[g];
   mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
   conic_opacity = vec4(conic, opacity);
+}
+
+void load_entry_shading(uint g, out vec4 color, out float depth) {
   color = vec4(0.0);
   for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
   depth = depths[g];
@@ -168,9 +171,10 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 cent
   float depth = 0.0;
   relevant = false;
   if (rel < chunk_end) {
-    load_entry(list_start + rel, g, mean_extent, conic_opacity, color, depth);
+    load_entry(list_start + rel, g, mean_extent, conic_opacity);
     relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi) &&
                footprint_touches_box(mean_extent, conic_opacity, subgroup_lo, subgroup_hi);
+    if (relevant) load_entry_shading(g, color, depth);
   }
   a0 = vec4(0.0);
   a1 = vec4(0.0);

@@ -76,11 +76,14 @@ void main() {
       const float opacity = opacities[g];
       mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
       conic_opacity = vec4(conic, opacity);
-      for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
-      depth = depths[g];
       // The bounding box only: the backward's exact ellipse test (footprint_touches_box) costs the forward
       // more than the cheap blends it skips (measured on lavapipe, docs/experiments.md).
       relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
+      // A per-lane load is the forward's main cost on lavapipe: colour and depth only for the entries kept.
+      if (relevant) {
+        for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
+        depth = depths[g];
+      }
     }
     uvec4 todo = subgroupBallot(relevant);
     for (uint word = 0u; word < 4u; ++word) {
