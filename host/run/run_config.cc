@@ -2,10 +2,10 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <set>
-#include <sstream>
 
 #include "io/error.h"
 
@@ -57,10 +57,10 @@ std::string yaml_text(uint32_t v) {
   return std::to_string(v);
 }
 std::string yaml_text(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
+  // The shortest text that reads back as the same double (0.3, not 0.29999999999999999).
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+  return std::string(text, end);
 }
 std::string yaml_text(bool v) {
   return v ? "true" : "false";
