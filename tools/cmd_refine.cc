@@ -38,6 +38,10 @@ void add_refine_command(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--pixel-noise", o->synthetic.pixel_noise_px, "Synthetic tracks: pixel noise (px)")
       ->capture_default_str();
+  c->add_option(
+       "--min-frame-observations", o->refine.min_frame_observations,
+       "Stop (keeping the priors) when more than half of the frames have fewer observations (0: off)")
+      ->capture_default_str();
   c->add_flag("--absolute-priors", o->refine.ba.absolute_priors,
               "The prior poses are absolute (Metashape, COLMAP with control points), not an odometry: a pose "
               "prior on every frame");

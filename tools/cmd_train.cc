@@ -16,6 +16,7 @@
 #include "engine/context.h"
 #include "host/train/init_gaussians.h"
 #include "host/train/lidar_planes.h"
+#include "host/train/scene_budget.h"
 #include "host/train/trainer.h"
 #include "host/train/training_data.h"
 #include "host/train/true_planes.h"
@@ -64,6 +65,14 @@ std::string anomaly_text(const host::TrainingCounters& c) {
   return s;
 }
 
+// The cameras of the views training fits (held-out views excluded).
+std::vector<kernels::SplatCamera> training_cameras(const host::TrainingData& data) {
+  std::vector<kernels::SplatCamera> cameras;
+  for (const host::TrainingView& v : data.views)
+    if (!v.heldout) cameras.push_back(v.camera);
+  return cameras;
+}
+
 std::string format_eta(double s) {
   if (!std::isfinite(s) || s < 0) return "?";
   char buf[32];
@@ -103,6 +112,15 @@ void run_train(TrainCliOptions o) {
   std::string init_kind = o.init;
   if (o.init == "auto") init_kind = !map_points.empty() ? "map" : !sfm_points.empty() ? "sfm" : "random";
 
+  // The budget: `auto` measures the LiDAR map when there is one (then it is known before the map
+  // initialization, which it caps), else the initialization's points.
+  BudgetInputs budget;
+  budget.data = &data;
+  budget.map_points = &map_points;
+  budget.resume = o.train.resume;
+  const bool budget_from_map = !map_points.empty();
+  if (budget_from_map) o.train.max_gaussians = resolve_max_gaussians(o.max_gaussians, budget, o.out);
+
   host::InitOptions init;
   init.sh_degree = o.train.sh_degree;
   kernels::GaussianModel model;
@@ -114,13 +132,20 @@ void run_train(TrainCliOptions o) {
     model = host::init_random(data, o.random_count, o.train.seed, init);
     init_what = std::to_string(o.random_count) + " random points";
   } else if (init_from_map) {
-    // Planar map points become discs on their plane (the plane fit's normal), the rest spheres.
-    std::vector<size_t> keep(map_points.size());
-    for (size_t i = 0; i < keep.size(); ++i) keep[i] = i;
-    if (keep.size() > o.max_init_points) {
+    // Planar map points become discs on their plane (the plane fit's normal), the rest spheres. Only the
+    // points a training view sees (a Gaussian none sees is never trained), and never more than the budget
+    // or --max-init-points: a seeded random subset.
+    const std::vector<uint8_t> seen = host::inside_any_view(map_points, training_cameras(data));
+    std::vector<size_t> keep;
+    for (size_t i = 0; i < map_points.size(); ++i)
+      if (seen[i]) keep.push_back(i);
+    if (keep.empty())  // no view sees the map (bad poses?): seed from all of it rather than nothing
+      for (size_t i = 0; i < map_points.size(); ++i) keep.push_back(i);
+    const size_t cap = std::min<size_t>(o.max_init_points, o.train.max_gaussians);
+    if (keep.size() > cap) {
       std::mt19937 rng(o.train.seed);
       std::shuffle(keep.begin(), keep.end(), rng);
-      keep.resize(o.max_init_points);
+      keep.resize(cap);
     }
     std::vector<Eigen::Vector3d> pts;
     std::vector<Eigen::Vector3f> normals;
@@ -150,13 +175,11 @@ void run_train(TrainCliOptions o) {
     init_what = o.init + (file.covariances.empty() ? "" : " (with covariances)");
   }
 
-  BudgetInputs budget;
-  budget.data = &data;
-  budget.map_points = &map_points;
-  budget.initial = &model;
-  budget.initial_is_random = init_kind == "random";
-  budget.resume = o.train.resume;
-  o.train.max_gaussians = resolve_max_gaussians(o.max_gaussians, budget, o.out);
+  if (!budget_from_map) {
+    budget.initial = &model;
+    budget.initial_is_random = init_kind == "random";
+    o.train.max_gaussians = resolve_max_gaussians(o.max_gaussians, budget, o.out);
+  }
   o.train.check();
 
   engine::Context context;
@@ -260,8 +283,10 @@ void add_train_command(CLI::App& app) {
       ->check(CLI::Range(1e-3, 1.0))
       ->capture_default_str();
   cmd->add_option("--random-count", o->random_count, "Gaussians of --init random")->capture_default_str();
-  cmd->add_option("--max-init-points", o->max_init_points,
-                  "LiDAR-map initialization: at most this many map points (a seeded random subset)")
+  cmd->add_option(
+         "--max-init-points", o->max_init_points,
+         "LiDAR-map initialization: at most this many of the map points the training views see (a seeded "
+         "random subset; never more than --max-gaussians)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--eval-every", o->train.eval_every,

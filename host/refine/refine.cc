@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "host/refine/weights.h"
@@ -51,6 +52,15 @@ void deactivate_weak_points(std::vector<TrackPoint>& points, size_t* dropped) {
       p.active = false;
       if (dropped) ++*dropped;
     }
+}
+
+// Active observations of active points, per frame.
+std::vector<size_t> frame_observations(const std::vector<TrackPoint>& points, size_t frames) {
+  std::vector<size_t> count(frames, 0);
+  for (const auto& p : points)
+    if (p.active)
+      for (const auto& ob : p.obs) count[ob.frame] += ob.active;
+  return count;
 }
 
 }  // namespace
@@ -154,11 +164,29 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
 
   size_t active_points = 0;
   for (const auto& p : in.points) active_points += p.active;
-  if (active_points == 0) {
+  report.before = residual_stats(in.points, poses, in.camera);  // round 1 restates it after association
+  const std::vector<size_t> per_frame = frame_observations(in.points, n);
+  for (size_t c : per_frame) report.weak_frames += c < o.min_frame_observations;
+  if (n > 0) {
+    std::vector<double> counts(per_frame.begin(), per_frame.end());
+    report.median_frame_observations = median(counts);
+  }
+  if (in.points.empty()) {
+    report.status = "stopped: no tracks (the front end found none to refine with); poses kept as the priors";
+    report.stopped_early = true;
+  } else if (active_points == 0) {
     report.status =
         "stopped: no point has two observations and a finite position (" +
         std::to_string(report.untriangulated_points) +
         " tracks could not be triangulated: no baseline, e.g. pure rotation); poses kept as the priors";
+    report.stopped_early = true;
+  } else if (2 * report.weak_frames > n) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "stopped: too few tracks to refine the poses: %zu of %zu frames have fewer than %zu "
+                  "observations (median %.0f); poses kept as the priors",
+                  report.weak_frames, n, o.min_frame_observations, report.median_frame_observations);
+    report.status = text;
     report.stopped_early = true;
   }
   for (size_t r = 0; r < o.rounds && !report.stopped_early; ++r) {

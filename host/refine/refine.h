@@ -23,6 +23,11 @@ struct RefineOptions {
   size_t anchors_from_round = 1;  // 0-based: the first round is solved without anchors (docs/refinement.md)
   int threads = 1;
   int max_iterations = 50;  // per Ceres solve
+  // Observability: a frame with fewer active observations than this is weakly constrained by the images
+  // (COLMAP registers an image only with 30 inliers). When more than half of the frames are, the tracks
+  // cannot refine the poses (a few noisy points per frame move them the wrong way): refine stops before
+  // solving and keeps the priors. 0: off.
+  size_t min_frame_observations = 30;
   WeightOptions weights;
   AnchorAssociationOptions anchor_association;
   PlaneAssociationOptions plane_association;
@@ -62,6 +67,8 @@ struct RefineReport {
   size_t frames = 0, points = 0, observations = 0, anchors = 0;
   size_t frozen_frames = 0;          // frames whose observations repeat the previous frame's: dropped
   size_t untriangulated_points = 0;  // inactive from the start (non-finite or fewer than 2 observations)
+  size_t weak_frames = 0;  // frames with fewer than min_frame_observations active observations at the start
+  double median_frame_observations = 0;
   AnchorAssociationReport anchor_association;
   size_t guarded_anchor_covariances = 0;
   double anchor_weight_median_raw = 0;  // m^-3

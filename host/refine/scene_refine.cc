@@ -144,6 +144,8 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                       {"observations", r.observations},
                       {"untriangulated_points", r.untriangulated_points},
                       {"frozen_frames", r.frozen_frames},
+                      {"weak_frames", r.weak_frames},
+                      {"median_frame_observations", r.median_frame_observations},
                       {"anchors", r.anchors},
                       {"anchored_tracks", r.anchor_association.anchored_tracks},
                       {"anchors_in_view", r.anchor_association.anchors_in_view},

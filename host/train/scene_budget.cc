@@ -41,6 +41,15 @@ void SceneBudgetOptions::check() const {
     bad("min_gaussians must be positive and at most max_gaussians");
 }
 
+std::vector<uint8_t> inside_any_view(const std::vector<Eigen::Vector3d>& points,
+                                     const std::vector<kernels::SplatCamera>& cameras) {
+  for (const kernels::SplatCamera& c : cameras) c.check();
+  std::vector<uint8_t> inside(points.size(), 0);
+  for (size_t i = 0; i < points.size(); ++i)
+    inside[i] = points[i].allFinite() && std::isfinite(finest_footprint_m(points[i], cameras));
+  return inside;
+}
+
 SceneBudget derive_scene_budget(const std::vector<Eigen::Vector3d>& points,
                                 const std::vector<kernels::SplatCamera>& cameras,
                                 const SceneBudgetOptions& o) {

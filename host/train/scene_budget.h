@@ -50,4 +50,10 @@ SceneBudget derive_scene_budget(const std::vector<Eigen::Vector3d>& points,
                                 const std::vector<kernels::SplatCamera>& cameras,
                                 const SceneBudgetOptions& options = {});
 
+// For each point: 1 when it is finite and projects into at least one of `cameras` (in front of its near
+// plane), else 0. The points derive_scene_budget counts as seen; the LiDAR-map initialization keeps only
+// these, since a Gaussian no training view sees is never trained.
+std::vector<uint8_t> inside_any_view(const std::vector<Eigen::Vector3d>& points,
+                                     const std::vector<kernels::SplatCamera>& cameras);
+
 }  // namespace litgs::host

@@ -85,6 +85,26 @@ TEST(RefineHardCases, PureRotationStopsWithAClearMessage) {
   for (size_t f = 0; f < r.poses.size(); ++f) EXPECT_EQ(r.poses[f].p, s.priors[f].p);
 }
 
+TEST(RefineHardCases, TooFewObservationsPerFrameKeepThePriors) {
+  TestScene s;
+  TestSceneOptions o;
+  o.anchors = 0;                  // the anchors' own tracks would add observations
+  o.tracks.tracks_per_frame = 2;  // about 2 x 7 = 14 observations per frame
+  make_test_scene(s, o);
+  const RefineRun r = run(s);
+  EXPECT_TRUE(r.report.stopped_early);
+  EXPECT_NE(r.report.status.find("too few tracks"), std::string::npos) << r.report.status;
+  EXPECT_LT(r.report.median_frame_observations, 30);
+  for (size_t f = 0; f < r.poses.size(); ++f) EXPECT_EQ(r.poses[f].p, s.priors[f].p);
+
+  // The same scene with the gate off solves (whatever it makes of so few tracks).
+  TestScene s2;
+  make_test_scene(s2, o);
+  RefineOptions ungated;
+  ungated.min_frame_observations = 0;
+  EXPECT_FALSE(run(s2, ungated).report.stopped_early);
+}
+
 TEST(RefineHardCases, ThirtyPercentOutlierMatches) {
   TestScene s;
   TestSceneOptions o;

@@ -159,7 +159,21 @@ TEST(RunStages, NothingToDoSaysWhy) {
   EXPECT_EQ(stage_status(dir, "refine"),
             "skipped: refine.tracks is synthetic and the scene has no gt/poses.txt to make them from");
   EXPECT_FALSE(fs::exists(dir / "refine"));
+  // run's default track source (auto) refines a scene without ground truth, as real data, from the front
+  // end's tracks (match's sfm/); none or too few of them here, so refine keeps the priors and says so.
+  std::string yaml_auto = small_run_yaml();
+  yaml_auto.replace(yaml_auto.find("tracks: synthetic"), 17, "tracks: auto");
+  const fs::path auto_tracks = write_text(kRoot / "why-auto.yaml", yaml_auto);
+  r = run_engine(run_args(scene.string(), dir, auto_tracks, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(stage_status(dir, "refine"), "done");
+  const nlohmann::json auto_refine = read_json_file(dir / "refine" / "scene" / "refine.json");
+  EXPECT_EQ(auto_refine["tracks"], "sfm") << auto_refine.dump();
+  EXPECT_NE(auto_refine["status"].get<std::string>().find("poses kept as the priors"), std::string::npos)
+      << auto_refine["status"];
   // Training from refine's points needs refine: the run stops at train and says why.
+  r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
+  ASSERT_EQ(r.status, 0) << r.output;
   const fs::path refined_init = write_text(kRoot / "why-refined.yaml", init_refined(small_run_yaml()));
   r = run_engine(run_args(scene.string(), dir, refined_init, "--until train"));
   EXPECT_NE(r.status, 0);
