@@ -18,7 +18,9 @@ void add_ablate_command(CLI::App& app) {
       "ablate", "The method's ablations (refinement, lambda_geo, features, strategy) as Markdown tables");
   cmd->add_option("input", o->input, "As `run`'s INPUT (a scene directory, synth:PRESET, ...)")->required();
   cmd->add_option("--out", o->out, "Folder: DIR/stages/ (shared), DIR/runs/, DIR/ablation.md")->required();
-  cmd->add_option("--study", o->study, "refine | lambda | features | strategy | all")->capture_default_str();
+  cmd->add_option("--study", o->study,
+                  "refine | lambda | features | strategy | all, or several: refine,features")
+      ->capture_default_str();
   cmd->add_option("--config", o->config, "run.yaml: the settings every run starts from")
       ->check(CLI::ExistingFile);
   cmd->add_option("--calib", o->calib, "ROS bag input: M2DGR calibration_results.txt")

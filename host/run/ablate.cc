@@ -1,5 +1,6 @@
 #include "host/run/ablate.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
 
@@ -159,22 +160,50 @@ std::string markdown_table(const AblationStudy& s, const std::vector<json>& reco
   std::string t = markdown_row(header) + markdown_row(std::vector<std::string>(header.size(), "---"));
   for (size_t i = 0; i < s.variants.size(); ++i) {
     std::vector<std::string> cells = s.variants[i].cells;
-    for (const auto& column : s.measured) cells.push_back(column.second(records[i]));
+    if (records[i].contains("failed")) {  // the row says why; its other cells stay empty
+      cells.push_back("not run: " + records[i]["failed"].get<std::string>());
+      cells.resize(header.size(), "-");
+    } else {
+      for (const auto& column : s.measured) cells.push_back(column.second(records[i]));
+    }
     t += markdown_row(cells);
   }
   return t;
 }
 
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> parts;
+  size_t start = 0;
+  for (size_t comma; (comma = text.find(',', start)) != std::string::npos; start = comma + 1)
+    parts.push_back(text.substr(start, comma - start));
+  parts.push_back(text.substr(start));
+  return parts;
+}
+
 }  // namespace
 
-std::vector<AblationStudy> ablation_studies(const std::string& name, const RunConfig& base) {
+std::vector<AblationStudy> ablation_studies(const std::string& names, const RunConfig& base) {
+  const std::vector<std::string> known = {"refine", "lambda", "features", "strategy"};
+  std::vector<std::string> wanted;
+  for (const std::string& name : split_commas(names)) {
+    if (name == "all") {
+      wanted = known;
+    } else if (std::find(known.begin(), known.end(), name) != known.end()) {
+      wanted.push_back(name);
+    } else {
+      throw std::invalid_argument("--study " + names + ": '" + name +
+                                  "' is not a study (refine, lambda, features, strategy, all, or a "
+                                  "comma-separated list of them)");
+    }
+  }
   std::vector<AblationStudy> studies;
-  if (name == "refine" || name == "all") studies.push_back(refine_study());
-  if (name == "lambda" || name == "all") studies.push_back(lambda_study());
-  if (name == "features" || name == "all") studies.push_back(features_study(base));
-  if (name == "strategy" || name == "all") studies.push_back(strategy_study(base));
-  if (studies.empty())
-    throw std::invalid_argument("--study " + name + ": expected refine, lambda, features, strategy or all");
+  for (const std::string& name : known) {  // each once, in the order of `known`
+    if (std::find(wanted.begin(), wanted.end(), name) == wanted.end()) continue;
+    if (name == "refine") studies.push_back(refine_study());
+    if (name == "lambda") studies.push_back(lambda_study());
+    if (name == "features") studies.push_back(features_study(base));
+    if (name == "strategy") studies.push_back(strategy_study(base));
+  }
   return studies;
 }
 
@@ -191,7 +220,14 @@ std::string run_ablation(const AblateOptions& o, const std::string& command_line
       RunOptions r{o.input,  o.out_dir, "",   v.until,
                    o.config, o.engine,  true, "runs/" + s.name + "-" + v.name};
       v.apply(r.config);
-      records.push_back(run_pipeline(r, out));
+      try {
+        records.push_back(run_pipeline(r, out));
+      } catch (const StageFailed& e) {
+        // A variant the scene cannot run (the true poses without gt/, say): its row says why, the
+        // others still run.
+        out << "ablate: " << s.name << ": " << v.name << ": " << e.what() << "; going on\n";
+        records.push_back({{"failed", e.what()}});
+      }
       all[s.name][v.name] = records.back();
     }
     md += "\n### " + s.name + "\n\n" + markdown_table(s, records);

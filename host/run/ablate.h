@@ -35,7 +35,8 @@ struct AblationStudy {
   std::string note;  // printed under the table
 };
 
-// The studies `name` names (refine, lambda, features, strategy, or all), built on `base`.
+// The studies `names` names (refine, lambda, features, strategy, all, or a comma-separated list), built on
+// `base`, each once, in that order.
 // std::invalid_argument for another name.
 std::vector<AblationStudy> ablation_studies(const std::string& name, const RunConfig& base);
 

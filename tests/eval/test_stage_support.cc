@@ -101,11 +101,28 @@ TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
   all[3].variants[0].apply(c);
   EXPECT_EQ(c.train.strategy, "adc");
   EXPECT_EQ(c.train.max_gaussians, "2000");
-  // Synthetic tracks: refine and train do not depend on the features, so the study stops after match.
-  EXPECT_EQ(all[2].variants[0].until, "match");
-  base.refine.tracks = "sfm";
-  EXPECT_EQ(ablation_studies("features", base)[0].variants[0].until, "eval");
+  // The default tracks (auto) are the front end's: each feature type runs through eval. With synthetic
+  // tracks refine and train do not depend on the features, so the study stops after match.
+  EXPECT_EQ(all[2].variants[0].until, "eval");
+  base.refine.tracks = "synthetic";
+  EXPECT_EQ(ablation_studies("features", base)[0].variants[0].until, "match");
   EXPECT_THROW(ablation_studies("colour", base), std::invalid_argument);
+}
+
+TEST(AblationStudies, ACommaSeparatedListRunsEachStudyOnceInItsOrder) {
+  RunConfig base;
+  base.train.max_gaussians = "8000";
+  const auto two = ablation_studies("strategy,refine,refine", base);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[0].name, "refine");
+  EXPECT_EQ(two[1].name, "strategy");
+  try {
+    ablation_studies("refine,colour", base);
+    FAIL() << "an unknown study in the list was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'colour' is not a study"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ablation_studies("refine,", base), std::invalid_argument);  // an empty name
 }
 
 TEST(AblationStudies, TheStrategyStudyComparesADerivedBudgetWithFixedOnes) {

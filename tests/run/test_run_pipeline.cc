@@ -352,6 +352,27 @@ TEST(RunBadInput, FullDiskFailsTheStageWithoutAManifestAndARerunRedoesIt) {
   EXPECT_EQ(read_json_file(dir / "train" / "metrics.json")["iterations"], 40);
 }
 
+// ablate on a scene without ground truth (as real data): the true-pose variant cannot run; its row says why
+// and the other variants still run.
+TEST(RunAblate, AVariantTheSceneCannotRunIsARowThatSaysWhy) {
+  const fs::path dir = kRoot / "ablate-nogt", scene = kRoot / "ablate-nogt-scene";
+  fs::remove_all(dir);
+  fs::remove_all(scene);
+  ASSERT_EQ(
+      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
+      0);
+  fs::remove_all(scene / "gt");
+  const fs::path config = write_text(kRoot / "ablate-nogt.yaml", small_run_yaml());
+  const CommandResult r = run_engine("ablate " + scene.string() + " --out " + dir.string() +
+                                     " --study refine --config " + config.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream in(dir / "ablation.md");
+  const std::string md{std::istreambuf_iterator<char>(in), {}};
+  EXPECT_NE(md.find("| true (gt/poses.txt) | not run: stage 'train' failed"), std::string::npos) << md;
+  EXPECT_NE(md.find("| input (unrefined) | - | "), std::string::npos) << md;  // no truth: no ATE, a PSNR
+  EXPECT_EQ(md.find("| input (unrefined) | - | - |"), std::string::npos) << md;
+}
+
 // ablate: the variants share the stages their options agree on, and the table holds what the runs measured.
 TEST(RunAblate, RefineStudySharesStagesAndWritesItsTable) {
   const fs::path dir = kRoot / "ablate";
