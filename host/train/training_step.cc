@@ -20,9 +20,8 @@ constexpr uint32_t kLossSlots = 5;
 
 // Per-view device data that never changes: the target and, with the geometric loss, the LiDAR maps.
 struct TrainingStep::ViewBuffers {
-  std::unique_ptr<DeviceArray<float>> target;   // [H][W]
-  std::unique_ptr<DeviceArray<float>> points;   // [H][W][4]
-  std::unique_ptr<DeviceArray<float>> normals;  // [H][W][4]
+  std::unique_ptr<DeviceArray<float>> target;  // [H][W]
+  std::unique_ptr<DeviceArray<float>> planes;  // [H][W][4] (n, n . P): GeometricLoss::pack_plane_targets
   uint32_t valid = 0;
 };
 
@@ -55,10 +54,10 @@ TrainingStep::TrainingStep(engine::Context& ctx, const TrainingData& data, const
     v.target->upload(data.views[i].image);
     if (geometric && !data.views[i].heldout) {
       const ViewPlaneMaps maps = project_planes(*planes, data.views[i].camera);
-      v.points = std::make_unique<DeviceArray<float>>(ctx, "train: lidar points", maps.points.size());
-      v.normals = std::make_unique<DeviceArray<float>>(ctx, "train: lidar normals", maps.normals.size());
-      v.points->upload(maps.points);
-      v.normals->upload(maps.normals);
+      const std::vector<float> targets =
+          kernels::GeometricLoss::pack_plane_targets(maps.points, maps.normals);
+      v.planes = std::make_unique<DeviceArray<float>>(ctx, "train: lidar plane targets", targets.size());
+      v.planes->upload(targets);
       v.valid = maps.valid_count;
     }
   }
@@ -92,9 +91,9 @@ void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy
                       losses_.buffer(), kSlotPhotometric);
   if (level) level->record_backward_step(s, *out.image, level_geometry, level_step, *up.image);
   if (geometric)
-    geometric_.record(s, *out.depth, views_[v].points->buffer(), views_[v].normals->buffer(), W, H,
-                      static_cast<float>(cam.fx), static_cast<float>(cam.fy), static_cast<float>(cam.cx),
-                      static_cast<float>(cam.cy), views_[v].valid, static_cast<float>(o.lambda_geo),
+    geometric_.record(s, *out.depth, views_[v].planes->buffer(), W, H, static_cast<float>(cam.fx),
+                      static_cast<float>(cam.fy), static_cast<float>(cam.cx), static_cast<float>(cam.cy),
+                      views_[v].valid, static_cast<float>(o.lambda_geo),
                       static_cast<float>(o.geo_robust_scale_m), *up.depth, losses_.buffer(), kSlotGeometric);
   else
     s.fill(*up.depth, 0u, uint64_t{W} * H * sizeof(float));

@@ -8,8 +8,7 @@
 #include "loss/loss_shared.h"
 
 layout(std430, binding = GEOMETRIC_BINDING_DEPTH) readonly buffer Depth { float depth[]; };
-layout(std430, binding = GEOMETRIC_BINDING_POINTS) readonly buffer Points { vec4 points[]; };
-layout(std430, binding = GEOMETRIC_BINDING_NORMALS) readonly buffer Normals { vec4 normals[]; };
+layout(std430, binding = GEOMETRIC_BINDING_PLANES) readonly buffer Planes { vec4 planes[]; };
 layout(std430, binding = GEOMETRIC_BINDING_GRAD) writeonly buffer Grad { float grad[]; };
 layout(std430, binding = GEOMETRIC_BINDING_TERMS) writeonly buffer Terms { vec2 terms[]; };
 layout(push_constant) uniform Push { GeometricParams p; };
@@ -21,15 +20,15 @@ void main() {
   const uint i = elementwise_index();
   if (i >= p.count) return;
   const float d = depth[i];
-  const vec4 point = points[i];
+  const vec4 plane = planes[i];
+  const vec3 n = plane.xyz;
   float r2 = 0.0, g = 0.0, counted = 0.0;
-  if (point.w > 0.5 && d > 0.0 && is_finite(d) && p.inv_valid > 0.0) {
-    const vec3 n = normals[i].xyz;
+  if (dot(n, n) > 0.25 && d > 0.0 && is_finite(d) && p.inv_valid > 0.0) {  // unit normal, or 0: no point
     const float u = float(i % p.width) + 0.5;
     const float v = float(i / p.width) + 0.5;
     const vec3 ray = vec3((u - p.cx) / p.fx, (v - p.cy) / p.fy, 1.0);
     const float n_ray = dot(n, ray);
-    const float r = dot(n, point.xyz) - d * n_ray;
+    const float r = plane.w - d * n_ray;  // n . P - n . (D ray)
     // rho(r) = log(1 + r^2 / s^2) s^2 (Cauchy), r^2 when inv_scale2 = 0; its series where log(1 + x) in
     // float would lose the small x.
     const float x = r * r * p.inv_scale2;

@@ -34,11 +34,40 @@ uint32_t GeometricLoss::count_valid(std::span<const float> points) {
   return count;
 }
 
+uint32_t GeometricLoss::count_valid_planes(std::span<const float> planes) {
+  if (planes.size() % 4 != 0)
+    throw std::invalid_argument("GeometricLoss::count_valid_planes: " + std::to_string(planes.size()) +
+                                " floats is not a [H][W][4] map");
+  uint32_t count = 0;
+  for (size_t i = 0; i < planes.size(); i += 4)
+    count += planes[i] * planes[i] + planes[i + 1] * planes[i + 1] + planes[i + 2] * planes[i + 2] > 0.25f;
+  return count;
+}
+
+std::vector<float> GeometricLoss::pack_plane_targets(std::span<const float> points,
+                                                     std::span<const float> normals) {
+  if (points.size() % 4 != 0 || normals.size() != points.size())
+    throw std::invalid_argument("GeometricLoss::pack_plane_targets: a point map of " +
+                                std::to_string(points.size()) + " floats and a normal map of " +
+                                std::to_string(normals.size()) + " (need two [H][W][4] maps of one size)");
+  std::vector<float> planes(points.size(), 0.0f);
+  for (size_t i = 0; i < points.size(); i += 4) {
+    if (!(points[i + 3] > 0.5f)) continue;
+    double offset = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      planes[i + k] = normals[i + k];
+      offset += double{normals[i + k]} * points[i + k];
+    }
+    planes[i + 3] = static_cast<float>(offset);
+  }
+  return planes;
+}
+
 void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& depth,
-                           const engine::Buffer& points, const engine::Buffer& normals, uint32_t width,
-                           uint32_t height, float fx, float fy, float cx, float cy, uint32_t valid_count,
-                           float weight, float robust_scale_m, const engine::Buffer& grad_depth,
-                           const engine::Buffer& loss_out, uint32_t loss_slot) {
+                           const engine::Buffer& planes, uint32_t width, uint32_t height, float fx, float fy,
+                           float cx, float cy, uint32_t valid_count, float weight, float robust_scale_m,
+                           const engine::Buffer& grad_depth, const engine::Buffer& loss_out,
+                           uint32_t loss_slot) {
   static const char* who = "GeometricLoss::record";
   if (width == 0 || height == 0)
     throw std::invalid_argument(std::string(who) + ": view size " + std::to_string(width) + "x" +
@@ -55,8 +84,7 @@ void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& dep
     throw std::invalid_argument(std::string(who) + ": valid_count " + std::to_string(valid_count) +
                                 " exceeds the " + std::to_string(n) + " pixels");
   loss_detail::check_binding(who, "depth", depth, n * sizeof(float));
-  loss_detail::check_binding(who, "points", points, 4 * n * sizeof(float));
-  loss_detail::check_binding(who, "normals", normals, 4 * n * sizeof(float));
+  loss_detail::check_binding(who, "planes", planes, 4 * n * sizeof(float));
   loss_detail::check_binding(who, "grad_depth", grad_depth, n * sizeof(float));
   loss_detail::check_binding(who, "loss_out", loss_out, (uint64_t{loss_slot} + kOutputs) * sizeof(float));
   const engine::Groups groups = elementwise_groups(*context_, n, who);
@@ -76,8 +104,7 @@ void GeometricLoss::record(engine::Sequence& sequence, const engine::Buffer& dep
       robust_scale_m > 0 ? static_cast<float>(1.0 / (double{robust_scale_m} * robust_scale_m)) : 0.0f;
   sequence.dispatch(*kernel_, groups,
                     {{GEOMETRIC_BINDING_DEPTH, &depth, Access::kRead},
-                     {GEOMETRIC_BINDING_POINTS, &points, Access::kRead},
-                     {GEOMETRIC_BINDING_NORMALS, &normals, Access::kRead},
+                     {GEOMETRIC_BINDING_PLANES, &planes, Access::kRead},
                      {GEOMETRIC_BINDING_GRAD, &grad_depth, Access::kWrite},
                      {GEOMETRIC_BINDING_TERMS, &terms_buf_->buffer(), Access::kWrite}},
                     p);

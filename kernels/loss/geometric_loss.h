@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "engine/buffer.h"
 #include "engine/context.h"
@@ -45,16 +46,24 @@ class GeometricLoss {
   //   loss_out[loss_slot]     = L_geo (unweighted, metres^2; robust_scale_m = s of the kernel, 0: squares)
   //   loss_out[loss_slot + 1] = pixels that counted
   //   grad_depth = weight * dL_geo/dD, [H][W] (metres^2 per metre), OVERWRITTEN (not accumulated).
-  // depth holds H*W floats, points and normals H*W*4 ([H][W][4]: x y z valid / nx ny nz 0), loss_out at
-  // least loss_slot + 2 floats; every buffer is checked. valid_count = 0: loss 0 and a zero gradient.
+  // depth holds H*W floats, planes H*W*4 (pack_plane_targets), loss_out at least loss_slot + 2 floats;
+  // every buffer is checked. valid_count = 0: loss 0 and a zero gradient.
   // Intrinsics in pixels; pixel (u, v) has its centre at (u + 0.5, v + 0.5). Scratch as PhotometricLoss.
-  void record(engine::Sequence& sequence, const engine::Buffer& depth, const engine::Buffer& points,
-              const engine::Buffer& normals, uint32_t width, uint32_t height, float fx, float fy, float cx,
-              float cy, uint32_t valid_count, float weight, float robust_scale_m,
-              const engine::Buffer& grad_depth, const engine::Buffer& loss_out, uint32_t loss_slot);
+  void record(engine::Sequence& sequence, const engine::Buffer& depth, const engine::Buffer& planes,
+              uint32_t width, uint32_t height, float fx, float fy, float cx, float cy, uint32_t valid_count,
+              float weight, float robust_scale_m, const engine::Buffer& grad_depth,
+              const engine::Buffer& loss_out, uint32_t loss_slot);
 
-  // N_valid of a point map [H][W][4]: pixels whose valid flag (element 3) is above 0.5.
+  // The kernel's per-pixel target [H][W][4] (n_x, n_y, n_z, n . P) from a point map [H][W][4] (x y z
+  // valid) and a normal map [H][W][4] (nx ny nz 0): half the bytes of the two, since the residual needs only
+  // n and n . P; n . P is taken in double. Pixels whose valid flag is not above 0.5 get zeros.
+  // std::invalid_argument when the maps are not [H][W][4] of the same size.
+  static std::vector<float> pack_plane_targets(std::span<const float> points, std::span<const float> normals);
+
+  // N_valid of a point map [H][W][4] (valid flag, element 3, above 0.5) or of packed plane targets (a
+  // non-zero normal): the same count for the same pixels.
   static uint32_t count_valid(std::span<const float> points);
+  static uint32_t count_valid_planes(std::span<const float> planes);
 
  private:
   engine::Context* context_;

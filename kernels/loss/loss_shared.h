@@ -66,12 +66,13 @@ struct PhotometricParams {
 };
 
 // ---- geometric.comp: one invocation per pixel: point-to-plane residual and dL/dD ----
-#define GEOMETRIC_BINDING_DEPTH 0    // [H][W] rendered expected depth, metres (0: nothing rendered)
-#define GEOMETRIC_BINDING_POINTS 1   // [H][W][4] LiDAR point x y z (camera frame, metres), valid in {0, 1}
-#define GEOMETRIC_BINDING_NORMALS 2  // [H][W][4] unit plane normal nx ny nz, 0
-#define GEOMETRIC_BINDING_GRAD 3     // [H][W] weight * dL_geo/dD, metres^-1 * m^2 (out, overwritten)
-#define GEOMETRIC_BINDING_TERMS 4    // [H][W][2] (rho(r), 1 if the pixel counted else 0) (out)
-#define GEOMETRIC_BINDING_COUNT 5
+#define GEOMETRIC_BINDING_DEPTH 0  // [H][W] rendered expected depth, metres (0: nothing rendered)
+// [H][W][4] the pixel's LiDAR plane target (n_x, n_y, n_z, n . P): unit normal and the point's offset along
+// it (camera frame, metres); n = 0 where the pixel has no LiDAR point (GeometricLoss::pack_plane_targets)
+#define GEOMETRIC_BINDING_PLANES 1
+#define GEOMETRIC_BINDING_GRAD 2   // [H][W] weight * dL_geo/dD, metres^-1 * m^2 (out, overwritten)
+#define GEOMETRIC_BINDING_TERMS 3  // [H][W][2] (rho(r), 1 if the pixel counted else 0) (out)
+#define GEOMETRIC_BINDING_COUNT 4
 
 struct GeometricParams {
   uint width, height;

@@ -295,17 +295,18 @@ class GeometricLossTest : public testing::GpuTest {
   GeoOut run(GeometricLoss& loss, const GeoScene& s, float weight, uint32_t valid_count,
              float robust_scale = 0.0f) {
     const size_t n = size_t{s.w} * s.h;
-    DeviceArray<float> depth(context(), "test: depth", n), points(context(), "test: points", 4 * n),
-        normals(context(), "test: normals", 4 * n), grad(context(), "test: grad depth", n),
-        out(context(), "test: loss out", kLossFloats);
+    // The kernel takes the packed targets; the reference the point and normal maps they come from.
+    const std::vector<float> packed = GeometricLoss::pack_plane_targets(s.points, s.normals);
+    EXPECT_EQ(GeometricLoss::count_valid_planes(packed), GeometricLoss::count_valid(s.points));
+    DeviceArray<float> depth(context(), "test: depth", n), planes(context(), "test: plane targets", 4 * n),
+        grad(context(), "test: grad depth", n), out(context(), "test: loss out", kLossFloats);
     depth.upload(s.depth);
-    points.upload(s.points);
-    normals.upload(s.normals);
+    planes.upload(packed);
     grad.upload(std::vector<float>(n, kSentinel));
     out.upload(std::vector<float>(kLossFloats, kSentinel));
     engine::Sequence seq(context());
-    loss.record(seq, depth.buffer(), points.buffer(), normals.buffer(), s.w, s.h, s.fx, s.fy, s.cx, s.cy,
-                valid_count, weight, robust_scale, grad.buffer(), out.buffer(), kSlot);
+    loss.record(seq, depth.buffer(), planes.buffer(), s.w, s.h, s.fx, s.fy, s.cx, s.cy, valid_count, weight,
+                robust_scale, grad.buffer(), out.buffer(), kSlot);
     seq.submit_and_wait();
     const auto o = out.download();
     for (uint32_t i = 0; i < kLossFloats; ++i)
@@ -405,31 +406,46 @@ TEST_F(GeometricLossTest, ExactPlaneHasZeroLossAndGradient) {
   for (float g : r.grad) ASSERT_LT(std::abs(g), 1e-5f);
 }
 
+TEST_F(GeometricLossTest, PackedTargetsHoldTheNormalAndTheOffsetAlongIt) {
+  // Two pixels: a point 5 m ahead on a tilted plane, and one without a point (its normal would be ignored).
+  const float n = 1.0f / std::sqrt(2.0f);
+  const std::vector<float> points = {0.5f, -0.25f, 5.0f, 1.0f, 1.0f, 2.0f, 3.0f, 0.0f};
+  const std::vector<float> normals = {n, 0.0f, -n, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
+  const std::vector<float> packed = GeometricLoss::pack_plane_targets(points, normals);
+  ASSERT_EQ(packed.size(), 8u);
+  EXPECT_FLOAT_EQ(packed[0], n);
+  EXPECT_FLOAT_EQ(packed[2], -n);
+  EXPECT_FLOAT_EQ(packed[3], static_cast<float>((0.5 - 5.0) / std::sqrt(2.0)));
+  for (size_t k = 4; k < 8; ++k) EXPECT_EQ(packed[k], 0.0f) << k;
+  EXPECT_EQ(GeometricLoss::count_valid_planes(packed), 1u);
+  EXPECT_THROW(GeometricLoss::pack_plane_targets(points, std::span(normals).first(4)), std::invalid_argument);
+}
+
 TEST_F(GeometricLossTest, RejectsBadArguments) {
   GeometricLoss loss(context());
   DeviceArray<float> a(context(), "test: a", 16), b(context(), "test: b", 64), out(context(), "test: out", 2);
   engine::Sequence seq(context());
-  // points too small for 4x4.
-  EXPECT_THROW(loss.record(seq, a.buffer(), a.buffer(), b.buffer(), 4, 4, 1, 1, 2, 2, 1, 1, 0, a.buffer(),
-                           out.buffer(), 0),
-               std::invalid_argument);
+  // plane targets too small for 4x4.
+  EXPECT_THROW(
+      loss.record(seq, a.buffer(), a.buffer(), 4, 4, 1, 1, 2, 2, 1, 1, 0, a.buffer(), out.buffer(), 0),
+      std::invalid_argument);
   // valid_count above the pixel count.
-  EXPECT_THROW(loss.record(seq, a.buffer(), b.buffer(), b.buffer(), 4, 4, 1, 1, 2, 2, 17, 1, 0, a.buffer(),
-                           out.buffer(), 0),
-               std::invalid_argument);
+  EXPECT_THROW(
+      loss.record(seq, a.buffer(), b.buffer(), 4, 4, 1, 1, 2, 2, 17, 1, 0, a.buffer(), out.buffer(), 0),
+      std::invalid_argument);
   // fx = 0.
-  EXPECT_THROW(loss.record(seq, a.buffer(), b.buffer(), b.buffer(), 4, 4, 0, 1, 2, 2, 1, 1, 0, a.buffer(),
-                           out.buffer(), 0),
-               std::invalid_argument);
+  EXPECT_THROW(
+      loss.record(seq, a.buffer(), b.buffer(), 4, 4, 0, 1, 2, 2, 1, 1, 0, a.buffer(), out.buffer(), 0),
+      std::invalid_argument);
   // a negative or NaN robust scale.
   for (const float bad : {-0.1f, std::numeric_limits<float>::quiet_NaN()})
-    EXPECT_THROW(loss.record(seq, a.buffer(), b.buffer(), b.buffer(), 4, 4, 1, 1, 2, 2, 1, 1, bad, a.buffer(),
-                             out.buffer(), 0),
-                 std::invalid_argument);
+    EXPECT_THROW(
+        loss.record(seq, a.buffer(), b.buffer(), 4, 4, 1, 1, 2, 2, 1, 1, bad, a.buffer(), out.buffer(), 0),
+        std::invalid_argument);
   // slot 1 needs 3 floats.
-  EXPECT_THROW(loss.record(seq, a.buffer(), b.buffer(), b.buffer(), 4, 4, 1, 1, 2, 2, 1, 1, 0, a.buffer(),
-                           out.buffer(), 1),
-               std::invalid_argument);
+  EXPECT_THROW(
+      loss.record(seq, a.buffer(), b.buffer(), 4, 4, 1, 1, 2, 2, 1, 1, 0, a.buffer(), out.buffer(), 1),
+      std::invalid_argument);
   EXPECT_EQ(seq.dispatch_count(), 0u);
 }
 
