@@ -1,9 +1,13 @@
 #include "engine/buffer.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
 #include <utility>
 
 #include "engine/context.h"
@@ -30,11 +34,29 @@ void check_limit(const std::string& name, uint64_t size, uint64_t limit, const c
 std::atomic<uint64_t> g_live_bytes{0};
 std::atomic<uint64_t> g_peak_bytes{0};
 
-void count_allocation(uint64_t bytes) {
+// The live allocations by their memory handle (it moves with the Buffer), and their sum by name at the peak.
+std::mutex g_registry_mutex;
+std::unordered_map<VkDeviceMemory, std::pair<std::string, uint64_t>> g_live_allocations;
+std::map<std::string, uint64_t> g_peak_by_name;
+
+void count_allocation(VkDeviceMemory memory, const std::string& name, uint64_t bytes) {
   const uint64_t live = g_live_bytes.fetch_add(bytes) + bytes;
   uint64_t peak = g_peak_bytes.load();
-  while (live > peak && !g_peak_bytes.compare_exchange_weak(peak, live)) {
+  bool new_peak = false;
+  while (live > peak && !(new_peak = g_peak_bytes.compare_exchange_weak(peak, live))) {
   }
+  std::lock_guard lock(g_registry_mutex);
+  g_live_allocations[memory] = {name, bytes};
+  if (new_peak) {  // allocations are rare (sizes grow by steps): a snapshot per new peak is cheap
+    g_peak_by_name.clear();
+    for (const auto& [handle, entry] : g_live_allocations) g_peak_by_name[entry.first] += entry.second;
+  }
+}
+
+void count_release(VkDeviceMemory memory, uint64_t bytes) {
+  g_live_bytes.fetch_sub(bytes);
+  std::lock_guard lock(g_registry_mutex);
+  g_live_allocations.erase(memory);
 }
 
 }  // namespace
@@ -44,6 +66,15 @@ uint64_t Buffer::live_bytes() {
 }
 uint64_t Buffer::peak_bytes() {
   return g_peak_bytes.load();
+}
+std::vector<std::pair<std::string, uint64_t>> Buffer::peak_breakdown() {
+  std::vector<std::pair<std::string, uint64_t>> out;
+  {
+    std::lock_guard lock(g_registry_mutex);
+    out.assign(g_peak_by_name.begin(), g_peak_by_name.end());
+  }
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  return out;
 }
 
 Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKind kind)
@@ -81,7 +112,7 @@ Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKi
                               context.info().name);
     LITGS_VK_CHECK(r);
     allocated_bytes_ = req.size;
-    count_allocation(allocated_bytes_);
+    count_allocation(memory_, name_, allocated_bytes_);
     LITGS_VK_CHECK(vkBindBufferMemory(dev, buffer_, memory_, 0));
     if ((context.memory_type_flags(type) & host) == host)
       LITGS_VK_CHECK(vkMapMemory(dev, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
@@ -123,8 +154,8 @@ void Buffer::release() {
   VkDevice dev = context_->device();
   if (mapped_) vkUnmapMemory(dev, memory_);
   if (buffer_) vkDestroyBuffer(dev, buffer_, nullptr);
+  if (allocated_bytes_) count_release(memory_, allocated_bytes_);
   if (memory_) vkFreeMemory(dev, memory_, nullptr);
-  g_live_bytes.fetch_sub(allocated_bytes_);
   allocated_bytes_ = 0;
   mapped_ = nullptr;
   buffer_ = VK_NULL_HANDLE;

@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace litgs::engine {
@@ -34,6 +35,9 @@ class Buffer {
   // Bytes of device memory held by all live buffers of the process, and the most ever held at once.
   static uint64_t live_bytes();
   static uint64_t peak_bytes();
+  // Where the peak went: the bytes of the buffers alive when peak_bytes() was reached, summed by buffer name
+  // (buffers of one role share a name: "train: view targets"), most first.
+  static std::vector<std::pair<std::string, uint64_t>> peak_breakdown();
 
   const std::string& name() const { return name_; }
   VkBuffer handle() const { return buffer_; }

@@ -24,6 +24,10 @@ nlohmann::json metrics_json(const TrainReport& report, const TrainingData& data,
                             {"evaluations", nlohmann::json::array()},
                             {"kernel_ms_per_iteration", nlohmann::json::object()}};
   for (const auto& [name, ms] : report.kernel_ms_per_iteration) metrics["kernel_ms_per_iteration"][name] = ms;
+  // Where peak_device_bytes went, by buffer name (engine::Buffer::peak_breakdown), most first.
+  metrics["peak_device_breakdown"] = nlohmann::json::array();
+  for (const auto& [name, bytes] : report.peak_device_breakdown)
+    metrics["peak_device_breakdown"].push_back({{"buffer", name}, {"bytes", bytes}});
   // Held-out error in the raw frames' counts (the stretch window's units); with a level model, heldout_psnr,
   // heldout_ssim and heldout_mae_counts score each held-out render at the level interpolated from the
   // training frames around it in time, and the *_identity_level fields score it at the identity level.

@@ -141,6 +141,7 @@ TrainReport make_report(const RunRecord& record, const kernels::TrainableGaussia
   report.ms_per_iteration = o.iterations > start ? 1000.0 * wall_s / (o.iterations - start) : 0.0;
   report.gaussians = model.size();
   report.peak_device_bytes = engine::Buffer::peak_bytes();
+  report.peak_device_breakdown = engine::Buffer::peak_breakdown();
   report.counters = record.counters;
   report.nonfinite_pruned = record.counters.pruned_nonfinite;
   report.plane_pruned = record.counters.pruned_plane;

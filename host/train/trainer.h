@@ -38,6 +38,7 @@ struct TrainReport {
   double ms_per_iteration = 0;
   size_t gaussians = 0;
   uint64_t peak_device_bytes = 0;
+  std::vector<std::pair<std::string, uint64_t>> peak_device_breakdown;  // by buffer name, most first
   EvalResult final_eval;
   std::vector<EvalResult> evals;
   size_t nonfinite_pruned = 0;        // = counters.pruned_nonfinite

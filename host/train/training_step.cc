@@ -49,8 +49,7 @@ TrainingStep::TrainingStep(engine::Context& ctx, const TrainingData& data, const
   views_.resize(data.views.size());
   for (uint32_t i = 0; i < data.views.size(); ++i) {
     ViewBuffers& v = views_[i];
-    v.target =
-        std::make_unique<DeviceArray<float>>(ctx, "train: target " + data.views[i].name, size_t{W} * H);
+    v.target = std::make_unique<DeviceArray<float>>(ctx, "train: view targets", size_t{W} * H);
     v.target->upload(data.views[i].image);
     if (geometric && !data.views[i].heldout) {
       const ViewPlaneMaps maps = project_planes(*planes, data.views[i].camera);

@@ -51,6 +51,41 @@ TEST_F(EngineTest, EmptyBufferIsValid) {
   EXPECT_TRUE(empty.download().empty());
 }
 
+// peak_breakdown() is the buffers alive at the peak, by name: a later, smaller allocation leaves it as it
+// was; a new peak replaces it, without what was released before.
+TEST_F(EngineTest, PeakBreakdownNamesTheBuffersAliveAtThePeak) {
+  auto bytes_of = [](const std::string& name) {
+    for (const auto& [n, b] : engine::Buffer::peak_breakdown())
+      if (n == name) return b;
+    return uint64_t{0};
+  };
+  constexpr uint64_t kMiB = 1 << 20;
+  // Over the process's peak so far (other tests of this binary may have set it), in chunks the device takes.
+  auto allocate_past_peak = [&](const std::string& name) {
+    const uint64_t target = engine::Buffer::peak_bytes();  // the peak rises with every allocation below
+    std::vector<engine::Buffer> chunks;
+    while (engine::Buffer::live_bytes() <= target)
+      chunks.emplace_back(context(), name,
+                          std::min<uint64_t>(64 * kMiB, target - engine::Buffer::live_bytes() + kMiB));
+    return chunks;
+  };
+  {
+    const std::vector<engine::Buffer> first = allocate_past_peak("test: first peak");
+    EXPECT_GE(bytes_of("test: first peak"), kMiB);
+    EXPECT_EQ(engine::Buffer::peak_breakdown().front().first, "test: first peak");
+  }
+  engine::Buffer small(context(), "test: below the peak", 4096);
+  EXPECT_EQ(bytes_of("test: below the peak"), 0u) << "no new peak, no new snapshot";
+  EXPECT_GE(bytes_of("test: first peak"), kMiB);
+  const std::vector<engine::Buffer> second = allocate_past_peak("test: second peak");
+  EXPECT_GE(bytes_of("test: second peak"), kMiB);
+  EXPECT_EQ(bytes_of("test: first peak"), 0u) << "released before the new peak";
+  EXPECT_GE(bytes_of("test: below the peak"), 4096u);
+  uint64_t sum = 0;
+  for (const auto& [name, b] : engine::Buffer::peak_breakdown()) sum += b;
+  EXPECT_EQ(sum, engine::Buffer::peak_bytes());
+}
+
 TEST_F(EngineTest, OversizedBufferNamesBufferAndLimit) {
   const uint64_t too_big = context().info().max_storage_buffer_range + 4;
   try {
