@@ -24,6 +24,13 @@ std::string run_args(const std::string& input, const fs::path& dir, const fs::pa
   return "run " + input + " --out " + dir.string() + " --config " + config.string() + " " + more;
 }
 
+// A fresh 16-frame 64x48 synthetic facade at `scene`.
+bool make_small_scene(const fs::path& scene) {
+  fs::remove_all(scene);
+  return run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string())
+             .status == 0;
+}
+
 // Also the fixture of the report's browser test (tests/run/CMakeLists.txt): leaves kRoot/e2e behind.
 TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
   const fs::path dir = kRoot / "e2e";
@@ -96,10 +103,7 @@ std::map<std::string, std::string> file_contents(const fs::path& dir) {
 TEST(RunStages, SceneStagesWorkOnCopiesAndLeaveTheInputAlone) {
   const fs::path dir = kRoot / "copies", scene = kRoot / "copies-scene";
   fs::remove_all(dir);
-  fs::remove_all(scene);
-  ASSERT_EQ(
-      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
-      0);
+  ASSERT_TRUE(make_small_scene(scene));
   const auto before = file_contents(scene);
   const fs::path config = write_text(kRoot / "copies.yaml", small_run_yaml() + "map:\n  build: always\n");
   const CommandResult r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
@@ -130,10 +134,7 @@ std::string init_refined(std::string yaml) {
 TEST(RunStages, NothingToDoSaysWhy) {
   const fs::path dir = kRoot / "why", scene = kRoot / "why-scene";
   fs::remove_all(dir);
-  fs::remove_all(scene);
-  ASSERT_EQ(
-      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
-      0);
+  ASSERT_TRUE(make_small_scene(scene));
   // No LiDAR at all, as a photogrammetry import.
   fs::remove_all(scene / "lidar");
   std::ifstream in(scene / "scene.yaml");
@@ -236,10 +237,7 @@ TEST(RunBadInput, FailingStageStopsNamesItAndKeepsEarlierOutputs) {
 TEST(RunBadInput, ChangedInputRerunsTheStagesWithoutMixing) {
   const fs::path dir = kRoot / "changed", scene = kRoot / "changed-scene";
   fs::remove_all(dir);
-  fs::remove_all(scene);
-  ASSERT_EQ(
-      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
-      0);
+  ASSERT_TRUE(make_small_scene(scene));
   const fs::path config = write_text(kRoot / "changed.yaml", small_run_yaml());
   CommandResult r = run_engine(run_args(scene.string(), dir, config, "--until train"));
   ASSERT_EQ(r.status, 0) << r.output;
@@ -357,10 +355,7 @@ TEST(RunBadInput, FullDiskFailsTheStageWithoutAManifestAndARerunRedoesIt) {
 TEST(RunAblate, AVariantTheSceneCannotRunIsARowThatSaysWhy) {
   const fs::path dir = kRoot / "ablate-nogt", scene = kRoot / "ablate-nogt-scene";
   fs::remove_all(dir);
-  fs::remove_all(scene);
-  ASSERT_EQ(
-      run_engine("synth --preset facade --frames 16 --width 64 --height 48 --out " + scene.string()).status,
-      0);
+  ASSERT_TRUE(make_small_scene(scene));
   fs::remove_all(scene / "gt");
   const fs::path config = write_text(kRoot / "ablate-nogt.yaml", small_run_yaml());
   const CommandResult r = run_engine("ablate " + scene.string() + " --out " + dir.string() +
