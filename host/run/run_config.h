@@ -115,7 +115,9 @@ void for_each_field(Config& c, F&& f) {
   f("refine", "extra_args", c.refine.extra_args, "more flags for `litgs-engine refine`, as is");
   f("train", "iterations", c.train.iterations, "training iterations");
   f("train", "downscale", c.train.downscale, "divide image size and intrinsics by this");
-  f("train", "strategy", c.train.strategy, "mcmc (fixed budget; measured better and faster on DUNR) | adc");
+  f("train", "strategy", c.train.strategy,
+    "mcmc (fixed budget; at 320x256 on DUNR better and faster than uncapped adc) | adc (capped by "
+    "max_gaussians: at 160x128 on DUNR 0.2 dB above mcmc at each budget, and slower; README)");
   f("train", "max_gaussians", c.train.max_gaussians,
     "MCMC budget (adc: cap): a count, or auto (derived from the surface the training views see)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
