@@ -65,14 +65,6 @@ std::string anomaly_text(const host::TrainingCounters& c) {
   return s;
 }
 
-// The cameras of the views training fits (held-out views excluded).
-std::vector<kernels::SplatCamera> training_cameras(const host::TrainingData& data) {
-  std::vector<kernels::SplatCamera> cameras;
-  for (const host::TrainingView& v : data.views)
-    if (!v.heldout) cameras.push_back(v.camera);
-  return cameras;
-}
-
 std::string format_eta(double s) {
   if (!std::isfinite(s) || s < 0) return "?";
   char buf[32];
@@ -135,7 +127,7 @@ void run_train(TrainCliOptions o) {
     // Planar map points become discs on their plane (the plane fit's normal), the rest spheres. Only the
     // points a training view sees (a Gaussian none sees is never trained), and never more than the budget
     // or --max-init-points: a seeded random subset.
-    const std::vector<uint8_t> seen = host::inside_any_view(map_points, training_cameras(data));
+    const std::vector<uint8_t> seen = host::inside_any_view(map_points, host::training_cameras(data));
     std::vector<size_t> keep;
     for (size_t i = 0; i < map_points.size(); ++i)
       if (seen[i]) keep.push_back(i);

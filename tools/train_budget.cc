@@ -55,9 +55,7 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
         "--max-gaussians auto measures the surface from points on it: the scene has no LiDAR map and the "
         "initialization is random; give --init sfm or a point file, or a number");
   }
-  std::vector<kernels::SplatCamera> cameras;
-  for (const host::TrainingView& v : in.data->views)
-    if (!v.heldout) cameras.push_back(v.camera);
+  const std::vector<kernels::SplatCamera> cameras = host::training_cameras(*in.data);
 
   const host::SceneBudgetOptions options;
   const host::SceneBudget b = host::derive_scene_budget(points, cameras, options);

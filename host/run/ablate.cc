@@ -105,9 +105,7 @@ AblationStudy features_study(const RunConfig& base) {
     s.measured.push_back(column("ATE (m)", "eval", "ate_m", 4));
     s.measured.push_back({"plane RMS after refinement (m)", [](const json& r) {
                             const json p = metric(r, "refine", "plane_rms_m");
-                            // Both 0: no point was held to a plane (a scene without LiDAR).
-                            const bool none = p.is_array() && p[0] == 0 && p[1] == 0;
-                            return p.is_array() && !none ? fixed(p[1], 4) : std::string("-");
+                            return p.is_array() ? fixed(p[1], 4) : std::string("-");
                           }});
     s.measured.push_back(column("PSNR (dB)", "eval", "psnr_db", 2));
   } else {

@@ -38,7 +38,7 @@ struct AblationStudy {
 // The studies `names` names (refine, lambda, features, strategy, all, or a comma-separated list), built on
 // `base`, each once, in that order.
 // std::invalid_argument for another name.
-std::vector<AblationStudy> ablation_studies(const std::string& name, const RunConfig& base);
+std::vector<AblationStudy> ablation_studies(const std::string& names, const RunConfig& base);
 
 struct AblateOptions {
   std::string input;

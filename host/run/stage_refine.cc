@@ -38,7 +38,9 @@ nlohmann::json result(const StageContext& c) {
   const nlohmann::json r = read_stage_json(scene / "refine.json");
   nlohmann::json metrics = pick(r, {"status", "frames", "points", "ate_before_m", "ate_after_m", "seconds"});
   metrics["reprojection_rms_px"] = {r["before"]["reprojection_rms_px"], r["after"]["reprojection_rms_px"]};
-  metrics["plane_rms_m"] = {r["before"]["plane_rms_m"], r["after"]["plane_rms_m"]};
+  // Only where points were held to LiDAR planes (a scene without LiDAR has no plane residual, not a 0).
+  if (r["before"].value("plane_points", 0) > 0 || r["after"].value("plane_points", 0) > 0)
+    metrics["plane_rms_m"] = {r["before"]["plane_rms_m"], r["after"]["plane_rms_m"]};
   return {{"scene", scene.string()}, {"metrics", metrics}};
 }
 

@@ -232,4 +232,11 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
   return out;
 }
 
+std::vector<kernels::SplatCamera> training_cameras(const TrainingData& data) {
+  std::vector<kernels::SplatCamera> cameras;
+  for (const TrainingView& v : data.views)
+    if (!v.heldout) cameras.push_back(v.camera);
+  return cameras;
+}
+
 }  // namespace litgs::host

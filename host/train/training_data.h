@@ -62,6 +62,9 @@ struct TrainingData {
 // Throws io::IoError / std::invalid_argument naming the file or the problem.
 TrainingData load_training_data(const std::filesystem::path& scene_dir, const TrainingDataOptions& options);
 
+// The cameras of the views training fits (held-out views left out), in view order.
+std::vector<kernels::SplatCamera> training_cameras(const TrainingData& data);
+
 // The camera training uses for the frame at `t_s` of `scene` (read from `scene_dir`), in the scene's
 // (recentred) frame: the pose at that time in poses.txt (gt/poses.txt with options.true_poses), matched
 // within pose_match_tolerance_s or interpolated and moved from the IMU to the camera where the poses are the
