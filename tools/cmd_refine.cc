@@ -38,6 +38,11 @@ void add_refine_command(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--pixel-noise", o->synthetic.pixel_noise_px, "Synthetic tracks: pixel noise (px)")
       ->capture_default_str();
+  c->add_option("--anchor-track-length", o->synthetic.anchor_track_length,
+                "Synthetic tracks: an anchor's track lasts up to N frames, then a new one starts where it is "
+                "seen again (0: one track through every frame that sees it)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   c->add_option(
        "--min-frame-observations", o->refine.min_frame_observations,
        "Stop (keeping the priors) when more than half of the frames have fewer observations (0: off)")

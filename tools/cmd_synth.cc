@@ -1,5 +1,6 @@
-// `litgs-engine synth --preset NAME --out DIR [--seed S] [--frames N] [--width W --height H] [--force]
-// [--drift]`: a synthetic scene directory with exact ground truth (docs/scene-format.md). CPU only.
+// `litgs-engine synth --preset NAME --out DIR [--seed S] [--frames N] [--frame-rate HZ] [--width W --height
+// H]
+// [--force] [--drift]`: a synthetic scene directory with exact ground truth (docs/scene-format.md). CPU only.
 #include <CLI/CLI.hpp>
 #include <iomanip>
 #include <iostream>
@@ -23,6 +24,11 @@ void add_synth_command(CLI::App& app) {
       ->capture_default_str();
   CLI::Option* f =
       synth->add_option("--frames", *frames, "Thermal frames (default: the preset's, facade 60)");
+  auto rate = std::make_shared<double>(10);
+  CLI::Option* rate_option =
+      synth->add_option("--frame-rate", *rate,
+                        "Frames (and LiDAR scans) per second (default 10; the presets' frame "
+                        "limits and default frame counts scale with it)");
   CLI::Option* w = synth->add_option("--width", *width, "Image width in pixels (default 320)");
   CLI::Option* h = synth->add_option("--height", *height, "Image height in pixels (default 256)");
   synth->add_flag("--force", o->force, "Replace the scene files in a non-empty --out");
@@ -31,8 +37,9 @@ void add_synth_command(CLI::App& app) {
                   "freeze) in the raw frames; the truth in gt/levels.txt");
   synth->add_option("--threads", o->threads, "Worker threads (0: all cores, at most 8)")
       ->capture_default_str();
-  synth->callback([o, frames, width, height, f, w, h] {
+  synth->callback([o, frames, width, height, rate, f, w, h, rate_option] {
     if (f->count()) o->frames = *frames;
+    if (rate_option->count()) o->frame_rate_hz = *rate;
     if (w->count()) o->width = *width;
     if (h->count()) o->height = *height;
     const host::synth::SynthReport r = host::synth::generate_synthetic_scene(*o);

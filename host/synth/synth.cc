@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <future>
 #include <set>
 #include <sstream>
@@ -82,6 +83,8 @@ std::string SynthOptions::check() const {
   }
   if (frames && (*frames < 1 || *frames > 100000))
     return "frames: must be in [1, 100000], got " + std::to_string(*frames);
+  if (frame_rate_hz && !(*frame_rate_hz >= 1 && *frame_rate_hz <= 200))
+    return "frame_rate_hz: must be in [1, 200], got " + std::to_string(*frame_rate_hz);
   if (width.has_value() != height.has_value()) return "width/height: give both or neither";
   if (width && (*width < 16 || *width > 8192))
     return "width: must be in [16, 8192], got " + std::to_string(*width);
@@ -97,11 +100,19 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   if (const std::string problem = options.check(); !problem.empty())
     throw std::invalid_argument("synth: " + problem);
   Preset p = make_preset(options.preset, options.seed);
+  if (options.frame_rate_hz) {  // the same stretch of the world, sampled more or less densely
+    p.max_frames = static_cast<int>(std::floor(p.max_frames * *options.frame_rate_hz / p.frame_rate_hz));
+    p.frames = static_cast<int>(std::lround(p.frames * *options.frame_rate_hz / p.frame_rate_hz));
+    p.frame_rate_hz = *options.frame_rate_hz;
+  }
   if (options.frames) {
+    std::ostringstream hz;
+    hz << p.frame_rate_hz;
     if (*options.frames > p.max_frames)
-      throw std::invalid_argument(
-          "synth: frames: preset " + p.name + " covers at most " + std::to_string(p.max_frames) +
-          " frames (the rig would leave its world), got " + std::to_string(*options.frames));
+      throw std::invalid_argument("synth: frames: preset " + p.name + " covers at most " +
+                                  std::to_string(p.max_frames) + " frames at " + hz.str() +
+                                  " Hz (the rig would leave its world), got " +
+                                  std::to_string(*options.frames));
     p.frames = *options.frames;
   }
   if (options.width) {

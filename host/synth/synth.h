@@ -10,9 +10,12 @@
 namespace litgs::host::synth {
 
 struct SynthOptions {
-  std::string preset = "facade";     // facade (default) | street | corridor
-  uint64_t seed = 1;                 // everything random derives from it
-  std::optional<int> frames;         // thermal frames (= LiDAR scans); default: the preset's (facade 60)
+  std::string preset = "facade";  // facade (default) | street | corridor
+  uint64_t seed = 1;              // everything random derives from it
+  std::optional<int> frames;      // thermal frames (= LiDAR scans); default: the preset's (facade 60)
+  // Frames (and scans) per second; default the presets' 10 Hz. A higher rate puts more frames on the same
+  // path: the presets' frame limits scale with it.
+  std::optional<double> frame_rate_hz;
   std::optional<int> width, height;  // thermal image size, both or neither; default 320 x 256
   std::filesystem::path out;         // the scene directory to write
   bool force = false;                // replace the scene files in a non-empty `out`

@@ -266,6 +266,34 @@ void expect_invalid(F&& f, const std::string& part) {
   }
 }
 
+// --frame-rate samples the same path more densely: frame 2 at 20 Hz is frame 1 at 10 Hz, and the presets'
+// frame limits scale with the rate.
+TEST_F(SynthSceneTest, AHigherFrameRateSamplesTheSamePathMoreDensely) {
+  SynthOptions slow = small("slow");
+  slow.frames = 2;
+  slow.width = slow.height = 32;
+  SynthOptions fast = slow;
+  fast.out = dir_ / "fast";
+  fast.frames = 3;
+  fast.frame_rate_hz = 20;
+  generate_synthetic_scene(slow);
+  generate_synthetic_scene(fast);
+  const io::Scene a = io::read_scene(slow.out), b = io::read_scene(fast.out);
+  ASSERT_EQ(a.gt->poses.size(), 2u);
+  ASSERT_EQ(b.gt->poses.size(), 3u);
+  EXPECT_DOUBLE_EQ(b.gt->poses[2].t_s, a.gt->poses[1].t_s);
+  EXPECT_LT((b.gt->poses[2].p_world - a.gt->poses[1].p_world).norm(), 1e-12);
+  EXPECT_GT((b.gt->poses[1].p_world - a.gt->poses[1].p_world).norm(), 1e-3) << "frame 1 at 20 Hz is between";
+
+  SynthOptions too_many = small("too-many");
+  too_many.frame_rate_hz = 30;
+  too_many.frames = 1200;
+  expect_invalid([&] { generate_synthetic_scene(too_many); }, "covers at most 1140 frames at 30 Hz");
+  too_many.frame_rate_hz = 0;
+  expect_invalid([&] { generate_synthetic_scene(too_many); }, "frame_rate_hz");
+  EXPECT_FALSE(fs::exists(too_many.out));
+}
+
 TEST_F(SynthSceneTest, BadArgumentsAreClearErrors) {
   SynthOptions o = small("bad");
   o.preset = "moon";

@@ -5,8 +5,10 @@
 #include <random>
 
 #include "host/refine/ate.h"
+#include "host/refine/synthetic_tracks.h"
 #include "host/refine/triangulation.h"
 #include "host/refine/weights.h"
+#include "refine_test_scene.h"
 
 namespace litgs::host::refine {
 namespace {
@@ -152,6 +154,38 @@ TEST(RefineTriangulation, RecoversAPointAndRefusesNoParallax) {
   EXPECT_LT((*T - X).norm(), 1e-9);
   for (auto& p : poses) p.p.setZero();  // one centre: pure rotation
   EXPECT_FALSE(triangulate(obs, poses, c).has_value());
+}
+
+// The synthetic stand-in for the front end: an anchor is followed through every frame that sees it as one
+// track (0), or tracked like any other feature for at most N frames and found again as a new track.
+TEST(RefineSyntheticTracks, AnchorTracksLastAsLongAsAsked) {
+  testing::TestScene scene;
+  testing::TestSceneOptions o;
+  o.tracks.tracks_per_frame = 0;  // anchors' tracks only
+  testing::make_test_scene(scene, o);
+  ASSERT_GT(scene.anchors_true.size(), 20u);
+  SyntheticTrackOptions whole = o.tracks, bounded = o.tracks;
+  whole.anchor_track_length = 0;
+  bounded.anchor_track_length = 5;
+  const auto one_each =
+      synthetic_tracks(scene.world, scene.truth, scene.priors, scene.camera, scene.anchors_true, whole);
+  const auto sightings =
+      synthetic_tracks(scene.world, scene.truth, scene.priors, scene.camera, scene.anchors_true, bounded);
+  EXPECT_LE(one_each.size(), scene.anchors_true.size());
+  EXPECT_GT(sightings.size(), one_each.size()) << "a lost anchor is found again as a new track";
+  size_t longest = 0, observations_whole = 0, observations_bounded = 0;
+  for (const auto& t : one_each) {
+    longest = std::max(longest, t.obs.size());
+    observations_whole += t.obs.size();
+  }
+  EXPECT_GT(longest, 5u) << "the whole-sequence tracks are longer than the bounded ones";
+  for (const auto& t : sightings) {
+    EXPECT_GE(t.obs.size(), 2u);
+    EXPECT_LE(t.obs.size(), 5u);
+    EXPECT_LE(t.obs.back().frame - t.obs.front().frame, 4u) << "a sighting is consecutive frames";
+    observations_bounded += t.obs.size();
+  }
+  EXPECT_GT(observations_bounded, observations_whole / 4) << "the sightings still cover the anchors";
 }
 
 }  // namespace
