@@ -65,8 +65,10 @@ void add_refine_command(CLI::App& app) {
               << " tracks; " << rr.frames << " frames, " << r.points_written << " points ("
               << rr.anchor_association.anchored_tracks << " anchored), " << rr.rounds.size() << " rounds in "
               << rr.seconds << " s; reprojection RMS " << rr.before.reprojection_rms_px << " -> "
-              << rr.after.reprojection_rms_px << " px, plane RMS " << rr.before.plane_rms_m << " -> "
-              << rr.after.plane_rms_m << " m";
+              << rr.after.reprojection_rms_px << " px";
+    if (rr.after.behind_camera > 0)
+      std::cout << " (" << rr.after.behind_camera << " observations behind their camera left out)";
+    std::cout << ", plane RMS " << rr.before.plane_rms_m << " -> " << rr.after.plane_rms_m << " m";
     if (r.has_truth) std::cout << "; ATE " << r.ate_before_m << " -> " << r.ate_after_m << " m";
     std::cout << "\n";
     if (r.control)

@@ -97,8 +97,14 @@ ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::v
     if (!p.active) continue;
     for (const auto& ob : p.obs)
       if (ob.active) {
-        e.push_back(reprojection_error_px(poses[ob.frame], camera, p.X, ob.uv));
-        sum2 += e.back() * e.back();
+        ++s.observations;
+        const double error = reprojection_error_px(poses[ob.frame], camera, p.X, ob.uv);
+        if (!std::isfinite(error)) {
+          ++s.behind_camera;
+          continue;
+        }
+        e.push_back(error);
+        sum2 += error * error;
       }
     if (p.has_plane) {
       const double d = p.plane.n.dot(p.X - p.plane.l);
@@ -106,7 +112,6 @@ ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::v
       ++s.plane_points;
     }
   }
-  s.observations = e.size();
   if (!e.empty()) {
     s.reprojection_rms_px = std::sqrt(sum2 / static_cast<double>(e.size()));
     s.reprojection_median_px = median(e);

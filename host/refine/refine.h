@@ -45,6 +45,9 @@ struct RefineInput {
 
 struct ResidualStats {
   size_t observations = 0;  // active
+  // Active observations whose point lies behind (or on) their camera: no finite reprojection error; the
+  // RMS and median are over the others.
+  size_t behind_camera = 0;
   double reprojection_rms_px = 0, reprojection_median_px = 0;
   size_t plane_points = 0;
   double plane_rms_m = 0;

@@ -98,11 +98,9 @@ std::set<size_t> read_frozen(const fs::path& path) {
 }
 
 nlohmann::json stats_json(const ResidualStats& s) {
-  return {{"observations", s.observations},
-          {"reprojection_rms_px", s.reprojection_rms_px},
-          {"reprojection_median_px", s.reprojection_median_px},
-          {"plane_points", s.plane_points},
-          {"plane_rms_m", s.plane_rms_m}};
+  return {{"observations", s.observations},   {"reprojection_rms_px", s.reprojection_rms_px},
+          {"behind_camera", s.behind_camera}, {"reprojection_median_px", s.reprojection_median_px},
+          {"plane_points", s.plane_points},   {"plane_rms_m", s.plane_rms_m}};
 }
 
 nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions& o) {

@@ -5,6 +5,7 @@
 #include <random>
 
 #include "host/refine/ate.h"
+#include "host/refine/refine.h"
 #include "host/refine/synthetic_tracks.h"
 #include "host/refine/triangulation.h"
 #include "host/refine/weights.h"
@@ -186,6 +187,26 @@ TEST(RefineSyntheticTracks, AnchorTracksLastAsLongAsAsked) {
     observations_bounded += t.obs.size();
   }
   EXPECT_GT(observations_bounded, observations_whole / 4) << "the sightings still cover the anchors";
+}
+
+// A point that a solve left behind a camera observing it has no reprojection error: it is counted, and the
+// RMS and median are those of the other observations (they were infinite before).
+TEST(RefineResiduals, APointBehindItsCameraIsCountedNotAveraged) {
+  PinholeCamera camera;
+  camera.fx = camera.fy = 100;
+  camera.cx = camera.cy = 50;
+  camera.width = camera.height = 100;
+  std::vector<CameraPose> poses(3);  // all at the origin, looking along +z
+  TrackPoint seen, behind;
+  seen.X = Eigen::Vector3d(0, 0, 2);
+  seen.obs = {{0, Eigen::Vector2d(53, 54)}, {1, Eigen::Vector2d(50, 50)}, {2, Eigen::Vector2d(53, 50)}};
+  behind.X = Eigen::Vector3d(0, 0, -2);
+  behind.obs = {{0, Eigen::Vector2d(50, 50)}, {1, Eigen::Vector2d(50, 50)}};
+  const ResidualStats s = residual_stats({seen, behind}, poses, camera);
+  EXPECT_EQ(s.observations, 5u);
+  EXPECT_EQ(s.behind_camera, 2u);
+  EXPECT_NEAR(s.reprojection_rms_px, std::sqrt((25.0 + 0.0 + 9.0) / 3), 1e-12);  // errors 5, 0, 3 px
+  EXPECT_NEAR(s.reprojection_median_px, 3.0, 1e-12);
 }
 
 }  // namespace
