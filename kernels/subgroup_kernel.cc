@@ -27,8 +27,11 @@ engine::KernelDesc kernel_desc(const std::string& name, uint32_t binding_count,
 }  // namespace
 
 std::unique_ptr<engine::Kernel> make_kernel(engine::Context& context, const std::string& name,
-                                            uint32_t binding_count, uint32_t push_constant_bytes) {
-  return std::make_unique<engine::Kernel>(context, kernel_desc(name, binding_count, push_constant_bytes));
+                                            uint32_t binding_count, uint32_t push_constant_bytes,
+                                            std::vector<engine::SpecConstant> spec_constants) {
+  engine::KernelDesc desc = kernel_desc(name, binding_count, push_constant_bytes);
+  desc.spec_constants = std::move(spec_constants);
+  return std::make_unique<engine::Kernel>(context, std::move(desc));
 }
 
 std::unique_ptr<engine::Kernel> make_subgroup_kernel(engine::Context& context, const std::string& name,

@@ -15,7 +15,8 @@ uint32_t subgroup_width(const engine::Context& context);
 
 // A kernel from the embedded shader `name` (no specialization constants).
 std::unique_ptr<engine::Kernel> make_kernel(engine::Context& context, const std::string& name,
-                                            uint32_t binding_count, uint32_t push_constant_bytes);
+                                            uint32_t binding_count, uint32_t push_constant_bytes,
+                                            std::vector<engine::SpecConstant> spec_constants = {});
 
 // A kernel from the embedded shader `name` with SUBGROUP_SIZE (constant_id 0) set and the subgroup size
 // pinned, so that a workgroup is exactly one full subgroup.

@@ -44,7 +44,8 @@ RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, 
                    const std::function<void(const std::string&)>& notice) {
   RunStart s;
   if (!o.resume) {
-    s.model = std::make_unique<kernels::TrainableGaussians>(ctx, initial);
+    s.model = std::make_unique<kernels::TrainableGaussians>(ctx, initial, kernels::AdamOptions{},
+                                                            o.strategy == "adc");
     s.record.options = options;
     return s;
   }
@@ -73,7 +74,8 @@ RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, 
   }
   notice("resume: from " + ckpt.string() + " (iteration " + std::to_string(c.iteration) + " of " +
          std::to_string(o.iterations) + ")");
-  s.model = std::make_unique<kernels::TrainableGaussians>(ctx, c.state);
+  s.model = std::make_unique<kernels::TrainableGaussians>(ctx, c.state, kernels::AdamOptions{},
+                                                          o.strategy == "adc");
   s.iteration = c.iteration;
   s.level_state = std::move(c.level_state);
   s.record = std::move(c.record);

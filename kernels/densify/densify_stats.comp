@@ -14,7 +14,7 @@ layout(std430, binding = STATS_BINDING_LOG_SCALES) readonly buffer LogScales { f
 layout(std430, binding = STATS_BINDING_QUATS) readonly buffer Quats { float quats[]; };
 layout(std430, binding = STATS_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
 layout(std430, binding = STATS_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 rects[]; };
-layout(std430, binding = STATS_BINDING_GRAD_MEANS2D) readonly buffer GradMeans2d { float grad_means2d[]; };
+layout(std430, binding = STATS_BINDING_GRAD2D) readonly buffer Grad2d { float grad2d[]; };
 layout(std430, binding = STATS_BINDING_GRAD_ACCUM) buffer GradAccum { float grad_accum[]; };
 layout(std430, binding = STATS_BINDING_DENOM) buffer Denom { uint denom[]; };
 layout(std430, binding = STATS_BINDING_MAX_RADIUS) buffer MaxRadius { float max_radius[]; };
@@ -26,8 +26,8 @@ void main() {
   if (rect.z <= rect.x || rect.w <= rect.y) return;
   // 3DGS's viewspace gradient is w.r.t. NDC (its backward multiplies dL/dpixel by W/2 and H/2): the same
   // scaling here makes its threshold (0.0002) apply unchanged, independent of the image size.
-  const vec2 g = vec2(grad_means2d[2 * i] * (0.5 * float(view.width)),
-                      grad_means2d[2 * i + 1] * (0.5 * float(view.height)));
+  const vec2 g = vec2(grad2d[i * GRAD2D_STRIDE] * (0.5 * float(view.width)),
+                      grad2d[i * GRAD2D_STRIDE + 1] * (0.5 * float(view.height)));
   const float norm = length(g);
   if (is_finite_real(norm)) grad_accum[i] += norm;
   denom[i] += 1u;

@@ -63,19 +63,23 @@ struct TrainableGaussians::Slot {
   size_t capacity = 0;
 };
 
-TrainableGaussians::TrainableGaussians(engine::Context& context, const GaussianModel& model, AdamOptions adam)
-    : TrainableGaussians(context, TrainingState::fresh(model), adam) {}
+TrainableGaussians::TrainableGaussians(engine::Context& context, const GaussianModel& model, AdamOptions adam,
+                                       bool densify_statistics)
+    : TrainableGaussians(context, TrainingState::fresh(model), adam, densify_statistics) {}
 
-TrainableGaussians::TrainableGaussians(engine::Context& context, const TrainingState& state, AdamOptions adam)
+TrainableGaussians::TrainableGaussians(engine::Context& context, const TrainingState& state, AdamOptions adam,
+                                       bool densify_statistics)
     : context_(&context),
       adam_options_(adam),
+      statistics_(densify_statistics),
       channels_(state.model.channels),
       sh_degree_(state.model.sh_degree),
       adam_(context),
       scan_(context) {
   adam_options_.check();
   state.check();
-  stats_ = make_kernel(context, "densify/densify_stats", STATS_BINDING_COUNT, sizeof(SplatView));
+  stats_ = make_kernel(context, "densify/densify_stats", STATS_BINDING_COUNT, sizeof(SplatView),
+                       {{1, channels_}});  // CHANNELS: the rasterizer's gradient row stride
   candidates_ =
       make_kernel(context, "densify/densify_candidates", DECIDE_BINDING_COUNT, sizeof(DensifyParams));
   decide_ = make_kernel(context, "densify/densify_decide", DECIDE_BINDING_COUNT, sizeof(DensifyParams));
@@ -94,6 +98,12 @@ TrainableGaussians::TrainableGaussians(engine::Context& context, const TrainingS
   ensure_capacity(*current_, state.size());
   current_->params->count = state.size();
   upload_state(*current_, state);
+}
+
+void TrainableGaussians::require_statistics(const char* what) const {
+  if (!statistics_)
+    throw std::logic_error(std::string("TrainableGaussians::") + what +
+                           ": this model keeps no densification statistics (made for the MCMC strategy)");
 }
 
 TrainableGaussians::~TrainableGaussians() = default;
@@ -124,6 +134,7 @@ void TrainableGaussians::ensure_capacity(Slot& slot, size_t rows) {
     slot.exp_avg_sq[g] = std::make_unique<DeviceArray<float>>(
         ctx, std::string("optim: exp_avg_sq ") + kParamGroupNames[g], slot.capacity * widths[g]);
   }
+  if (!statistics_) return;
   slot.grad_accum = std::make_unique<DeviceArray<float>>(ctx, "densify: grad accum", slot.capacity);
   slot.denom = std::make_unique<DeviceArray<uint32_t>>(ctx, "densify: denom", slot.capacity);
   slot.max_radius = std::make_unique<DeviceArray<float>>(ctx, "densify: max radius", slot.capacity);
@@ -135,6 +146,7 @@ void TrainableGaussians::upload_state(Slot& slot, const TrainingState& state) {
     slot.exp_avg[g]->upload(state.exp_avg[g]);
     slot.exp_avg_sq[g]->upload(state.exp_avg_sq[g]);
   }
+  if (!statistics_) return;
   slot.grad_accum->upload(state.grad_accum);
   slot.denom->upload(state.denom);
   slot.max_radius->upload(state.max_radius);
@@ -165,11 +177,13 @@ void TrainableGaussians::record_accumulate_stats(engine::Sequence& sequence,
                                                  const Rasterizer::DeviceGrads& grads,
                                                  const engine::Buffer& rects, const SplatCamera& camera) {
   camera.check();
+  require_statistics("record_accumulate_stats");
   const Slot& s = *current_;
   const uint64_t n = size();
-  if (!grads.means2d) throw std::invalid_argument("record_accumulate_stats: no means2d gradient buffer");
+  if (!grads.grad2d) throw std::invalid_argument("record_accumulate_stats: no screen-space gradient buffer");
   check_binding(rects, 4 * n, 4, "densify stats: tile rects");
-  check_binding(*grads.means2d, 2 * n, 4, "densify stats: means2d gradients");
+  check_binding(*grads.grad2d, n * (SPLAT_GRAD2D_FIXED + channels_), 4,
+                "densify stats: screen-space gradients");
   const SplatView view =
       make_splat_view(camera, static_cast<uint32_t>(n), (sh_degree_ + 1) * (sh_degree_ + 1));
   const DeviceGaussians& g = *s.params;
@@ -179,7 +193,7 @@ void TrainableGaussians::record_accumulate_stats(engine::Sequence& sequence,
                      {STATS_BINDING_QUATS, &g.quats.buffer(), Access::kRead},
                      {STATS_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kRead},
                      {STATS_BINDING_TILE_RECTS, &rects, Access::kRead},
-                     {STATS_BINDING_GRAD_MEANS2D, grads.means2d, Access::kRead},
+                     {STATS_BINDING_GRAD2D, grads.grad2d, Access::kRead},
                      {STATS_BINDING_GRAD_ACCUM, &s.grad_accum->buffer(), Access::kReadWrite},
                      {STATS_BINDING_DENOM, &s.denom->buffer(), Access::kReadWrite},
                      {STATS_BINDING_MAX_RADIUS, &s.max_radius->buffer(), Access::kReadWrite}},
@@ -193,6 +207,7 @@ DensifyReport TrainableGaussians::densify_and_prune(const DensifyOptions& option
   const uint32_t sv = sh_values();
   const DensifyParams params =
       make_densify_params(options, scene_extent, step, n, sv, plane_distance != nullptr);
+  require_statistics("densify_and_prune");
   DensifyReport report;
   report.before = n;
   if (n == 0) return report;
@@ -356,6 +371,7 @@ std::vector<TrainableGaussians::RowArray> TrainableGaussians::row_arrays() const
     out.push_back({&s.exp_avg[g]->buffer(), widths[g], RowArray::kMoment});
     out.push_back({&s.exp_avg_sq[g]->buffer(), widths[g], RowArray::kMoment});
   }
+  if (!statistics_) return out;
   out.push_back({&s.grad_accum->buffer(), 1, RowArray::kStatistic});
   out.push_back({&s.denom->buffer(), 1, RowArray::kStatistic});
   out.push_back({&s.max_radius->buffer(), 1, RowArray::kStatistic});
@@ -402,6 +418,12 @@ TrainingState TrainableGaussians::download_state() const {
   for (uint32_t g = 0; g < kParamGroupCount; ++g) {
     st.exp_avg[g] = s.exp_avg[g]->download(0, n * widths[g]);
     st.exp_avg_sq[g] = s.exp_avg_sq[g]->download(0, n * widths[g]);
+  }
+  if (!statistics_) {  // zeros, as a model that never accumulated them (checkpoints keep one layout)
+    st.grad_accum.assign(n, 0.0f);
+    st.denom.assign(n, 0u);
+    st.max_radius.assign(n, 0.0f);
+    return st;
   }
   st.grad_accum = s.grad_accum->download(0, n);
   st.denom = s.denom->download(0, n);

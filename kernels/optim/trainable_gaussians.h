@@ -26,8 +26,13 @@ namespace litgs::kernels {
 
 class TrainableGaussians {
  public:
-  TrainableGaussians(engine::Context& context, const GaussianModel& model, AdamOptions adam = {});
-  TrainableGaussians(engine::Context& context, const TrainingState& state, AdamOptions adam = {});
+  // densify_statistics false: no grad_accum / denom / max_radius arrays (12 bytes per Gaussian), for
+  // strategies that do not read them (MCMC); record_accumulate_stats and densify_and_prune then throw
+  // std::logic_error, and download_state() reports them as zeros.
+  TrainableGaussians(engine::Context& context, const GaussianModel& model, AdamOptions adam = {},
+                     bool densify_statistics = true);
+  TrainableGaussians(engine::Context& context, const TrainingState& state, AdamOptions adam = {},
+                     bool densify_statistics = true);
   ~TrainableGaussians();
   TrainableGaussians(const TrainableGaussians&) = delete;
   TrainableGaussians& operator=(const TrainableGaussians&) = delete;
@@ -78,10 +83,12 @@ class TrainableGaussians {
   struct Slot;
   void upload_state(Slot& slot, const TrainingState& state);
   void ensure_capacity(Slot& slot, size_t rows);
+  void require_statistics(const char* what) const;
   uint32_t sh_values() const;
 
   engine::Context* context_;
   AdamOptions adam_options_;
+  bool statistics_;  // the densification statistics are kept
   uint32_t channels_, sh_degree_;
   AdamKernel adam_;
   ExclusiveScan scan_;

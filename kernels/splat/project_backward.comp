@@ -19,7 +19,6 @@ layout(std430, binding = PBWD_BINDING_GRAD_LOG_SCALES) writeonly buffer GLogScal
 layout(std430, binding = PBWD_BINDING_GRAD_QUATS) writeonly buffer GQuats { float g_quats[]; };
 layout(std430, binding = PBWD_BINDING_GRAD_OPACITY_LOGITS) writeonly buffer GLogits { float g_logits[]; };
 layout(std430, binding = PBWD_BINDING_GRAD_SH) writeonly buffer GSh { float g_sh[]; };
-layout(std430, binding = PBWD_BINDING_GRAD_MEANS2D) writeonly buffer GMeans2d { float g_means2d[]; };
 
 void main() {
   const uint i = elementwise_index();
@@ -34,8 +33,6 @@ void main() {
     for (uint a = 0u; a < 4u; ++a) g_quats[4 * i + a] = 0.0;
     g_logits[i] = 0.0;
     for (uint k = 0u; k < K * CHANNELS; ++k) g_sh[i * K * CHANNELS + k] = 0.0;
-    g_means2d[2 * i] = 0.0;
-    g_means2d[2 * i + 1] = 0.0;
     return;
   }
   const uint base = i * GRAD2D_STRIDE;
@@ -78,6 +75,4 @@ void main() {
   }
   for (uint a = 0u; a < 4u; ++a) g_quats[4 * i + a] = p.quat[a];
   g_logits[i] = p.opacity_logit;
-  g_means2d[2 * i] = pg.mean2d.x;
-  g_means2d[2 * i + 1] = pg.mean2d.y;
 }

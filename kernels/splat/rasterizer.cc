@@ -90,7 +90,7 @@ struct Rasterizer::Buffers {
   // Per Gaussian.
   std::unique_ptr<DeviceArray<float>> means2d, conics, depths, opacities, colors, grad2d;
   std::unique_ptr<DeviceArray<uint32_t>> rects, depth_keys, order, counts, offsets;
-  std::unique_ptr<DeviceArray<float>> g_means, g_log_scales, g_quats, g_logits, g_sh, g_means2d;
+  std::unique_ptr<DeviceArray<float>> g_means, g_log_scales, g_quats, g_logits, g_sh;
   // Per intersection.
   std::unique_ptr<DeviceArray<uint32_t>> tile_keys, isect_ids, isect_gaussian;
   std::unique_ptr<DeviceArray<float>> isect_grads;
@@ -454,7 +454,6 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
   grow(ctx, b.g_quats, 4 * size_t{n}, "splat: grad quats");
   grow(ctx, b.g_logits, n, "splat: grad opacity_logits");
   grow(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
-  grow(ctx, b.g_means2d, 2 * size_t{n}, "splat: grad means2d");
   if (options_.deterministic) grow(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
   backward_passes_ = passes_for(backward_entries_per_pass_);
   const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
@@ -502,11 +501,10 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
               {PBWD_BINDING_GRAD_LOG_SCALES, &b.g_log_scales->buffer(), Access::kWrite},
               {PBWD_BINDING_GRAD_QUATS, &b.g_quats->buffer(), Access::kWrite},
               {PBWD_BINDING_GRAD_OPACITY_LOGITS, &b.g_logits->buffer(), Access::kWrite},
-              {PBWD_BINDING_GRAD_SH, &b.g_sh->buffer(), Access::kWrite},
-              {PBWD_BINDING_GRAD_MEANS2D, &b.g_means2d->buffer(), Access::kWrite}},
+              {PBWD_BINDING_GRAD_SH, &b.g_sh->buffer(), Access::kWrite}},
              view);
   return {&b.g_means->buffer(),  &b.g_log_scales->buffer(), &b.g_quats->buffer(),
-          &b.g_logits->buffer(), &b.g_sh->buffer(),         &b.g_means2d->buffer()};
+          &b.g_logits->buffer(), &b.g_sh->buffer(),         &b.grad2d->buffer()};
 }
 
 GaussianGrads<float> Rasterizer::download_grads() const {
@@ -521,7 +519,13 @@ GaussianGrads<float> Rasterizer::download_grads() const {
   out.quats = b.g_quats->download(0, 4 * n);
   out.opacity_logits = b.g_logits->download(0, n);
   out.sh = b.g_sh->download(0, n * K * channels_);
-  out.means2d = b.g_means2d->download(0, 2 * n);
+  const size_t stride = SPLAT_GRAD2D_FIXED + channels_;
+  const std::vector<float> rows = b.grad2d->download(0, n * stride);
+  out.means2d.resize(2 * n);
+  for (size_t i = 0; i < n; ++i) {
+    out.means2d[2 * i] = rows[i * stride];
+    out.means2d[2 * i + 1] = rows[i * stride + 1];
+  }
   return out;
 }
 

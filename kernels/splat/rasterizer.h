@@ -112,7 +112,9 @@ class Rasterizer {
     const engine::Buffer* quats;           // [N][4]
     const engine::Buffer* opacity_logits;  // [N]
     const engine::Buffer* sh;              // [N][K][C]
-    const engine::Buffer* means2d;         // [N][2]
+    // [N][SPLAT_GRAD2D_FIXED + C] the projected quantities' gradients; dL/d(mean2d) in columns 0 and 1
+    // (densification statistics read them there: no separate copy).
+    const engine::Buffer* grad2d;
   };
   // Records the backward from the upstream buffers into `sequence` (no submit), for a training step that
   // records loss kernels before it and the optimizer after it.

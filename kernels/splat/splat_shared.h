@@ -158,8 +158,7 @@ using uint = uint32_t;
 #define PBWD_BINDING_GRAD_QUATS 9            // [N][4] (out)
 #define PBWD_BINDING_GRAD_OPACITY_LOGITS 10  // [N] (out)
 #define PBWD_BINDING_GRAD_SH 11              // [N][K][C] (out)
-#define PBWD_BINDING_GRAD_MEANS2D 12         // [N][2] screen-space mean gradient, for densification (out)
-#define PBWD_BINDING_COUNT 13
+#define PBWD_BINDING_COUNT 12
 
 // The view: world-to-camera pose, pinhole intrinsics, image size. Push constants of every splat kernel.
 struct SplatView {
@@ -198,7 +197,7 @@ static_assert(RANGES_BINDING_COUNT == RANGES_BINDING_RANGES + 1);
 static_assert(FWD_BINDING_COUNT == FWD_BINDING_COUNTERS + 1);
 static_assert(BWD_BINDING_COUNT == BWD_BINDING_COUNTERS + 1);
 static_assert(REDUCE_BINDING_COUNT == REDUCE_BINDING_GRAD2D + 1);
-static_assert(PBWD_BINDING_COUNT == PBWD_BINDING_GRAD_MEANS2D + 1);
+static_assert(PBWD_BINDING_COUNT == PBWD_BINDING_GRAD_SH + 1);
 }  // namespace litgs::kernels
 #endif
 #endif

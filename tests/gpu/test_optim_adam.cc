@@ -155,9 +155,9 @@ TEST_F(AdamTest, TrainableModelStepsEveryGroupAtItsRate) {
         std::make_unique<DeviceArray<float>>(context(), "grad", group_values(grads_host, g).size()));
     grads.back()->upload(group_values(grads_host, g));
   }
-  DeviceArray<float> means2d(context(), "grad means2d", 2 * n);
+  DeviceArray<float> grad2d(context(), "grad2d", 8 * n);
   const Rasterizer::DeviceGrads device_grads{&grads[0]->buffer(), &grads[1]->buffer(), &grads[2]->buffer(),
-                                             &grads[3]->buffer(), &grads[4]->buffer(), &means2d.buffer()};
+                                             &grads[3]->buffer(), &grads[4]->buffer(), &grad2d.buffer()};
   const LearningRates lr{1e-3f, 2e-3f, 3e-3f, 4e-3f, 5e-3f, 6e-4f};
   const AdamOptions& o = trainable.adam_options();
   for (uint32_t step = 1; step <= 2; ++step) {

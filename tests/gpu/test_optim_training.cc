@@ -206,5 +206,29 @@ TEST_F(TrainingSmokeTest, NonFiniteRowsAreCountedSkippedAndPrunedWhileTheRestTra
   EXPECT_LT(got.losses.back(), 0.7 * got.losses[25]);
 }
 
+// A model made for the MCMC strategy keeps no densification statistics (12 bytes per Gaussian): they are not
+// among its row arrays, asking for them is a logic error, and its state reports them as zeros.
+TEST_F(TrainingSmokeTest, WithoutDensifyStatisticsTheModelHasNoStatisticArrays) {
+  const GaussianModel m = testing::random_scene(40, 1, 1, 7);
+  TrainableGaussians with(context(), m), without(context(), m, AdamOptions{}, false);
+  auto statistics = [](const TrainableGaussians& t) {
+    size_t k = 0;
+    for (const auto& a : t.row_arrays()) k += a.kind == TrainableGaussians::RowArray::kStatistic;
+    return k;
+  };
+  EXPECT_EQ(statistics(with), 3u);
+  EXPECT_EQ(statistics(without), 0u);
+  EXPECT_THROW(without.densify_and_prune(DensifyOptions{}, 1.0f, 1), std::logic_error);
+  without.grow_rows(m.size() + 5, 0);
+  const TrainingState st = without.download_state();
+  ASSERT_EQ(st.size(), m.size() + 5);
+  ASSERT_EQ(st.grad_accum.size(), st.size());
+  for (size_t i = 0; i < st.size(); ++i) {
+    EXPECT_EQ(st.grad_accum[i], 0.0f);
+    EXPECT_EQ(st.denom[i], 0u);
+    EXPECT_EQ(st.max_radius[i], 0.0f);
+  }
+}
+
 }  // namespace
 }  // namespace litgs::kernels
