@@ -13,7 +13,8 @@ layout(std430, binding = STATS_BINDING_MEANS) readonly buffer Means { float mean
 layout(std430, binding = STATS_BINDING_LOG_SCALES) readonly buffer LogScales { float log_scales[]; };
 layout(std430, binding = STATS_BINDING_QUATS) readonly buffer Quats { float quats[]; };
 layout(std430, binding = STATS_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
-layout(std430, binding = STATS_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 rects[]; };
+layout(std430, binding = STATS_BINDING_TILE_RECTS) readonly buffer Rects { uvec2 rects[]; };
+#include "splat/tile_rect.glsl"
 layout(std430, binding = STATS_BINDING_GRAD2D) readonly buffer Grad2d { float grad2d[]; };
 layout(std430, binding = STATS_BINDING_GRAD_ACCUM) buffer GradAccum { float grad_accum[]; };
 layout(std430, binding = STATS_BINDING_DENOM) buffer Denom { uint denom[]; };
@@ -22,7 +23,7 @@ layout(std430, binding = STATS_BINDING_MAX_RADIUS) buffer MaxRadius { float max_
 void main() {
   const uint i = elementwise_index();
   if (i >= view.count) return;
-  const uvec4 rect = rects[i];
+  const uvec4 rect = unpack_tile_rect(rects[i]);
   if (rect.z <= rect.x || rect.w <= rect.y) return;
   // 3DGS's viewspace gradient is w.r.t. NDC (its backward multiplies dL/dpixel by W/2 and H/2): the same
   // scaling here makes its threshold (0.0002) apply unchanged, independent of the image size.

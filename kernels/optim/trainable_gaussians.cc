@@ -181,7 +181,7 @@ void TrainableGaussians::record_accumulate_stats(engine::Sequence& sequence,
   const Slot& s = *current_;
   const uint64_t n = size();
   if (!grads.grad2d) throw std::invalid_argument("record_accumulate_stats: no screen-space gradient buffer");
-  check_binding(rects, 4 * n, 4, "densify stats: tile rects");
+  check_binding(rects, 2 * n, 4, "densify stats: tile rects");
   check_binding(*grads.grad2d, n * (SPLAT_GRAD2D_FIXED + channels_), 4,
                 "densify stats: screen-space gradients");
   const SplatView view =

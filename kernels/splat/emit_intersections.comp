@@ -7,7 +7,8 @@
 #include "splat/splat_shared.h"
 
 layout(std430, binding = EMIT_BINDING_ORDER) readonly buffer Order { uint order[]; };
-layout(std430, binding = EMIT_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 rects[]; };
+layout(std430, binding = EMIT_BINDING_TILE_RECTS) readonly buffer Rects { uvec2 rects[]; };
+#include "splat/tile_rect.glsl"
 layout(std430, binding = EMIT_BINDING_OFFSETS) readonly buffer Offsets { uint offsets[]; };
 layout(std430, binding = EMIT_BINDING_TILE_KEYS) writeonly buffer TileKeys { uint tile_keys[]; };
 layout(std430, binding = EMIT_BINDING_ISECT_IDS) writeonly buffer IsectIds { uint isect_ids[]; };
@@ -20,7 +21,7 @@ void main() {
   const uint s = elementwise_index();
   if (s >= view.count) return;
   const uint g = order[s];
-  const uvec4 r = rects[g];
+  const uvec4 r = unpack_tile_rect(rects[g]);
   uint e = offsets[s];
   for (uint ty = r.y; ty < r.w; ++ty)
     for (uint tx = r.x; tx < r.z; ++tx) {

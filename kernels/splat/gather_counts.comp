@@ -10,7 +10,8 @@
 #include "splat/splat_shared.h"
 
 layout(std430, binding = GATHER_BINDING_ORDER) readonly buffer Order { uint order[]; };
-layout(std430, binding = GATHER_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 rects[]; };
+layout(std430, binding = GATHER_BINDING_TILE_RECTS) readonly buffer Rects { uvec2 rects[]; };
+#include "splat/tile_rect.glsl"
 layout(std430, binding = GATHER_BINDING_COUNTS) writeonly buffer Counts { uint counts[]; };
 layout(std430, binding = GATHER_BINDING_CORNERS) buffer Corners { uint corners[]; };
 layout(std430, binding = GATHER_BINDING_COUNTERS) buffer Counters { uint counters[]; };
@@ -20,7 +21,7 @@ void main() {
   const uint s = elementwise_index();
   uint count = 0u;
   if (s < view.count) {
-    const uvec4 r = rects[order[s]];
+    const uvec4 r = unpack_tile_rect(rects[order[s]]);
     count = (r.z - r.x) * (r.w - r.y);
     counts[s] = count;
     if (count > 0u) {

@@ -18,7 +18,8 @@ layout(std430, binding = PROJECT_BINDING_CONICS) writeonly buffer Conics { float
 layout(std430, binding = PROJECT_BINDING_DEPTHS) writeonly buffer Depths { float depths[]; };
 layout(std430, binding = PROJECT_BINDING_OPACITIES) writeonly buffer Opacities { float opacities[]; };
 layout(std430, binding = PROJECT_BINDING_COLORS) writeonly buffer Colors { float colors[]; };
-layout(std430, binding = PROJECT_BINDING_TILE_RECTS) writeonly buffer Rects { uvec4 rects[]; };
+layout(std430, binding = PROJECT_BINDING_TILE_RECTS) writeonly buffer Rects { uvec2 rects[]; };
+#include "splat/tile_rect.glsl"
 layout(std430, binding = PROJECT_BINDING_DEPTH_KEYS) writeonly buffer DepthKeys { uint depth_keys[]; };
 layout(std430, binding = PROJECT_BINDING_ORDER) writeonly buffer Order { uint order[]; };
 layout(std430, binding = PROJECT_BINDING_COUNTERS) buffer Counters { uint counters[]; };
@@ -45,7 +46,7 @@ void main() {
     if (rect.x >= rect.z || rect.y >= rect.w) rect = uvec4(0u);
   }
   const bool kept = rect.z > rect.x;
-  rects[i] = rect;
+  rects[i] = pack_tile_rect(rect);
   order[i] = i;
   // Camera z >= near > 0: the bits of a positive float sort like the float. Culled Gaussians go last.
   depth_keys[i] = kept ? floatBitsToUint(pr.depth) : 0xFFFFFFFFu;

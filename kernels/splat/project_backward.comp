@@ -12,7 +12,8 @@ layout(std430, binding = PBWD_BINDING_LOG_SCALES) readonly buffer LogScales { fl
 layout(std430, binding = PBWD_BINDING_QUATS) readonly buffer Quats { float quats[]; };
 layout(std430, binding = PBWD_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
 layout(std430, binding = PBWD_BINDING_SH) readonly buffer Sh { float sh[]; };
-layout(std430, binding = PBWD_BINDING_TILE_RECTS) readonly buffer Rects { uvec4 rects[]; };
+layout(std430, binding = PBWD_BINDING_TILE_RECTS) readonly buffer Rects { uvec2 rects[]; };
+#include "splat/tile_rect.glsl"
 layout(std430, binding = PBWD_BINDING_GRAD2D) readonly buffer Grad2d { float grad2d[]; };
 layout(std430, binding = PBWD_BINDING_GRAD_MEANS) writeonly buffer GMeans { float g_means[]; };
 layout(std430, binding = PBWD_BINDING_GRAD_LOG_SCALES) writeonly buffer GLogScales { float g_log_scales[]; };
@@ -24,7 +25,7 @@ void main() {
   const uint i = elementwise_index();
   if (i >= view.count) return;
   const uint K = view.sh_coeffs;
-  const uvec4 r = rects[i];
+  const uvec4 r = unpack_tile_rect(rects[i]);
   if (r.z <= r.x) {  // culled: no gradient
     for (uint a = 0u; a < 3u; ++a) {
       g_means[3 * i + a] = 0.0;

@@ -268,7 +268,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   grow(ctx, b.depths, n, "splat: depths");
   grow(ctx, b.opacities, n, "splat: opacities");
   grow(ctx, b.colors, size_t{n} * channels_, "splat: colors");
-  grow(ctx, b.rects, 4 * size_t{n}, "splat: tile rects");
+  grow(ctx, b.rects, 2 * size_t{n}, "splat: tile rects");  // packed 16-bit (splat/tile_rect.glsl)
   grow(ctx, b.depth_keys, n, "splat: depth keys");
   grow(ctx, b.order, n, "splat: depth order");
   grow(ctx, b.counts, n, "splat: tile counts");

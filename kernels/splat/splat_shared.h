@@ -39,7 +39,7 @@ using uint = uint32_t;
 #define PROJECT_BINDING_DEPTHS 7          // [N] camera z (out)
 #define PROJECT_BINDING_OPACITIES 8       // [N] sigmoid(logit) (out)
 #define PROJECT_BINDING_COLORS 9          // [N][C] (out)
-#define PROJECT_BINDING_TILE_RECTS 10     // [N][4] tile x0 y0 x1 y1, half-open; empty if culled (out)
+#define PROJECT_BINDING_TILE_RECTS 10     // [N][2] tile x0 y0 x1 y1, half-open, 16 bits each (tile_rect.glsl); empty if culled (out)
 #define PROJECT_BINDING_DEPTH_KEYS 11     // [N] sortable depth bits, 0xFFFFFFFF if culled (out)
 #define PROJECT_BINDING_ORDER 12          // [N] identity permutation, the depth sort's values (out)
 #define PROJECT_BINDING_COUNTERS 13       // [SPLAT_COUNTER_COUNT] uint, see SPLAT_COUNTER_*
@@ -65,7 +65,7 @@ using uint = uint32_t;
 
 // ---- gather_counts.comp: one invocation per depth-sorted position ----
 #define GATHER_BINDING_ORDER 0       // [N] Gaussian index by depth rank
-#define GATHER_BINDING_TILE_RECTS 1  // [N][4]
+#define GATHER_BINDING_TILE_RECTS 1  // [N][2] packed (tile_rect.glsl)
 #define GATHER_BINDING_COUNTS 2      // [N] tiles touched, in depth order (out)
 #define GATHER_BINDING_CORNERS \
   3                                // [(tiles_y + 1) * (tiles_x + 1)] uint, zeroed before: each
@@ -81,7 +81,7 @@ using uint = uint32_t;
 
 // ---- emit_intersections.comp: one invocation per depth-sorted position ----
 #define EMIT_BINDING_ORDER 0           // [N]
-#define EMIT_BINDING_TILE_RECTS 1      // [N][4]
+#define EMIT_BINDING_TILE_RECTS 1      // [N][2] packed (tile_rect.glsl)
 #define EMIT_BINDING_OFFSETS 2         // [N] exclusive scan of the counts
 #define EMIT_BINDING_TILE_KEYS 3       // [M] tile id (out)
 #define EMIT_BINDING_ISECT_IDS 4       // [M] intersection id = its emission position (out)

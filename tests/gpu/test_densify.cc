@@ -398,10 +398,12 @@ TEST_F(DensifyTest, AccumulatesScreenGradientVisibilityAndRadius) {
     t.record_accumulate_stats(s, grads, *raster.device_outputs().rects, camera);
     s.submit_and_wait();
     const GaussianGrads<float> g = raster.download_grads();
-    std::vector<uint32_t> rects(4 * model.size());
+    std::vector<uint32_t> rects(2 * model.size());  // packed: x0 | y0 << 16, x1 | y1 << 16
     raster.device_outputs().rects->download(rects.data(), rects.size() * 4);
     for (size_t i = 0; i < model.size(); ++i) {
-      if (rects[4 * i + 2] <= rects[4 * i] || rects[4 * i + 3] <= rects[4 * i + 1]) continue;
+      const uint32_t x0 = rects[2 * i] & 0xffffu, y0 = rects[2 * i] >> 16, x1 = rects[2 * i + 1] & 0xffffu,
+                     y1 = rects[2 * i + 1] >> 16;
+      if (x1 <= x0 || y1 <= y0) continue;
       accum[i] += std::hypot(g.means2d[2 * i] * 48.0, g.means2d[2 * i + 1] * 40.0);
       ++denom[i];
     }
