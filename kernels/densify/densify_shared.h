@@ -23,11 +23,11 @@ using uint = uint32_t;
 #define STATS_BINDING_LOG_SCALES 1      // [N][3]
 #define STATS_BINDING_QUATS 2           // [N][4]
 #define STATS_BINDING_OPACITY_LOGITS 3  // [N]
-#define STATS_BINDING_TILE_RECTS 4      // [N][2] uint, the rasterizer's, packed; empty (x1 <= x0): not visible
-#define STATS_BINDING_GRAD2D 5          // [N][SPLAT_GRAD2D_FIXED + C] the rasterizer's; dL/d(pixel) in 0, 1
-#define STATS_BINDING_GRAD_ACCUM 6      // [N] float += |(dL/du W/2, dL/dv H/2)| where visible
-#define STATS_BINDING_DENOM 7           // [N] uint += 1 where visible
-#define STATS_BINDING_MAX_RADIUS 8      // [N] float = max(., max(extent.x, extent.y)) pixels where visible
+#define STATS_BINDING_TILE_RECTS 4  // [N][2] uint, the rasterizer's, packed; empty (x1 <= x0): not visible
+#define STATS_BINDING_GRAD2D 5      // [N][SPLAT_GRAD2D_FIXED + C] the rasterizer's; dL/d(pixel) in 0, 1
+#define STATS_BINDING_GRAD_ACCUM 6  // [N] float += |(dL/du W/2, dL/dv H/2)| where visible
+#define STATS_BINDING_DENOM 7       // [N] uint += 1 where visible
+#define STATS_BINDING_MAX_RADIUS 8  // [N] float = max(., max(extent.x, extent.y)) pixels where visible
 #define STATS_BINDING_COUNT 9
 
 // ---- densify_candidates.comp and densify_decide.comp (push constants: DensifyParams) ----

@@ -39,10 +39,11 @@ using uint = uint32_t;
 #define PROJECT_BINDING_DEPTHS 7          // [N] camera z (out)
 #define PROJECT_BINDING_OPACITIES 8       // [N] sigmoid(logit) (out)
 #define PROJECT_BINDING_COLORS 9          // [N][C] (out)
-#define PROJECT_BINDING_TILE_RECTS 10     // [N][2] tile x0 y0 x1 y1, half-open, 16 bits each (tile_rect.glsl); empty if culled (out)
-#define PROJECT_BINDING_DEPTH_KEYS 11     // [N] sortable depth bits, 0xFFFFFFFF if culled (out)
-#define PROJECT_BINDING_ORDER 12          // [N] identity permutation, the depth sort's values (out)
-#define PROJECT_BINDING_COUNTERS 13       // [SPLAT_COUNTER_COUNT] uint, see SPLAT_COUNTER_*
+#define PROJECT_BINDING_TILE_RECTS \
+  10  // [N][2] tile x0 y0 x1 y1, half-open, 16 bits each (tile_rect.glsl); empty if culled (out)
+#define PROJECT_BINDING_DEPTH_KEYS 11  // [N] sortable depth bits, 0xFFFFFFFF if culled (out)
+#define PROJECT_BINDING_ORDER 12       // [N] identity permutation, the depth sort's values (out)
+#define PROJECT_BINDING_COUNTERS 13    // [SPLAT_COUNTER_COUNT] uint, see SPLAT_COUNTER_*
 #define PROJECT_BINDING_COUNT 14
 
 // ---- The rasterizer's counters buffer: [SPLAT_COUNTER_COUNT] uint ----
