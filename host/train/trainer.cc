@@ -39,13 +39,20 @@ struct RunStart {
   std::vector<float> level_state;  // the checkpoint's (empty: identity, or no level model)
 };
 
+// The model on the device; only ADC reads the densification statistics, so MCMC does not keep them.
+std::unique_ptr<kernels::TrainableGaussians> trainable_model(engine::Context& ctx,
+                                                             const kernels::TrainingState& state,
+                                                             const TrainOptions& o) {
+  return std::make_unique<kernels::TrainableGaussians>(ctx, state, kernels::AdamOptions{},
+                                                       o.strategy == "adc");
+}
+
 RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, const TrainOptions& o,
                    const fs::path& out_dir, const nlohmann::json& options, ViewSampler& sampler,
                    const std::function<void(const std::string&)>& notice) {
   RunStart s;
   if (!o.resume) {
-    s.model = std::make_unique<kernels::TrainableGaussians>(ctx, initial, kernels::AdamOptions{},
-                                                            o.strategy == "adc");
+    s.model = trainable_model(ctx, kernels::TrainingState::fresh(initial), o);
     s.record.options = options;
     return s;
   }
@@ -74,8 +81,7 @@ RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, 
   }
   notice("resume: from " + ckpt.string() + " (iteration " + std::to_string(c.iteration) + " of " +
          std::to_string(o.iterations) + ")");
-  s.model = std::make_unique<kernels::TrainableGaussians>(ctx, c.state, kernels::AdamOptions{},
-                                                          o.strategy == "adc");
+  s.model = trainable_model(ctx, c.state, o);
   s.iteration = c.iteration;
   s.level_state = std::move(c.level_state);
   s.record = std::move(c.record);

@@ -202,12 +202,12 @@ void TrainableGaussians::record_accumulate_stats(engine::Sequence& sequence,
 
 DensifyReport TrainableGaussians::densify_and_prune(const DensifyOptions& options, float scene_extent,
                                                     uint32_t step, const engine::Buffer* plane_distance) {
+  require_statistics("densify_and_prune");
   engine::Context& ctx = *context_;
   const uint32_t n = static_cast<uint32_t>(size());
   const uint32_t sv = sh_values();
   const DensifyParams params =
       make_densify_params(options, scene_extent, step, n, sv, plane_distance != nullptr);
-  require_statistics("densify_and_prune");
   DensifyReport report;
   report.before = n;
   if (n == 0) return report;

@@ -92,8 +92,8 @@ class Rasterizer {
     const engine::Buffer* image;  // [C][H][W]
     const engine::Buffer* depth;  // [H][W]
     const engine::Buffer* alpha;  // [H][W]
-    const engine::Buffer*
-        rects;  // [N][2] uint tile rectangles, packed (splat/tile_rect.glsl); empty (x1 <= x0) when culled
+    // [N][2] uint tile rectangles, packed (splat/tile_rect.glsl); empty (x1 <= x0) when culled
+    const engine::Buffer* rects;
     // [SPLAT_COUNTER_COUNT] uint (splat_shared.h, SPLAT_COUNTER_*): the last forward's culls, and the running
     // totals of walks cut short, for a copy inside a training step's submit.
     const engine::Buffer* counters;
