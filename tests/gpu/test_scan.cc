@@ -1,6 +1,7 @@
 // Exclusive scan on the device against a CPU scan: sizes 0, 1, subgroup +-1, block +-1, multi-level.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -60,7 +61,9 @@ TEST_F(ScanTest, MultiLevelWithSmallBlocks) {
   kernels::ScanOptions options;
   options.block_size = 2 * s;
   kernels::ExclusiveScan probe(context(), options);
-  const size_t n = 100003;
+  // Three levels need more than block^3 elements: 4,096 with lavapipe's 8 lanes, 262,144 with 32 lanes.
+  const size_t block = options.block_size;
+  const size_t n = std::max<size_t>(100003, block * block * block + 3 * block + 1);
   EXPECT_GE(probe.levels(static_cast<uint32_t>(n)), 3u) << "the test should exercise several levels";
   const auto input = random_values(n, 7, 3);
   EXPECT_EQ(device_scan(input, options), cpu_exclusive_scan(input));
