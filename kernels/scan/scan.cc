@@ -28,7 +28,12 @@ ExclusiveScan::ExclusiveScan(engine::Context& context, ScanOptions options)
     : context_(&context), unused_offsets_(context, "scan: unused offsets", 1) {
   const uint32_t width = subgroup_width(context);
   options.check(width);
-  block_size_ = options.block_size != 0 ? options.block_size : width * 256;
+  // A block is walked serially by one subgroup. A CPU device runs each workgroup on one thread, so long
+  // blocks (few dispatches) suit it; a GPU waits on each batch's load in turn, so it takes shorter blocks
+  // and many more workgroups (on an H200, 32 batches instead of 256 took the scans of a 100k-Gaussian
+  // render from 0.92 to 0.21 ms).
+  const uint32_t batches = context.info().type == "cpu" ? 256u : 32u;
+  block_size_ = options.block_size != 0 ? options.block_size : width * batches;
   reduce_ = make_subgroup_kernel(context, "scan/scan_reduce", SCAN_REDUCE_BINDING_COUNT, sizeof(ScanParams));
   downsweep_ =
       make_subgroup_kernel(context, "scan/scan_downsweep", SCAN_DOWNSWEEP_BINDING_COUNT, sizeof(ScanParams));

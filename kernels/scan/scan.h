@@ -13,7 +13,8 @@
 namespace litgs::kernels {
 
 struct ScanOptions {
-  // Elements per workgroup; a multiple of the subgroup size. 0: 256 subgroup-wide batches.
+  // Elements per workgroup; a multiple of the subgroup size. 0: 256 subgroup-wide batches on a CPU device,
+  // 32 on a GPU.
   uint32_t block_size = 0;
   // Throws std::invalid_argument naming the bad field.
   void check(uint32_t subgroup_size) const;
