@@ -14,7 +14,7 @@ constexpr uint32_t kSetsPerPool = 128;
 // Descriptor pools are sized for this many bindings per set (lavapipe allows 32 storage buffers per stage).
 constexpr uint32_t kMaxBindingsPerKernel = 32;
 constexpr uint32_t kQueriesPerPool = 512;  // 256 dispatches
-constexpr int kFencePollMs = 20;            // longer submits block (see wait_for_fence)
+constexpr int kFencePollMs = 20;           // longer submits block (see wait_for_fence)
 
 bool reads(Access a) {
   return a != Access::kWrite;
