@@ -368,6 +368,7 @@ Context::Context(const ContextOptions& options) : validation_(options.validation
     pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     pool_info.queueFamilyIndex = queue_family_;
     LITGS_VK_CHECK(vkCreateCommandPool(device_, &pool_info, nullptr, &command_pool_));
+    sequence_pools_ = std::make_unique<SequencePools>(device_, command_pool_);
     VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
     LITGS_VK_CHECK(vkCreateFence(device_, &fence_info, nullptr, &one_off_fence_));
   } catch (...) {
@@ -383,6 +384,7 @@ Context::~Context() {
 void Context::release() {
   if (device_) {
     vkDeviceWaitIdle(device_);
+    sequence_pools_.reset();
     if (one_off_fence_) vkDestroyFence(device_, one_off_fence_, nullptr);
     if (command_pool_) vkDestroyCommandPool(device_, command_pool_, nullptr);
     vkDestroyDevice(device_, nullptr);

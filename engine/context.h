@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "engine/sequence_pools.h"
+
 namespace litgs::engine {
 
 struct ContextOptions {
@@ -74,6 +76,7 @@ class Context {
   VkQueue queue() const { return queue_; }
   uint32_t queue_family() const { return queue_family_; }
   VkCommandPool command_pool() const { return command_pool_; }
+  SequencePools& sequence_pools() { return *sequence_pools_; }
 
   // A memory type index with all `required` flags, preferring one that also has `preferred`.
   uint32_t find_memory_type(uint32_t type_bits, VkMemoryPropertyFlags required,
@@ -119,6 +122,7 @@ class Context {
   uint32_t queue_family_ = 0;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkFence one_off_fence_ = VK_NULL_HANDLE;
+  std::unique_ptr<SequencePools> sequence_pools_;
 
   bool validation_ = false;
   mutable std::mutex messages_mutex_;

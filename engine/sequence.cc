@@ -27,16 +27,23 @@ bool writes(Access a) {
 
 Sequence::Sequence(Context& context, bool timestamps)
     : context_(&context), timestamps_(timestamps && context.info().timestamps) {
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = context.command_pool();
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  LITGS_VK_CHECK(vkAllocateCommandBuffers(context.device(), &ai, &cmd_));
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  const VkResult r = vkCreateFence(context.device(), &fci, nullptr, &fence_);
-  if (r != VK_SUCCESS) {
-    release();
-    LITGS_VK_CHECK(r);
+  SequencePools& kept = context.sequence_pools();
+  cmd_ = kept.take_command_buffer();
+  if (!cmd_) {
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = context.command_pool();
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    LITGS_VK_CHECK(vkAllocateCommandBuffers(context.device(), &ai, &cmd_));
+  }
+  fence_ = kept.take_fence();
+  if (!fence_) {
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    const VkResult r = vkCreateFence(context.device(), &fci, nullptr, &fence_);
+    if (r != VK_SUCCESS) {
+      release();
+      LITGS_VK_CHECK(r);
+    }
   }
 }
 
@@ -44,12 +51,13 @@ Sequence::~Sequence() {
   release();
 }
 
+// Everything goes back to the context's SequencePools for the next sequence.
 void Sequence::release() {
-  VkDevice dev = context_->device();
-  if (fence_) vkDestroyFence(dev, fence_, nullptr);
-  if (cmd_) vkFreeCommandBuffers(dev, context_->command_pool(), 1, &cmd_);
-  for (VkDescriptorPool p : pools_) vkDestroyDescriptorPool(dev, p, nullptr);
-  for (VkQueryPool q : query_pools_) vkDestroyQueryPool(dev, q, nullptr);
+  SequencePools& kept = context_->sequence_pools();
+  if (fence_) kept.give_back(fence_);
+  if (cmd_) kept.give_back(cmd_);
+  for (VkDescriptorPool p : pools_) kept.give_back(p);
+  for (VkQueryPool q : query_pools_) kept.give_back(q);
   fence_ = VK_NULL_HANDLE;
   cmd_ = VK_NULL_HANDLE;
   pools_.clear();
@@ -58,8 +66,7 @@ void Sequence::release() {
 
 void Sequence::reset() {
   LITGS_VK_CHECK(vkResetCommandBuffer(cmd_, 0));
-  VkDevice dev = context_->device();
-  for (VkDescriptorPool p : pools_) vkDestroyDescriptorPool(dev, p, nullptr);
+  for (VkDescriptorPool p : pools_) context_->sequence_pools().give_back(p);
   pools_.clear();
   sets_in_last_pool_ = 0;
   dispatch_names_.clear();
@@ -110,13 +117,15 @@ void Sequence::track(const Buffer* buffer, Access access) {
 VkDescriptorSet Sequence::allocate_set(const Kernel& kernel) {
   VkDevice dev = context_->device();
   if (pools_.empty() || sets_in_last_pool_ == kSetsPerPool) {
-    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSetsPerPool * kMaxBindingsPerKernel};
-    VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    pci.maxSets = kSetsPerPool;
-    pci.poolSizeCount = 1;
-    pci.pPoolSizes = &size;
-    VkDescriptorPool pool = VK_NULL_HANDLE;
-    LITGS_VK_CHECK(vkCreateDescriptorPool(dev, &pci, nullptr, &pool));
+    VkDescriptorPool pool = context_->sequence_pools().take_descriptor_pool();
+    if (!pool) {
+      VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSetsPerPool * kMaxBindingsPerKernel};
+      VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+      pci.maxSets = kSetsPerPool;
+      pci.poolSizeCount = 1;
+      pci.pPoolSizes = &size;
+      LITGS_VK_CHECK(vkCreateDescriptorPool(dev, &pci, nullptr, &pool));
+    }
     pools_.push_back(pool);
     sets_in_last_pool_ = 0;
   }
@@ -187,11 +196,13 @@ void Sequence::dispatch_raw(const Kernel& kernel, Groups groups, std::initialize
   VkQueryPool qpool = VK_NULL_HANDLE;
   if (timestamps_) {
     if (query / kQueriesPerPool >= query_pools_.size()) {
-      VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-      qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
-      qci.queryCount = kQueriesPerPool;
-      VkQueryPool pool = VK_NULL_HANDLE;
-      LITGS_VK_CHECK(vkCreateQueryPool(context_->device(), &qci, nullptr, &pool));
+      VkQueryPool pool = context_->sequence_pools().take_query_pool();
+      if (!pool) {
+        VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+        qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+        qci.queryCount = kQueriesPerPool;
+        LITGS_VK_CHECK(vkCreateQueryPool(context_->device(), &qci, nullptr, &pool));
+      }
       query_pools_.push_back(pool);
     }
     qpool = query_pools_[query / kQueriesPerPool];

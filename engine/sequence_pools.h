@@ -1,0 +1,42 @@
+// Vulkan objects a Sequence needs for one recording (command buffer, fence, descriptor pools, timestamp
+// query pools), kept for the next Sequence instead of being destroyed. Creating them takes the driver into
+// the kernel on a GPU, and a training iteration records three sequences.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <mutex>
+#include <vector>
+
+namespace litgs::engine {
+
+class SequencePools {
+ public:
+  SequencePools(VkDevice device, VkCommandPool command_pool);
+  ~SequencePools();  // destroys what it holds; the device must be idle
+  SequencePools(const SequencePools&) = delete;
+  SequencePools& operator=(const SequencePools&) = delete;
+
+  // Each take_* returns a kept object, or VK_NULL_HANDLE when none is kept (the caller creates one).
+  VkCommandBuffer take_command_buffer();
+  VkFence take_fence();  // unsignalled
+  VkDescriptorPool take_descriptor_pool();
+  VkQueryPool take_query_pool();
+
+  // Each give_back resets the object for its next use (never throws); it must not be in use on the device.
+  void give_back(VkCommandBuffer cmd) noexcept;
+  void give_back(VkFence fence) noexcept;
+  void give_back(VkDescriptorPool pool) noexcept;
+  void give_back(VkQueryPool pool) noexcept;
+
+ private:
+  VkDevice device_;
+  VkCommandPool command_pool_;
+  std::mutex mutex_;
+  std::vector<VkCommandBuffer> command_buffers_;
+  std::vector<VkFence> fences_;
+  std::vector<VkDescriptorPool> descriptor_pools_;
+  std::vector<VkQueryPool> query_pools_;
+};
+
+}  // namespace litgs::engine
