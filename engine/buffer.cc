@@ -100,7 +100,7 @@ Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKi
         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
     // Device-local memory that is also host-visible (CPU drivers, resizable BAR) is mapped: no staging.
     const uint32_t type =
-        kind == MemoryKind::kDeviceLocal
+        kind != MemoryKind::kHostVisible
             ? context.find_memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, host)
             : context.find_memory_type(req.memoryTypeBits, host, VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
     VkMemoryAllocateInfo ai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
@@ -114,7 +114,7 @@ Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKi
     allocated_bytes_ = req.size;
     count_allocation(memory_, name_, allocated_bytes_);
     LITGS_VK_CHECK(vkBindBufferMemory(dev, buffer_, memory_, 0));
-    if ((context.memory_type_flags(type) & host) == host)
+    if (kind != MemoryKind::kDeviceOnly && (context.memory_type_flags(type) & host) == host)
       LITGS_VK_CHECK(vkMapMemory(dev, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_));
   } catch (...) {
     release();
@@ -176,12 +176,16 @@ void Buffer::upload(const void* data, uint64_t bytes, uint64_t offset) {
     std::memcpy(static_cast<char*>(mapped_) + offset, data, bytes);
     return;
   }
+  const auto through = [&](Buffer& staging) {
+    std::memcpy(staging.mapped_, data, bytes);
+    context_->run_once([&](VkCommandBuffer cmd) {
+      VkBufferCopy region{0, offset, bytes};
+      vkCmdCopyBuffer(cmd, staging.handle(), buffer_, 1, &region);
+    });
+  };
+  if (bytes <= Context::kKeptStagingBytes) return context_->with_kept_staging(bytes, through);
   Buffer staging(*context_, name_ + " (staging)", bytes, MemoryKind::kHostVisible);
-  std::memcpy(staging.mapped_, data, bytes);
-  context_->run_once([&](VkCommandBuffer cmd) {
-    VkBufferCopy region{0, offset, bytes};
-    vkCmdCopyBuffer(cmd, staging.handle(), buffer_, 1, &region);
-  });
+  through(staging);
 }
 
 void Buffer::download(void* data, uint64_t bytes, uint64_t offset) const {
@@ -191,12 +195,16 @@ void Buffer::download(void* data, uint64_t bytes, uint64_t offset) const {
     std::memcpy(data, static_cast<const char*>(mapped_) + offset, bytes);
     return;
   }
+  const auto through = [&](Buffer& staging) {
+    context_->run_once([&](VkCommandBuffer cmd) {
+      VkBufferCopy region{offset, 0, bytes};
+      vkCmdCopyBuffer(cmd, buffer_, staging.handle(), 1, &region);
+    });
+    std::memcpy(data, staging.mapped_, bytes);
+  };
+  if (bytes <= Context::kKeptStagingBytes) return context_->with_kept_staging(bytes, through);
   Buffer staging(*context_, name_ + " (readback)", bytes, MemoryKind::kHostVisible);
-  context_->run_once([&](VkCommandBuffer cmd) {
-    VkBufferCopy region{offset, 0, bytes};
-    vkCmdCopyBuffer(cmd, buffer_, staging.handle(), 1, &region);
-  });
-  std::memcpy(data, staging.mapped_, bytes);
+  through(staging);
 }
 
 }  // namespace litgs::engine

@@ -18,6 +18,8 @@ class Context;
 enum class MemoryKind {
   kDeviceLocal,  // fastest for kernels; up/downloads go through a staging buffer unless it is host-visible
   kHostVisible,  // host-coherent, mapped: staging and readback
+  kDeviceOnly,   // device-local and never mapped, even where it could be: up/downloads always go through
+                 // staging (as they do on a discrete GPU; tests use it to run that path on lavapipe)
 };
 
 // One VkBuffer with its own memory, usable as a storage buffer and as a transfer source and destination.

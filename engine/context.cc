@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
 
+#include "engine/buffer.h"
 #include "engine/vk_check.h"
 
 namespace litgs::engine {
@@ -384,6 +386,7 @@ Context::~Context() {
 void Context::release() {
   if (device_) {
     vkDeviceWaitIdle(device_);
+    staging_.reset();
     sequence_pools_.reset();
     if (one_off_fence_) vkDestroyFence(device_, one_off_fence_, nullptr);
     if (command_pool_) vkDestroyCommandPool(device_, command_pool_, nullptr);
@@ -426,31 +429,67 @@ VkMemoryPropertyFlags Context::memory_type_flags(uint32_t type_index) const {
 }
 
 VkCommandBuffer Context::begin_one_off() {
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = command_pool_;
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  LITGS_VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cmd));
+  VkCommandBuffer cmd = sequence_pools_->take_command_buffer();
+  if (!cmd) {
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = command_pool_;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    LITGS_VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cmd));
+  }
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  LITGS_VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+  const VkResult r = vkBeginCommandBuffer(cmd, &bi);
+  if (r != VK_SUCCESS) {
+    sequence_pools_->give_back(cmd);
+    LITGS_VK_CHECK(r);
+  }
   return cmd;
 }
 
 void Context::end_one_off(VkCommandBuffer cmd) {
-  struct Free {
-    Context* c;
+  struct GiveBack {
+    SequencePools* pools;
     VkCommandBuffer cmd;
-    ~Free() { vkFreeCommandBuffers(c->device_, c->command_pool_, 1, &cmd); }
-  } free_on_exit{this, cmd};
+    ~GiveBack() { pools->give_back(cmd); }
+  } give_back_on_exit{sequence_pools_.get(), cmd};
   LITGS_VK_CHECK(vkEndCommandBuffer(cmd));
   VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   si.commandBufferCount = 1;
   si.pCommandBuffers = &cmd;
   LITGS_VK_CHECK(vkResetFences(device_, 1, &one_off_fence_));
   LITGS_VK_CHECK(vkQueueSubmit(queue_, 1, &si, one_off_fence_));
-  LITGS_VK_CHECK(vkWaitForFences(device_, 1, &one_off_fence_, VK_TRUE, UINT64_MAX));
+  wait_for_fence(one_off_fence_);
+}
+
+void Context::wait_for_fence(VkFence fence) {
+  if (info_.type != "cpu") {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
+    do {
+      const VkResult r = vkGetFenceStatus(device_, fence);
+      if (r == VK_SUCCESS) return;
+      if (r != VK_NOT_READY) LITGS_VK_CHECK(r);
+    } while (std::chrono::steady_clock::now() < give_up);
+  }
+  LITGS_VK_CHECK(vkWaitForFences(device_, 1, &fence, VK_TRUE, UINT64_MAX));
+}
+
+uint64_t Context::kept_staging_bytes() {
+  std::lock_guard<std::mutex> lock(staging_mutex_);
+  return staging_ ? staging_->size_bytes() : 0;
+}
+
+Buffer& Context::kept_staging(uint64_t bytes) {
+  if (bytes > kKeptStagingBytes)
+    throw std::logic_error("Context::kept_staging: " + std::to_string(bytes) + " bytes exceed the kept " +
+                           std::to_string(kKeptStagingBytes));
+  if (!staging_ || staging_->size_bytes() < bytes) {
+    staging_.reset();  // before allocating the larger one
+    // Grown in steps of 1 MiB so that a few sizes cover every render.
+    const uint64_t rounded = (bytes + (1ull << 20) - 1) & ~((1ull << 20) - 1);
+    staging_ = std::make_unique<Buffer>(*this, "context: kept staging", rounded, MemoryKind::kHostVisible);
+  }
+  return *staging_;
 }
 
 void Context::record_validation_message(bool is_error, const std::string& message) {

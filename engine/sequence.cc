@@ -1,7 +1,6 @@
 #include "engine/sequence.h"
 
 #include <algorithm>
-#include <chrono>
 #include <stdexcept>
 
 #include "engine/context.h"
@@ -14,7 +13,6 @@ constexpr uint32_t kSetsPerPool = 128;
 // Descriptor pools are sized for this many bindings per set (lavapipe allows 32 storage buffers per stage).
 constexpr uint32_t kMaxBindingsPerKernel = 32;
 constexpr uint32_t kQueriesPerPool = 512;  // 256 dispatches
-constexpr int kFencePollMs = 20;           // longer submits block (see wait_for_fence)
 
 bool reads(Access a) {
   return a != Access::kWrite;
@@ -258,7 +256,7 @@ void Sequence::submit_and_wait() {
   si.pCommandBuffers = &cmd_;
   LITGS_VK_CHECK(vkResetFences(context_->device(), 1, &fence_));
   LITGS_VK_CHECK(vkQueueSubmit(context_->queue(), 1, &si, fence_));
-  wait_for_fence();
+  context_->wait_for_fence(fence_);
 
   ticks_.assign(dispatch_names_.size() * 2, 0);
   if (timestamps_) {
@@ -269,22 +267,6 @@ void Sequence::submit_and_wait() {
                                            VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
     }
   }
-}
-
-void Sequence::wait_for_fence() {
-  VkDevice dev = context_->device();
-  // A blocking wait on a GPU returns only when the driver's interrupt wakes this thread, which cost about
-  // 0.9 ms per submit on an H200 in a VM; polling for a while first avoids it. A CPU device (lavapipe)
-  // needs every core for the work itself, so there the thread blocks at once.
-  if (context_->info().type != "cpu") {
-    const auto give_up = std::chrono::steady_clock::now() + std::chrono::milliseconds(kFencePollMs);
-    do {
-      const VkResult r = vkGetFenceStatus(dev, fence_);
-      if (r == VK_SUCCESS) return;
-      if (r != VK_NOT_READY) LITGS_VK_CHECK(r);
-    } while (std::chrono::steady_clock::now() < give_up);
-  }
-  LITGS_VK_CHECK(vkWaitForFences(dev, 1, &fence_, VK_TRUE, UINT64_MAX));
 }
 
 std::vector<KernelTime> Sequence::profile() const {

@@ -79,7 +79,6 @@ class Sequence {
   void before_command(const std::vector<std::pair<const Buffer*, Access>>& accesses);
   void track(const Buffer* buffer, Access access);
   VkDescriptorSet allocate_set(const Kernel& kernel);
-  void wait_for_fence();
   void release();
 
   Context* context_;

@@ -45,6 +45,25 @@ TEST_F(EngineTest, HostVisibleBufferRoundTrips) {
   EXPECT_EQ(device.download(), data);
 }
 
+// Transfers to memory the host cannot map go through staging: the context's kept staging buffer up to
+// kKeptStagingBytes (reused, grown when needed), a temporary one beyond. Both directions, at offsets, and
+// sizes on either side of the limit.
+TEST_F(EngineTest, UnmappedBuffersRoundTripThroughKeptAndTemporaryStaging) {
+  const size_t kept_floats = engine::Context::kKeptStagingBytes / sizeof(float);
+  for (size_t n : {size_t{3}, size_t{300000}, kept_floats, kept_floats + 1}) {
+    std::vector<float> data(n);
+    for (size_t i = 0; i < n; ++i) data[i] = static_cast<float>(i % 1000) * 0.5f - 7.0f;
+    engine::DeviceArray<float> device(context(), "device only", n, engine::MemoryKind::kDeviceOnly);
+    device.upload(data);
+    EXPECT_EQ(device.download(), data) << n << " floats";
+    if (n > 2) {
+      EXPECT_EQ(device.download(1, 2), std::vector<float>(data.begin() + 1, data.begin() + 3));
+    }
+  }
+  EXPECT_EQ(context().kept_staging_bytes(), engine::Context::kKeptStagingBytes)
+      << "the kept staging buffer grows to the largest transfer within the limit and stays";
+}
+
 TEST_F(EngineTest, EmptyBufferIsValid) {
   engine::DeviceArray<uint32_t> empty(context(), "empty", 0);
   EXPECT_EQ(empty.size(), 0u);
