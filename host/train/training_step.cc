@@ -108,7 +108,8 @@ void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy
       model.adam_options().rates(it, o.iterations, static_cast<float>(data_->scene_extent_m));
   for (float* r : {&lr.means, &lr.log_scales, &lr.quats, &lr.opacity_logits, &lr.sh_dc, &lr.sh_rest})
     *r *= o.lr_scale;
-  model.record_adam_step(s, grads, lr, step);
+  const kernels::TrainableGaussians::ShFromColour sh_from_colour{out.rects, cam};
+  model.record_adam_step(s, grads, lr, step, &sh_from_colour);
   if (mcmc) mcmc->record_noise(s, model, mcmc_options_, lr.means, step);
   s.submit_and_wait();
   for (const auto& k : s.profile()) times[k.name] += k.ms;

@@ -62,6 +62,24 @@ void check_binding(const engine::Buffer& buffer, uint64_t count, uint64_t value_
                             std::to_string(count));
 }
 
+AdamParams adam_params(const AdamOptions& options, uint32_t step, float lr, float lr_rest, uint32_t count,
+                       uint32_t period, uint32_t lead, uint32_t counter_slot) {
+  AdamParams p{};
+  p.count = count;
+  p.period = period;
+  p.lead = lead;
+  p.counter_slot = counter_slot;
+  p.lr = lr;
+  p.lr_rest = lr_rest;
+  p.beta1 = options.beta1;
+  p.beta2 = options.beta2;
+  p.eps = options.eps;
+  p.bias_correction1 = static_cast<float>(1.0 - std::pow(double{options.beta1}, double(step)));
+  p.sqrt_bias_correction2 =
+      static_cast<float>(std::sqrt(1.0 - std::pow(double{options.beta2}, double(step))));
+  return p;
+}
+
 AdamKernel::AdamKernel(engine::Context& context) : context_(&context) {
   engine::KernelDesc desc;
   desc.name = "optim/adam";
@@ -86,19 +104,8 @@ void AdamKernel::record(engine::Sequence& sequence, const Target& t, uint64_t co
   check_binding(*t.exp_avg, count, 4, "adam exp_avg");
   check_binding(*t.exp_avg_sq, count, 4, "adam exp_avg_sq");
   check_binding(*t.counters, ADAM_COUNTER_SLOTS, 4, "adam counters");
-  AdamParams p{};
-  p.count = static_cast<uint32_t>(count);
-  p.period = period;
-  p.lead = lead;
-  p.counter_slot = counter_slot;
-  p.lr = lr;
-  p.lr_rest = lr_rest;
-  p.beta1 = options.beta1;
-  p.beta2 = options.beta2;
-  p.eps = options.eps;
-  p.bias_correction1 = static_cast<float>(1.0 - std::pow(double{options.beta1}, double(step)));
-  p.sqrt_bias_correction2 =
-      static_cast<float>(std::sqrt(1.0 - std::pow(double{options.beta2}, double(step))));
+  const AdamParams p =
+      adam_params(options, step, lr, lr_rest, static_cast<uint32_t>(count), period, lead, counter_slot);
   using engine::Access;
   sequence.dispatch(*kernel_, elementwise_groups(*context_, count, "optim/adam"),
                     {{ADAM_BINDING_PARAMS, t.params, Access::kReadWrite},

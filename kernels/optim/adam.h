@@ -9,6 +9,7 @@
 #include "engine/context.h"
 #include "engine/kernel.h"
 #include "engine/sequence.h"
+#include "kernels/optim/optim_shared.h"
 
 namespace litgs::kernels {
 
@@ -72,6 +73,10 @@ class AdamKernel {
   engine::Context* context_;
   std::unique_ptr<engine::Kernel> kernel_;
 };
+
+// The push constants of one Adam step (bias corrections of `step`, counted from 1).
+AdamParams adam_params(const AdamOptions& options, uint32_t step, float lr, float lr_rest, uint32_t count,
+                       uint32_t period, uint32_t lead, uint32_t counter_slot);
 
 // Throws std::out_of_range when `buffer` holds fewer than `count` values of `value_bytes` bytes.
 void check_binding(const engine::Buffer& buffer, uint64_t count, uint64_t value_bytes, const char* what);

@@ -37,8 +37,29 @@ struct AdamParams {
   uint reserved;
 };
 
+// ---- sh_adam.comp: Adam on the SH coefficients, their gradient computed in the kernel from the colour
+// gradient of the rasterizer's per-Gaussian rows (no stored SH gradient). One invocation per Gaussian. ----
+#define SH_ADAM_BINDING_SH 0          // [N][K][C] float, updated in place
+#define SH_ADAM_BINDING_EXP_AVG 1     // [N][K][C] float, updated in place
+#define SH_ADAM_BINDING_EXP_AVG_SQ 2  // [N][K][C] float, updated in place
+#define SH_ADAM_BINDING_COUNTERS 3    // [ADAM_COUNTER_SLOTS] uint
+#define SH_ADAM_BINDING_MEANS 4       // [N][3] float: the means the backward used (before their own step)
+#define SH_ADAM_BINDING_TILE_RECTS 5  // [N][2] packed tile rectangles: an empty one means culled, no gradient
+#define SH_ADAM_BINDING_GRAD2D 6      // [N][SPLAT_GRAD2D_FIXED + C] float: the colour gradient at the end
+#define SH_ADAM_BINDING_COUNT 7
+
+struct ShAdamParams {
+  AdamParams adam;  // count: Gaussians; period K * C and lead C as for the SH buffer in adam.comp
+  float centre[3];  // camera centre in world coordinates
+  uint sh_degree;   // active degree (basis beyond it is 0)
+  uint sh_coeffs;   // K of the SH buffer
+  uint reserved;
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(AdamParams) <= 128);
+static_assert(sizeof(ShAdamParams) <= 128);
+static_assert(SH_ADAM_BINDING_COUNT == SH_ADAM_BINDING_GRAD2D + 1);
 static_assert(ADAM_BINDING_COUNT == ADAM_BINDING_COUNTERS + 1);
 }  // namespace litgs::kernels
 #endif

@@ -20,6 +20,8 @@ layout(std430, binding = PBWD_BINDING_GRAD_LOG_SCALES) writeonly buffer GLogScal
 layout(std430, binding = PBWD_BINDING_GRAD_QUATS) writeonly buffer GQuats { float g_quats[]; };
 layout(std430, binding = PBWD_BINDING_GRAD_OPACITY_LOGITS) writeonly buffer GLogits { float g_logits[]; };
 layout(std430, binding = PBWD_BINDING_GRAD_SH) writeonly buffer GSh { float g_sh[]; };
+// 0: no SH gradient is stored (the optimizer computes it, kernels/optim/sh_adam.comp; g_sh is a dummy).
+layout(constant_id = 2) const uint WRITE_SH_GRAD = 1;
 
 void main() {
   const uint i = elementwise_index();
@@ -33,7 +35,8 @@ void main() {
     }
     for (uint a = 0u; a < 4u; ++a) g_quats[4 * i + a] = 0.0;
     g_logits[i] = 0.0;
-    for (uint k = 0u; k < K * CHANNELS; ++k) g_sh[i * K * CHANNELS + k] = 0.0;
+    if (WRITE_SH_GRAD != 0u)
+      for (uint k = 0u; k < K * CHANNELS; ++k) g_sh[i * K * CHANNELS + k] = 0.0;
     return;
   }
   const uint base = i * GRAD2D_STRIDE;
@@ -63,7 +66,7 @@ void main() {
     const bool clamped = sum < 0.0;
     for (uint k = 0u; k < K; ++k) {
       const uint idx = (i * K + k) * CHANNELS + c;
-      g_sh[idx] = clamped ? 0.0 : basis[k] * g_color;
+      if (WRITE_SH_GRAD != 0u) g_sh[idx] = clamped ? 0.0 : basis[k] * g_color;
       if (!clamped) weights[k] += g_color * sh[idx];
     }
   }

@@ -176,7 +176,8 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   backward_ = make(backward, BWD_BINDING_COUNT, sizeof(RasterizeParams),
                    {{2, options_.depth_gradient_to_opacity ? 1u : 0u}});
   reduce_ = make("splat/reduce_isect_grads", REDUCE_BINDING_COUNT, sizeof(SplatView));
-  project_backward_ = make("splat/project_backward", PBWD_BINDING_COUNT, sizeof(SplatView));
+  project_backward_ = make("splat/project_backward", PBWD_BINDING_COUNT, sizeof(SplatView),
+                           {{2, options_.sh_gradient ? 1u : 0u}});
   buffers_->counters =
       std::make_unique<DeviceArray<uint32_t>>(context, "splat: counters", SPLAT_COUNTER_COUNT);
   buffers_->counters->upload(std::vector<uint32_t>(SPLAT_COUNTER_COUNT, 0u));
@@ -453,7 +454,7 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
   grow(ctx, b.g_log_scales, 3 * size_t{n}, "splat: grad log_scales");
   grow(ctx, b.g_quats, 4 * size_t{n}, "splat: grad quats");
   grow(ctx, b.g_logits, n, "splat: grad opacity_logits");
-  grow(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
+  grow(ctx, b.g_sh, options_.sh_gradient ? size_t{n} * K * channels_ : 1, "splat: grad sh");
   if (options_.deterministic) grow(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
   backward_passes_ = passes_for(backward_entries_per_pass_);
   const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
@@ -503,8 +504,12 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
               {PBWD_BINDING_GRAD_OPACITY_LOGITS, &b.g_logits->buffer(), Access::kWrite},
               {PBWD_BINDING_GRAD_SH, &b.g_sh->buffer(), Access::kWrite}},
              view);
-  return {&b.g_means->buffer(),  &b.g_log_scales->buffer(), &b.g_quats->buffer(),
-          &b.g_logits->buffer(), &b.g_sh->buffer(),         &b.grad2d->buffer()};
+  return {&b.g_means->buffer(),
+          &b.g_log_scales->buffer(),
+          &b.g_quats->buffer(),
+          &b.g_logits->buffer(),
+          options_.sh_gradient ? &b.g_sh->buffer() : nullptr,
+          &b.grad2d->buffer()};
 }
 
 GaussianGrads<float> Rasterizer::download_grads() const {
@@ -518,7 +523,7 @@ GaussianGrads<float> Rasterizer::download_grads() const {
   out.log_scales = b.g_log_scales->download(0, 3 * n);
   out.quats = b.g_quats->download(0, 4 * n);
   out.opacity_logits = b.g_logits->download(0, n);
-  out.sh = b.g_sh->download(0, n * K * channels_);
+  if (options_.sh_gradient) out.sh = b.g_sh->download(0, n * K * channels_);
   const size_t stride = SPLAT_GRAD2D_FIXED + channels_;
   const std::vector<float> rows = b.grad2d->download(0, n * stride);
   out.means2d.resize(2 * n);

@@ -32,6 +32,10 @@ struct RasterizerOptions {
   // the device's subgroup size so that no pass exceeds a driver's loop limit (the default). Tests set it to
   // force many passes on short lists, or one oversized pass.
   uint32_t entries_per_pass = 0;
+  // false: the backward stores no SH gradient (DeviceGrads::sh is null, download_grads() leaves `sh` empty);
+  // the optimizer computes it from the colour gradient in grad2d (kernels/optim/sh_adam.h). Training uses it:
+  // 64 B per Gaussian at SH degree 3 and one channel.
+  bool sh_gradient = true;
 };
 
 // Counters of a rasterizer's renders (Rasterizer::read_counters).
@@ -112,7 +116,7 @@ class Rasterizer {
     const engine::Buffer* log_scales;      // [N][3]
     const engine::Buffer* quats;           // [N][4]
     const engine::Buffer* opacity_logits;  // [N]
-    const engine::Buffer* sh;              // [N][K][C]
+    const engine::Buffer* sh;              // [N][K][C]; null without RasterizerOptions::sh_gradient
     // [N][SPLAT_GRAD2D_FIXED + C] the projected quantities' gradients; dL/d(mean2d) in columns 0 and 1
     // (densification statistics read them there: no separate copy).
     const engine::Buffer* grad2d;

@@ -230,5 +230,80 @@ TEST_F(TrainingSmokeTest, WithoutDensifyStatisticsTheModelHasNoStatisticArrays) 
   }
 }
 
+// Training stores no SH gradient: the SH step computes it from the colour gradient in the rasterizer's rows
+// (kernels/optim/sh_adam.comp). Three steps that way must match three steps from the stored gradient
+// (project_backward's, itself checked against the double reference): every parameter and moment of every
+// group, for one and three channels, with the active SH degree below the model's and some Gaussians culled.
+TEST_F(TrainingSmokeTest, TheShStepFromTheColourGradientEqualsTheStepFromTheStoredGradient) {
+  for (uint32_t channels : {1u, 3u}) {
+    SCOPED_TRACE(channels);
+    const uint32_t W = 64, H = 48;
+    SplatCamera camera = testing::camera_looking_down_z(W, H);
+    camera.sh_degree = 2;  // the model has degree 3: its last band has no gradient
+    GaussianModel start = testing::random_scene(300, channels, 3, 17);
+    for (size_t i = 0; i < 20; ++i) start.means[3 * i + 2] = -1.0f;  // behind the camera: culled
+    TrainableGaussians stored(context(), start), computed(context(), start);
+    RasterizerOptions without_sh;
+    without_sh.sh_gradient = false;
+    Rasterizer raster_stored(context(), channels), raster_computed(context(), channels, without_sh);
+    std::mt19937 rng(3);
+    std::normal_distribution<float> normal(0.0f, 1e-3f);
+    for (uint32_t step = 1; step <= 3; ++step) {
+      std::vector<float> grad_image(size_t{W} * H * channels);
+      for (float& g : grad_image) g = normal(rng);
+      for (auto [model, raster] :
+           {std::pair{&stored, &raster_stored}, std::pair{&computed, &raster_computed}}) {
+        raster->forward(model->gaussians(), camera);
+        const Rasterizer::DeviceUpstream up = raster->upstream_buffers();
+        const_cast<engine::Buffer*>(up.image)->upload(grad_image.data(), grad_image.size() * sizeof(float));
+        engine::Sequence s(context());
+        s.fill(*up.depth, 0u, uint64_t{W} * H * 4);
+        s.fill(*up.alpha, 0u, uint64_t{W} * H * 4);
+        const Rasterizer::DeviceGrads grads = raster->record_backward(s);
+        const LearningRates lr = model->adam_options().rates(step - 1, 3, 5.0f);
+        if (raster == &raster_computed) {
+          ASSERT_EQ(grads.sh, nullptr);
+          const TrainableGaussians::ShFromColour from{raster->device_outputs().rects, camera};
+          model->record_adam_step(s, grads, lr, step, &from);
+        } else {
+          ASSERT_NE(grads.sh, nullptr);
+          model->record_adam_step(s, grads, lr, step);
+        }
+        s.submit_and_wait();
+      }
+    }
+    const TrainingState a = stored.download_state(), b = computed.download_state();
+    auto expect_close = [](const std::vector<float>& x, const std::vector<float>& y, const char* what) {
+      ASSERT_EQ(x.size(), y.size()) << what;
+      size_t off = 0;
+      for (size_t i = 0; i < x.size(); ++i)
+        off += !(std::abs(x[i] - y[i]) <= 1e-6f * (1.0f + std::abs(x[i])));
+      EXPECT_EQ(off, 0u) << what << ": values that differ beyond float rounding";
+    };
+    expect_close(a.model.sh, b.model.sh, "sh");
+    expect_close(a.model.means, b.model.means, "means");
+    for (uint32_t g = 0; g < kParamGroupCount; ++g) {
+      expect_close(a.exp_avg[g], b.exp_avg[g], "exp_avg");
+      expect_close(a.exp_avg_sq[g], b.exp_avg_sq[g], "exp_avg_sq");
+    }
+    // Not vacuous: the steps moved the active bands' coefficients of the Gaussians in view, and none of the
+    // last band's (no gradient, zero moments: Adam leaves them).
+    size_t active = 0, moved = 0, last_band_moved = 0;
+    for (size_t i = 20; i < start.size(); ++i)
+      for (size_t k = 0; k < 16; ++k)
+        for (size_t c = 0; c < channels; ++c) {
+          const size_t j = (i * 16 + k) * channels + c;
+          if (k < 9) {
+            ++active;
+            moved += b.model.sh[j] != start.sh[j];
+          } else {
+            last_band_moved += b.model.sh[j] != start.sh[j];
+          }
+        }
+    EXPECT_GT(moved, active * 9 / 10);
+    EXPECT_EQ(last_band_moved, 0u);
+  }
+}
+
 }  // namespace
 }  // namespace litgs::kernels
