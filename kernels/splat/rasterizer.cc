@@ -89,7 +89,8 @@ SplatView make_splat_view(const SplatCamera& camera, uint32_t count, uint32_t sh
 struct Rasterizer::Buffers {
   // Per Gaussian.
   std::unique_ptr<DeviceArray<float>> means2d, conics, depths, opacities, colors, grad2d;
-  std::unique_ptr<DeviceArray<uint32_t>> rects, depth_keys, order, counts, offsets;
+  std::unique_ptr<DeviceArray<uint32_t>> rects, depth_keys, order;
+  std::unique_ptr<DeviceArray<uint32_t>> offsets;  // [N + 1] tile counts, scanned in place
   std::unique_ptr<DeviceArray<float>> g_means, g_log_scales, g_quats, g_logits, g_sh;
   // Per intersection.
   std::unique_ptr<DeviceArray<uint32_t>> tile_keys, isect_ids, isect_gaussian;
@@ -272,8 +273,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   grow(ctx, b.rects, 2 * size_t{n}, "splat: tile rects");  // packed 16-bit (splat/tile_rect.glsl)
   grow(ctx, b.depth_keys, n, "splat: depth keys");
   grow(ctx, b.order, n, "splat: depth order");
-  grow(ctx, b.counts, n, "splat: tile counts");
-  grow(ctx, b.offsets, n, "splat: tile offsets");
+  grow(ctx, b.offsets, size_t{n} + 1, "splat: tile offsets");
   grow(ctx, b.corners, corner_cells, "splat: tile corners");
   profile_.clear();
 
@@ -283,6 +283,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   s1.fill(b.counters->buffer(), 0u, (SPLAT_COUNTER_MAX_LIST + 1) * sizeof(uint32_t));
   s1.fill(b.counters->buffer(), 0u, sizeof(uint32_t), SPLAT_COUNTER_CONTRIBUTIONS * sizeof(uint32_t));
   s1.fill(b.corners->buffer(), 0u, corner_cells * sizeof(uint32_t));
+  s1.fill(b.offsets->buffer(), 0u, sizeof(uint32_t), uint64_t{n} * sizeof(uint32_t));
   s1.dispatch(*project_, elementwise_groups(*context_, n, "splat/project"),
               {{PROJECT_BINDING_MEANS, &g.means.buffer(), Access::kRead},
                {PROJECT_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
@@ -303,12 +304,11 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   s1.dispatch(*gather_, elementwise_groups(*context_, n, "splat/gather_counts"),
               {{GATHER_BINDING_ORDER, &b.order->buffer(), Access::kRead},
                {GATHER_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kRead},
-               {GATHER_BINDING_COUNTS, &b.counts->buffer(), Access::kWrite},
+               {GATHER_BINDING_COUNTS, &b.offsets->buffer(), Access::kWrite},
                {GATHER_BINDING_CORNERS, &b.corners->buffer(), Access::kReadWrite},
                {GATHER_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
               view);
-  s1.copy(b.counts->buffer(), b.offsets->buffer(), uint64_t{n} * sizeof(uint32_t));
-  scan_.record(s1, b.offsets->buffer(), n);
+  scan_.record(s1, b.offsets->buffer(), n + 1);  // element n (zeroed above) becomes the total
   s1.dispatch(*lengths_, {1},
               {{LENGTHS_BINDING_CORNERS, &b.corners->buffer(), Access::kReadWrite},
                {LENGTHS_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
@@ -486,7 +486,6 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
     s.dispatch(*reduce_, elementwise_groups(*context_, n, "splat/reduce_isect_grads"),
                {{REDUCE_BINDING_ORDER, &b.order->buffer(), Access::kRead},
                 {REDUCE_BINDING_OFFSETS, &b.offsets->buffer(), Access::kRead},
-                {REDUCE_BINDING_COUNTS, &b.counts->buffer(), Access::kRead},
                 {REDUCE_BINDING_ISECT_GRADS, &b.isect_grads->buffer(), Access::kRead},
                 {REDUCE_BINDING_GRAD2D, &b.grad2d->buffer(), Access::kWrite}},
                view);

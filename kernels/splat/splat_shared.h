@@ -67,7 +67,9 @@ using uint = uint32_t;
 // ---- gather_counts.comp: one invocation per depth-sorted position ----
 #define GATHER_BINDING_ORDER 0       // [N] Gaussian index by depth rank
 #define GATHER_BINDING_TILE_RECTS 1  // [N][2] packed (tile_rect.glsl)
-#define GATHER_BINDING_COUNTS 2      // [N] tiles touched, in depth order (out)
+#define GATHER_BINDING_COUNTS \
+  2  // [N + 1] tiles touched, in depth order (out; scanned in place into
+     // the offsets, whose element N, zeroed, becomes the total)
 #define GATHER_BINDING_CORNERS \
   3                                // [(tiles_y + 1) * (tiles_x + 1)] uint, zeroed before: each
                                    // rectangle adds +1 -1 -1 +1 at its corners (a 2D difference grid)
@@ -83,7 +85,7 @@ using uint = uint32_t;
 // ---- emit_intersections.comp: one invocation per depth-sorted position ----
 #define EMIT_BINDING_ORDER 0           // [N]
 #define EMIT_BINDING_TILE_RECTS 1      // [N][2] packed (tile_rect.glsl)
-#define EMIT_BINDING_OFFSETS 2         // [N] exclusive scan of the counts
+#define EMIT_BINDING_OFFSETS 2         // [N + 1] exclusive scan of the counts
 #define EMIT_BINDING_TILE_KEYS 3       // [M] tile id (out)
 #define EMIT_BINDING_ISECT_IDS 4       // [M] intersection id = its emission position (out)
 #define EMIT_BINDING_ISECT_GAUSSIAN 5  // [M] Gaussian index of each intersection id (out)
@@ -140,11 +142,10 @@ using uint = uint32_t;
 
 // ---- reduce_isect_grads.comp (deterministic mode): one invocation per depth-sorted position ----
 #define REDUCE_BINDING_ORDER 0
-#define REDUCE_BINDING_OFFSETS 1
-#define REDUCE_BINDING_COUNTS 2
-#define REDUCE_BINDING_ISECT_GRADS 3  // [M][7 + C]
-#define REDUCE_BINDING_GRAD2D 4       // [N][7 + C] (out)
-#define REDUCE_BINDING_COUNT 5
+#define REDUCE_BINDING_OFFSETS 1      // [N + 1]: position s owns intersections offsets[s] .. offsets[s + 1]
+#define REDUCE_BINDING_ISECT_GRADS 2  // [M][7 + C]
+#define REDUCE_BINDING_GRAD2D 3       // [N][7 + C] (out)
+#define REDUCE_BINDING_COUNT 4
 
 // ---- project_backward.comp: one invocation per Gaussian ----
 #define PBWD_BINDING_MEANS 0
