@@ -4,6 +4,7 @@
 #include "limits.h"
 #include "optim/optim_shared.h"
 #include "elementwise.glsl"
+#include "optim/adam_step.glsl"
 
 layout(std430, binding = ADAM_BINDING_PARAMS) buffer Params { float params[]; };
 layout(std430, binding = ADAM_BINDING_GRADS) readonly buffer Grads { float grads[]; };
@@ -15,13 +16,9 @@ layout(push_constant) uniform Push { AdamParams p; };
 void main() {
   const uint j = elementwise_index();
   if (j >= p.count) return;
-  const float g = grads[j];
   const float lr = (j % p.period) < p.lead ? p.lr : p.lr_rest;
-  const float m = p.beta1 * exp_avg[j] + (1.0 - p.beta1) * g;
-  const float v = p.beta2 * exp_avg_sq[j] + (1.0 - p.beta2) * (g * g);
-  const float denom = sqrt(v) / p.sqrt_bias_correction2 + p.eps;
-  const float x = params[j] - (lr / p.bias_correction1) * (m / denom);
-  if (!finite_bits(g) || !finite_bits(m) || !finite_bits(v) || !finite_bits(x)) {
+  float x = params[j], m = exp_avg[j], v = exp_avg_sq[j];
+  if (!adam_step_value(p, lr, grads[j], x, m, v)) {
     atomicAdd(counters[p.counter_slot], 1u);
     return;
   }

@@ -4,10 +4,11 @@
 // rasterizer left in its per-Gaussian row, rather than read from a stored [N][K][C] gradient (64 B per
 // Gaussian at degree 3 and one channel). The gradient is project_backward's: colour = sum_k basis_k(dir) c_k
 // + 0.5, clamped at 0, with dir from the camera centre to the mean; none for a culled Gaussian. The step is
-// adam.comp's, element for element.
+// adam.comp's (optim/adam_step.glsl), element for element.
 #include "limits.h"
 #include "optim/optim_shared.h"
 #include "elementwise.glsl"
+#include "optim/adam_step.glsl"
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
 
@@ -25,13 +26,9 @@ layout(push_constant) uniform Push { ShAdamParams p; };
 layout(constant_id = 1) const uint CHANNELS = 1;
 
 void adam_step(uint j, float g, float lr) {
-  const AdamParams a = p.adam;
-  const float m = a.beta1 * exp_avg[j] + (1.0 - a.beta1) * g;
-  const float v = a.beta2 * exp_avg_sq[j] + (1.0 - a.beta2) * (g * g);
-  const float denom = sqrt(v) / a.sqrt_bias_correction2 + a.eps;
-  const float x = sh[j] - (lr / a.bias_correction1) * (m / denom);
-  if (!finite_bits(g) || !finite_bits(m) || !finite_bits(v) || !finite_bits(x)) {
-    atomicAdd(counters[a.counter_slot], 1u);
+  float x = sh[j], m = exp_avg[j], v = exp_avg_sq[j];
+  if (!adam_step_value(p.adam, lr, g, x, m, v)) {
+    atomicAdd(counters[p.adam.counter_slot], 1u);
     return;
   }
   exp_avg[j] = m;
