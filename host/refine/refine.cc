@@ -92,7 +92,7 @@ ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::v
                              const PinholeCamera& camera) {
   ResidualStats s;
   std::vector<double> e;
-  double sum2 = 0, plane2 = 0;
+  double sum2 = 0, anchored2 = 0, plane2 = 0;
   for (const auto& p : points) {
     if (!p.active) continue;
     for (const auto& ob : p.obs)
@@ -105,6 +105,10 @@ ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::v
         }
         e.push_back(error);
         sum2 += error * error;
+        if (p.anchor >= 0) {
+          ++s.anchored_observations;
+          anchored2 += error * error;
+        }
       }
     if (p.has_plane) {
       const double d = p.plane.n.dot(p.X - p.plane.l);
@@ -116,6 +120,8 @@ ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::v
     s.reprojection_rms_px = std::sqrt(sum2 / static_cast<double>(e.size()));
     s.reprojection_median_px = median(e);
   }
+  if (s.anchored_observations)
+    s.anchored_reprojection_rms_px = std::sqrt(anchored2 / static_cast<double>(s.anchored_observations));
   if (s.plane_points) s.plane_rms_m = std::sqrt(plane2 / static_cast<double>(s.plane_points));
   return s;
 }

@@ -49,6 +49,10 @@ struct ResidualStats {
   // RMS and median are over the others.
   size_t behind_camera = 0;
   double reprojection_rms_px = 0, reprojection_median_px = 0;
+  // The observations of anchored points alone (TrackPoint::anchor set): an anchor prior that disagrees with
+  // the tracks shows here first.
+  size_t anchored_observations = 0;
+  double anchored_reprojection_rms_px = 0;
   size_t plane_points = 0;
   double plane_rms_m = 0;
 };

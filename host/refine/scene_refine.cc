@@ -98,9 +98,14 @@ std::set<size_t> read_frozen(const fs::path& path) {
 }
 
 nlohmann::json stats_json(const ResidualStats& s) {
-  return {{"observations", s.observations},   {"reprojection_rms_px", s.reprojection_rms_px},
-          {"behind_camera", s.behind_camera}, {"reprojection_median_px", s.reprojection_median_px},
-          {"plane_points", s.plane_points},   {"plane_rms_m", s.plane_rms_m}};
+  return {{"observations", s.observations},
+          {"reprojection_rms_px", s.reprojection_rms_px},
+          {"behind_camera", s.behind_camera},
+          {"reprojection_median_px", s.reprojection_median_px},
+          {"plane_points", s.plane_points},
+          {"plane_rms_m", s.plane_rms_m},
+          {"anchored_observations", s.anchored_observations},
+          {"anchored_reprojection_rms_px", s.anchored_reprojection_rms_px}};
 }
 
 nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions& o) {

@@ -207,6 +207,26 @@ TEST(RefineResiduals, APointBehindItsCameraIsCountedNotAveraged) {
   EXPECT_EQ(s.behind_camera, 2u);
   EXPECT_NEAR(s.reprojection_rms_px, std::sqrt((25.0 + 0.0 + 9.0) / 3), 1e-12);  // errors 5, 0, 3 px
   EXPECT_NEAR(s.reprojection_median_px, 3.0, 1e-12);
+  EXPECT_EQ(s.anchored_observations, 0u);
+}
+
+// The anchored points' observations get their own RMS beside the overall one.
+TEST(RefineResiduals, AnchoredObservationsHaveTheirOwnRms) {
+  PinholeCamera camera;
+  camera.fx = camera.fy = 100;
+  camera.cx = camera.cy = 50;
+  camera.width = camera.height = 100;
+  std::vector<CameraPose> poses(2);  // at the origin, looking along +z
+  TrackPoint plain, anchored;
+  plain.X = anchored.X = Eigen::Vector3d(0, 0, 2);
+  plain.obs = {{0, Eigen::Vector2d(50, 50)}, {1, Eigen::Vector2d(50, 50)}};     // errors 0, 0 px
+  anchored.obs = {{0, Eigen::Vector2d(54, 53)}, {1, Eigen::Vector2d(50, 51)}};  // errors 5, 1 px
+  anchored.anchor = 0;
+  const ResidualStats s = residual_stats({plain, anchored}, poses, camera);
+  EXPECT_EQ(s.observations, 4u);
+  EXPECT_EQ(s.anchored_observations, 2u);
+  EXPECT_NEAR(s.anchored_reprojection_rms_px, std::sqrt((25.0 + 1.0) / 2), 1e-12);
+  EXPECT_NEAR(s.reprojection_rms_px, std::sqrt((25.0 + 1.0) / 4), 1e-12);
 }
 
 }  // namespace
