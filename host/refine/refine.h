@@ -14,7 +14,10 @@
 namespace litgs::host::refine {
 
 struct RefineOptions {
-  size_t rounds = 3;
+  // Rounds of association, solve and rejection. 5, not 3: the anchors join in the second round and need
+  // rounds after it (synthetic street ATE 32 -> 10 mm, facade 6.1 -> 5.8 mm, corridor 3 mm either way; DUNR's
+  // control points 2.99 -> 2.96 px; docs/experiments.md, 2026-11-25 night).
+  size_t rounds = 5;
   bool use_anchors = true, use_planes = true;
   size_t window = 20;             // frames per local window (step: half of it); 0: no local pass
   double reject_k = 3;            // rejection bound: median + k * 1.4826 * MAD ...

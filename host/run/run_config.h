@@ -44,7 +44,7 @@ struct RunConfig {
     std::string tracks = "auto";
     bool anchors = true;
     bool planes = true;
-    uint32_t rounds = 3;
+    uint32_t rounds = 5;  // refine's default (host/refine/refine.h)
     uint32_t threads = 1;
     std::vector<std::string> extra_args;
   } refine;
