@@ -430,13 +430,6 @@ VkMemoryPropertyFlags Context::memory_type_flags(uint32_t type_index) const {
 
 VkCommandBuffer Context::begin_one_off() {
   VkCommandBuffer cmd = sequence_pools_->take_command_buffer();
-  if (!cmd) {
-    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = command_pool_;
-    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ai.commandBufferCount = 1;
-    LITGS_VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cmd));
-  }
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   const VkResult r = vkBeginCommandBuffer(cmd, &bi);

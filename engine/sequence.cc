@@ -9,10 +9,10 @@
 namespace litgs::engine {
 namespace {
 
-constexpr uint32_t kSetsPerPool = 128;
-// Descriptor pools are sized for this many bindings per set (lavapipe allows 32 storage buffers per stage).
-constexpr uint32_t kMaxBindingsPerKernel = 32;
-constexpr uint32_t kQueriesPerPool = 512;  // 256 dispatches
+// The pools' sizes (engine/sequence_pools.h).
+constexpr uint32_t kSetsPerPool = SequencePools::kSetsPerPool;
+constexpr uint32_t kMaxBindingsPerKernel = SequencePools::kMaxBindingsPerKernel;
+constexpr uint32_t kQueriesPerPool = SequencePools::kQueriesPerPool;  // 256 dispatches
 
 bool reads(Access a) {
   return a != Access::kWrite;
@@ -27,21 +27,11 @@ Sequence::Sequence(Context& context, bool timestamps)
     : context_(&context), timestamps_(timestamps && context.info().timestamps) {
   SequencePools& kept = context.sequence_pools();
   cmd_ = kept.take_command_buffer();
-  if (!cmd_) {
-    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    ai.commandPool = context.command_pool();
-    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    ai.commandBufferCount = 1;
-    LITGS_VK_CHECK(vkAllocateCommandBuffers(context.device(), &ai, &cmd_));
-  }
-  fence_ = kept.take_fence();
-  if (!fence_) {
-    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    const VkResult r = vkCreateFence(context.device(), &fci, nullptr, &fence_);
-    if (r != VK_SUCCESS) {
-      release();
-      LITGS_VK_CHECK(r);
-    }
+  try {
+    fence_ = kept.take_fence();
+  } catch (...) {
+    release();
+    throw;
   }
 }
 
@@ -115,16 +105,7 @@ void Sequence::track(const Buffer* buffer, Access access) {
 VkDescriptorSet Sequence::allocate_set(const Kernel& kernel) {
   VkDevice dev = context_->device();
   if (pools_.empty() || sets_in_last_pool_ == kSetsPerPool) {
-    VkDescriptorPool pool = context_->sequence_pools().take_descriptor_pool();
-    if (!pool) {
-      VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSetsPerPool * kMaxBindingsPerKernel};
-      VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-      pci.maxSets = kSetsPerPool;
-      pci.poolSizeCount = 1;
-      pci.pPoolSizes = &size;
-      LITGS_VK_CHECK(vkCreateDescriptorPool(dev, &pci, nullptr, &pool));
-    }
-    pools_.push_back(pool);
+    pools_.push_back(context_->sequence_pools().take_descriptor_pool());
     sets_in_last_pool_ = 0;
   }
   VkDescriptorSetLayout layout = kernel.set_layout();
@@ -194,14 +175,7 @@ void Sequence::dispatch_raw(const Kernel& kernel, Groups groups, std::initialize
   VkQueryPool qpool = VK_NULL_HANDLE;
   if (timestamps_) {
     if (query / kQueriesPerPool >= query_pools_.size()) {
-      VkQueryPool pool = context_->sequence_pools().take_query_pool();
-      if (!pool) {
-        VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-        qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
-        qci.queryCount = kQueriesPerPool;
-        LITGS_VK_CHECK(vkCreateQueryPool(context_->device(), &qci, nullptr, &pool));
-      }
-      query_pools_.push_back(pool);
+      query_pools_.push_back(context_->sequence_pools().take_query_pool());
     }
     qpool = query_pools_[query / kQueriesPerPool];
     vkCmdResetQueryPool(cmd_, qpool, query % kQueriesPerPool, 2);

@@ -1,5 +1,7 @@
 #include "engine/sequence_pools.h"
 
+#include "engine/vk_check.h"
+
 namespace litgs::engine {
 namespace {
 
@@ -26,23 +28,56 @@ SequencePools::~SequencePools() {
 }
 
 VkCommandBuffer SequencePools::take_command_buffer() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return pop_or_null(command_buffers_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (VkCommandBuffer kept = pop_or_null(command_buffers_)) return kept;
+  }
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = command_pool_;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  LITGS_VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cmd));
+  return cmd;
 }
 
 VkFence SequencePools::take_fence() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return pop_or_null(fences_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (VkFence kept = pop_or_null(fences_)) return kept;
+  }
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence = VK_NULL_HANDLE;
+  LITGS_VK_CHECK(vkCreateFence(device_, &fci, nullptr, &fence));
+  return fence;
 }
 
 VkDescriptorPool SequencePools::take_descriptor_pool() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return pop_or_null(descriptor_pools_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (VkDescriptorPool kept = pop_or_null(descriptor_pools_)) return kept;
+  }
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSetsPerPool * kMaxBindingsPerKernel};
+  VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pci.maxSets = kSetsPerPool;
+  pci.poolSizeCount = 1;
+  pci.pPoolSizes = &size;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  LITGS_VK_CHECK(vkCreateDescriptorPool(device_, &pci, nullptr, &pool));
+  return pool;
 }
 
 VkQueryPool SequencePools::take_query_pool() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return pop_or_null(query_pools_);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (VkQueryPool kept = pop_or_null(query_pools_)) return kept;
+  }
+  VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  qci.queryCount = kQueriesPerPool;
+  VkQueryPool pool = VK_NULL_HANDLE;
+  LITGS_VK_CHECK(vkCreateQueryPool(device_, &qci, nullptr, &pool));
+  return pool;
 }
 
 // A give_back never throws (sequences give back from their destructors): an object that fails to reset

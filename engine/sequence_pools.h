@@ -17,11 +17,17 @@ class SequencePools {
   SequencePools(const SequencePools&) = delete;
   SequencePools& operator=(const SequencePools&) = delete;
 
-  // Each take_* returns a kept object, or VK_NULL_HANDLE when none is kept (the caller creates one).
-  VkCommandBuffer take_command_buffer();
-  VkFence take_fence();  // unsignalled
+  // The sizes of the pools it makes: storage-buffer descriptor sets of up to kMaxBindingsPerKernel bindings
+  // (lavapipe allows 32 storage buffers per stage), timestamp queries (two per dispatch).
+  static constexpr uint32_t kSetsPerPool = 128;
+  static constexpr uint32_t kMaxBindingsPerKernel = 32;
+  static constexpr uint32_t kQueriesPerPool = 512;
+
+  // Each take_* returns a kept object, or a new one when none is kept; it throws what LITGS_VK_CHECK throws.
+  VkCommandBuffer take_command_buffer();  // primary, from the context's command pool
+  VkFence take_fence();                   // unsignalled
   VkDescriptorPool take_descriptor_pool();
-  VkQueryPool take_query_pool();
+  VkQueryPool take_query_pool();  // timestamps
 
   // Each give_back resets the object for its next use (never throws); it must not be in use on the device.
   void give_back(VkCommandBuffer cmd) noexcept;
