@@ -5,12 +5,18 @@
 namespace litgs::engine {
 namespace {
 
-template <class T>
-T pop_or_null(std::vector<T>& kept) {
-  if (kept.empty()) return VK_NULL_HANDLE;
-  const T object = kept.back();
-  kept.pop_back();
-  return object;
+// The last kept object, else a new one from `make` (made outside the lock).
+template <class T, class Make>
+T take_or_make(std::mutex& mutex, std::vector<T>& kept, Make&& make) {
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!kept.empty()) {
+      const T object = kept.back();
+      kept.pop_back();
+      return object;
+    }
+  }
+  return make();
 }
 
 }  // namespace
@@ -28,56 +34,48 @@ SequencePools::~SequencePools() {
 }
 
 VkCommandBuffer SequencePools::take_command_buffer() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (VkCommandBuffer kept = pop_or_null(command_buffers_)) return kept;
-  }
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = command_pool_;
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  LITGS_VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cmd));
-  return cmd;
+  return take_or_make(mutex_, command_buffers_, [&] {
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = command_pool_;
+    ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    ai.commandBufferCount = 1;
+    VkCommandBuffer cmd = VK_NULL_HANDLE;
+    LITGS_VK_CHECK(vkAllocateCommandBuffers(device_, &ai, &cmd));
+    return cmd;
+  });
 }
 
 VkFence SequencePools::take_fence() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (VkFence kept = pop_or_null(fences_)) return kept;
-  }
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VkFence fence = VK_NULL_HANDLE;
-  LITGS_VK_CHECK(vkCreateFence(device_, &fci, nullptr, &fence));
-  return fence;
+  return take_or_make(mutex_, fences_, [&] {
+    VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    VkFence fence = VK_NULL_HANDLE;
+    LITGS_VK_CHECK(vkCreateFence(device_, &fci, nullptr, &fence));
+    return fence;
+  });
 }
 
 VkDescriptorPool SequencePools::take_descriptor_pool() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (VkDescriptorPool kept = pop_or_null(descriptor_pools_)) return kept;
-  }
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSetsPerPool * kMaxBindingsPerKernel};
-  VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pci.maxSets = kSetsPerPool;
-  pci.poolSizeCount = 1;
-  pci.pPoolSizes = &size;
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  LITGS_VK_CHECK(vkCreateDescriptorPool(device_, &pci, nullptr, &pool));
-  return pool;
+  return take_or_make(mutex_, descriptor_pools_, [&] {
+    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSetsPerPool * kMaxBindingsPerKernel};
+    VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    pci.maxSets = kSetsPerPool;
+    pci.poolSizeCount = 1;
+    pci.pPoolSizes = &size;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    LITGS_VK_CHECK(vkCreateDescriptorPool(device_, &pci, nullptr, &pool));
+    return pool;
+  });
 }
 
 VkQueryPool SequencePools::take_query_pool() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (VkQueryPool kept = pop_or_null(query_pools_)) return kept;
-  }
-  VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
-  qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
-  qci.queryCount = kQueriesPerPool;
-  VkQueryPool pool = VK_NULL_HANDLE;
-  LITGS_VK_CHECK(vkCreateQueryPool(device_, &qci, nullptr, &pool));
-  return pool;
+  return take_or_make(mutex_, query_pools_, [&] {
+    VkQueryPoolCreateInfo qci{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qci.queryCount = kQueriesPerPool;
+    VkQueryPool pool = VK_NULL_HANDLE;
+    LITGS_VK_CHECK(vkCreateQueryPool(device_, &qci, nullptr, &pool));
+    return pool;
+  });
 }
 
 // A give_back never throws (sequences give back from their destructors): an object that fails to reset
