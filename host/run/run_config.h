@@ -45,6 +45,9 @@ struct RunConfig {
     bool anchors = true;
     bool planes = true;
     uint32_t rounds = 5;  // refine's default (host/refine/refine.h)
+    // auto: a pose prior on every frame (`refine --absolute-priors`) when INPUT is a Metashape or COLMAP
+    // project, whose poses are a global photogrammetric solution, not a drifting odometry.
+    std::string absolute_priors = "auto";
     uint32_t threads = 1;
     std::vector<std::string> extra_args;
   } refine;
@@ -111,6 +114,9 @@ void for_each_field(Config& c, F&& f) {
   f("refine", "anchors", c.refine.anchors, "anchor weights and priors");
   f("refine", "planes", c.refine.planes, "LiDAR point-to-plane term (off where the scene has no LiDAR map)");
   f("refine", "rounds", c.refine.rounds, "rounds of association, solve and rejection");
+  f("refine", "absolute_priors", c.refine.absolute_priors,
+    "auto (a pose prior on every frame when INPUT is a Metashape or COLMAP project: a global solution, not "
+    "an odometry) | true | false");
   f("refine", "threads", c.refine.threads, "Ceres threads");
   f("refine", "extra_args", c.refine.extra_args, "more flags for `litgs-engine refine`, as is");
   f("train", "iterations", c.train.iterations, "training iterations");

@@ -1,11 +1,23 @@
 // refine: LiDAR-plane bundle adjustment of the poses (`litgs-engine refine`) on DIR/refine/scene, whose
 // poses.txt becomes the refined trajectory (the input kept as poses_prior.txt) for train and eval.
+#include <stdexcept>
+
 #include "host/run/stage.h"
 
 namespace litgs::host::run {
 namespace {
 
 namespace fs = std::filesystem;
+
+// refine.absolute_priors: "auto" decides by the input (see run_config.h).
+bool absolute_priors(const StageContext& c) {
+  const std::string& v = c.config.refine.absolute_priors;
+  if (v == "true") return true;
+  if (v == "false") return false;
+  if (v != "auto")
+    throw std::invalid_argument("refine.absolute_priors: expected auto, true or false, not '" + v + "'");
+  return c.kind == InputKind::kMetashape || c.kind == InputKind::kColmap;
+}
 
 StagePlan plan(const StageContext& c) {
   const RunConfig::Refine& o = c.config.refine;
@@ -21,15 +33,16 @@ StagePlan plan(const StageContext& c) {
   }
   if (!p.skip_reason.empty()) return p;
   nlohmann::json flags_from = p.options;
+  flags_from["absolute_priors"] = absolute_priors(c);
   if (o.planes && !fs::exists(scene / "lidar" / "map.pcd")) {
     flags_from["planes"] = false;
     p.notes.push_back("the scene has no LiDAR map: refine runs without the plane term");
   }
-  plan_on_scene_copy(
-      c, "refine", SceneCopy{scene, {"poses.txt", "poses_prior.txt"}, {"refine", "refine.json"}},
-      option_flags(flags_from,
-                   {"tracks", "anchors=!--no-anchors", "planes=!--no-planes", "rounds", "threads"}),
-      o.extra_args, p);
+  plan_on_scene_copy(c, "refine",
+                     SceneCopy{scene, {"poses.txt", "poses_prior.txt"}, {"refine", "refine.json"}},
+                     option_flags(flags_from, {"tracks", "anchors=!--no-anchors", "planes=!--no-planes",
+                                               "rounds", "threads", "absolute_priors"}),
+                     o.extra_args, p);
   return p;
 }
 

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -65,6 +66,33 @@ TEST_F(SceneCopyTest, CopiesLinksAndLeavesOutAsAsked) {
   std::ofstream(out / "lidar/map.pcd") << "rebuilt";
   EXPECT_EQ(text(in / "poses.txt"), "poses.txt");
   EXPECT_EQ(text(in / "lidar/map.pcd"), "lidar/map.pcd");
+}
+
+// Metashape and COLMAP poses are a global solution: refine gets a prior on every frame unless run.yaml says.
+TEST(RefineStagePlan, AbsolutePriorsFollowTheInputUnlessSet) {
+  StageContext c;
+  c.out_dir = fs::temp_directory_path() / "litgs-refine-plan";
+  c.results["import"] = {{"scene", (c.out_dir / "import" / "scene").string()}};
+  const auto has_flag = [&] {
+    const auto command = refine_stage().plan(c).command;
+    return std::find(command.begin(), command.end(), "--absolute-priors") != command.end();
+  };
+  for (const InputKind kind : {InputKind::kMetashape, InputKind::kColmap}) {
+    c.kind = kind;
+    EXPECT_TRUE(has_flag()) << kind_name(kind);
+  }
+  for (const InputKind kind :
+       {InputKind::kScene, InputKind::kSynthetic, InputKind::kRosBag, InputKind::kLivo2}) {
+    c.kind = kind;
+    EXPECT_FALSE(has_flag()) << kind_name(kind);
+  }
+  c.config.refine.absolute_priors = "true";
+  EXPECT_TRUE(has_flag());
+  c.kind = InputKind::kMetashape;
+  c.config.refine.absolute_priors = "false";
+  EXPECT_FALSE(has_flag());
+  c.config.refine.absolute_priors = "yes";
+  EXPECT_THROW(has_flag(), std::invalid_argument);
 }
 
 TEST_F(SceneCopyTest, MissingSceneIsAnError) {
