@@ -141,7 +141,7 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
           new ceres::AutoDiffCostFunction<PointToPlane, 1, 3>(new PointToPlane{p.plane, 1 / w.plane_sigma_m});
       problem.AddResidualBlock(
           cost,
-          new ceres::ScaledLoss(new ceres::HuberLoss(1.0), weight_sum / static_cast<double>(count),
+          new ceres::ScaledLoss(new ceres::CauchyLoss(1.0), weight_sum / static_cast<double>(count),
                                 ceres::TAKE_OWNERSHIP),
           p.X.data());
       ++s.plane_residuals;
