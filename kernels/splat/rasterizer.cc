@@ -89,8 +89,10 @@ SplatView make_splat_view(const SplatCamera& camera, uint32_t count, uint32_t sh
 struct Rasterizer::Buffers {
   // Per Gaussian.
   std::unique_ptr<DeviceArray<float>> means2d, conics, depths, opacities, colors, grad2d;
-  std::unique_ptr<DeviceArray<uint32_t>> rects, depth_keys, order;
-  std::unique_ptr<DeviceArray<uint32_t>> offsets;  // [N + 1] tile counts, scanned in place
+  std::unique_ptr<DeviceArray<uint32_t>> rects, order;
+  // [N + 1]: first the depth keys, sorted in place with `order` (then dead), then the tile counts in depth
+  // order, scanned in place into offsets: one buffer for two lifetimes that do not overlap.
+  std::unique_ptr<DeviceArray<uint32_t>> keys_then_offsets;
   std::unique_ptr<DeviceArray<float>> g_means, g_log_scales, g_quats, g_logits, g_sh;
   // Per intersection.
   std::unique_ptr<DeviceArray<uint32_t>> tile_keys, isect_ids, isect_gaussian;
@@ -271,9 +273,8 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   grow(ctx, b.opacities, n, "splat: opacities");
   grow(ctx, b.colors, size_t{n} * channels_, "splat: colors");
   grow(ctx, b.rects, 2 * size_t{n}, "splat: tile rects");  // packed 16-bit (splat/tile_rect.glsl)
-  grow(ctx, b.depth_keys, n, "splat: depth keys");
   grow(ctx, b.order, n, "splat: depth order");
-  grow(ctx, b.offsets, size_t{n} + 1, "splat: tile offsets");
+  grow(ctx, b.keys_then_offsets, size_t{n} + 1, "splat: depth keys, then tile offsets");
   grow(ctx, b.corners, corner_cells, "splat: tile corners");
   profile_.clear();
 
@@ -283,7 +284,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   s1.fill(b.counters->buffer(), 0u, (SPLAT_COUNTER_MAX_LIST + 1) * sizeof(uint32_t));
   s1.fill(b.counters->buffer(), 0u, sizeof(uint32_t), SPLAT_COUNTER_CONTRIBUTIONS * sizeof(uint32_t));
   s1.fill(b.corners->buffer(), 0u, corner_cells * sizeof(uint32_t));
-  s1.fill(b.offsets->buffer(), 0u, sizeof(uint32_t), uint64_t{n} * sizeof(uint32_t));
+  s1.fill(b.keys_then_offsets->buffer(), 0u, sizeof(uint32_t), uint64_t{n} * sizeof(uint32_t));
   s1.dispatch(*project_, elementwise_groups(*context_, n, "splat/project"),
               {{PROJECT_BINDING_MEANS, &g.means.buffer(), Access::kRead},
                {PROJECT_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
@@ -296,19 +297,19 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
                {PROJECT_BINDING_OPACITIES, &b.opacities->buffer(), Access::kWrite},
                {PROJECT_BINDING_COLORS, &b.colors->buffer(), Access::kWrite},
                {PROJECT_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kWrite},
-               {PROJECT_BINDING_DEPTH_KEYS, &b.depth_keys->buffer(), Access::kWrite},
+               {PROJECT_BINDING_DEPTH_KEYS, &b.keys_then_offsets->buffer(), Access::kWrite},
                {PROJECT_BINDING_ORDER, &b.order->buffer(), Access::kWrite},
                {PROJECT_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
               view);
-  sort_.record(s1, *b.depth_keys, *b.order, n, 32);
+  sort_.record(s1, *b.keys_then_offsets, *b.order, n, 32);  // element n is not touched
   s1.dispatch(*gather_, elementwise_groups(*context_, n, "splat/gather_counts"),
               {{GATHER_BINDING_ORDER, &b.order->buffer(), Access::kRead},
                {GATHER_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kRead},
-               {GATHER_BINDING_COUNTS, &b.offsets->buffer(), Access::kWrite},
+               {GATHER_BINDING_COUNTS, &b.keys_then_offsets->buffer(), Access::kWrite},
                {GATHER_BINDING_CORNERS, &b.corners->buffer(), Access::kReadWrite},
                {GATHER_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
               view);
-  scan_.record(s1, b.offsets->buffer(), n + 1);  // element n (zeroed above) becomes the total
+  scan_.record(s1, b.keys_then_offsets->buffer(), n + 1);  // element n (zeroed above) becomes the total
   s1.dispatch(*lengths_, {1},
               {{LENGTHS_BINDING_CORNERS, &b.corners->buffer(), Access::kReadWrite},
                {LENGTHS_BINDING_COUNTERS, &b.counters->buffer(), Access::kReadWrite}},
@@ -346,7 +347,7 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
   s2.dispatch(*emit_, elementwise_groups(*context_, n, "splat/emit_intersections"),
               {{EMIT_BINDING_ORDER, &b.order->buffer(), Access::kRead},
                {EMIT_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kRead},
-               {EMIT_BINDING_OFFSETS, &b.offsets->buffer(), Access::kRead},
+               {EMIT_BINDING_OFFSETS, &b.keys_then_offsets->buffer(), Access::kRead},
                {EMIT_BINDING_TILE_KEYS, &b.tile_keys->buffer(), Access::kWrite},
                {EMIT_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kWrite},
                {EMIT_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kWrite}},
@@ -485,7 +486,7 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
   if (options_.deterministic)
     s.dispatch(*reduce_, elementwise_groups(*context_, n, "splat/reduce_isect_grads"),
                {{REDUCE_BINDING_ORDER, &b.order->buffer(), Access::kRead},
-                {REDUCE_BINDING_OFFSETS, &b.offsets->buffer(), Access::kRead},
+                {REDUCE_BINDING_OFFSETS, &b.keys_then_offsets->buffer(), Access::kRead},
                 {REDUCE_BINDING_ISECT_GRADS, &b.isect_grads->buffer(), Access::kRead},
                 {REDUCE_BINDING_GRAD2D, &b.grad2d->buffer(), Access::kWrite}},
                view);
