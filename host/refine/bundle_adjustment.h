@@ -25,11 +25,11 @@
 namespace litgs::host::refine {
 
 struct BaWeights {
-  double pixel_loss_px = 2;          // Cauchy scale of the reprojection residual
-  double plane_sigma_m = 0.02;       // point-to-plane: residual = distance / sigma
-  double anchor_loss = 1;            // Cauchy scale of the whitened anchor residual
-  double rel_sigma_t_m = 0.01;       // relative-pose prior: translation sigma ...
-  double rel_sigma_t_per_m = 0.02;   // ... plus this per metre travelled between the frames
+  double pixel_loss_px = 2;         // Cauchy scale of the reprojection residual
+  double plane_sigma_m = 0.02;      // point-to-plane: residual = distance / sigma
+  double anchor_loss = 1;           // Cauchy scale of the whitened anchor residual
+  double rel_sigma_t_m = 0.01;      // relative-pose prior: translation sigma ...
+  double rel_sigma_t_per_m = 0.02;  // ... plus this per metre travelled between the frames
   // Rotation sigma between consecutive frames: an odometry's relative rotation comes from its gyro over
   // one frame interval and is far better than any frame's absolute orientation (gauge_sigma_r_rad); at
   // 3 mrad a sideways shift of the camera traded against a small rotation cost almost nothing
