@@ -15,6 +15,8 @@ layout(std430, binding = PROJECT_BINDING_OPACITY_LOGITS) readonly buffer Logits 
 layout(std430, binding = PROJECT_BINDING_SH) readonly buffer Sh { float sh[]; };
 layout(std430, binding = PROJECT_BINDING_MEANS2D) writeonly buffer Means2d { float means2d[]; };
 layout(std430, binding = PROJECT_BINDING_CONICS) writeonly buffer Conics { float conics[]; };
+layout(std430, binding = PROJECT_BINDING_DEPTHS) writeonly buffer Depths { float depths[]; };
+layout(std430, binding = PROJECT_BINDING_OPACITIES) writeonly buffer Opacities { float opacities[]; };
 layout(std430, binding = PROJECT_BINDING_COLORS) writeonly buffer Colors { float colors[]; };
 layout(std430, binding = PROJECT_BINDING_TILE_RECTS) writeonly buffer Rects { uvec2 rects[]; };
 #include "splat/tile_rect.glsl"
@@ -53,6 +55,8 @@ void main() {
   conics[3 * i] = pr.conic.x;
   conics[3 * i + 1] = pr.conic.y;
   conics[3 * i + 2] = pr.conic.z;
+  depths[i] = pr.depth;
+  opacities[i] = pr.opacity;
 
   float basis[SPLAT_MAX_SH_COEFFS];
   sh_basis(view.sh_degree, normalize(mean - camera_centre()), basis);

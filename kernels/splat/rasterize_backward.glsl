@@ -26,8 +26,8 @@ layout(std430, binding = BWD_BINDING_ISECT_IDS) readonly buffer IsectIds { uint 
 layout(std430, binding = BWD_BINDING_ISECT_GAUSSIAN) readonly buffer IsectGaussian { uint isect_gaussian[]; };
 layout(std430, binding = BWD_BINDING_MEANS2D) readonly buffer Means2d { float means2d[]; };
 layout(std430, binding = BWD_BINDING_CONICS) readonly buffer Conics { float conics[]; };
-layout(std430, binding = BWD_BINDING_MEANS) readonly buffer Means { float means[]; };
-layout(std430, binding = BWD_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
+layout(std430, binding = BWD_BINDING_DEPTHS) readonly buffer Depths { float depths[]; };
+layout(std430, binding = BWD_BINDING_OPACITIES) readonly buffer Opacities { float opacities[]; };
 layout(std430, binding = BWD_BINDING_COLORS) readonly buffer Colors { float colors[]; };
 layout(std430, binding = BWD_BINDING_DEPTH) readonly buffer FwdDepth { float fwd_depth[]; };
 layout(std430, binding = BWD_BINDING_ALPHA) readonly buffer FwdAlpha { float fwd_alpha[]; };
@@ -97,7 +97,7 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
 void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity) {
   g = isect_gaussian[isect_ids[i]];
   const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
-  const float opacity = opacity_from_logit(opacity_logits[g]);
+  const float opacity = opacities[g];
   mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
   conic_opacity = vec4(conic, opacity);
 }
@@ -105,7 +105,7 @@ void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity
 void load_entry_shading(uint g, out vec4 color, out float depth) {
   color = vec4(0.0);
   for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
-  depth = camera_depth(view_geometry(), vec3(means[3 * g], means[3 * g + 1], means[3 * g + 2]));
+  depth = depths[g];
 }
 
 // Sums of three vectors over the subgroup, as a butterfly of XOR shuffles: on CPU drivers a shuffle with a

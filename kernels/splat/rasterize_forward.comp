@@ -21,8 +21,8 @@ layout(std430, binding = FWD_BINDING_ISECT_IDS) readonly buffer IsectIds { uint 
 layout(std430, binding = FWD_BINDING_ISECT_GAUSSIAN) readonly buffer IsectGaussian { uint isect_gaussian[]; };
 layout(std430, binding = FWD_BINDING_MEANS2D) readonly buffer Means2d { float means2d[]; };
 layout(std430, binding = FWD_BINDING_CONICS) readonly buffer Conics { float conics[]; };
-layout(std430, binding = FWD_BINDING_MEANS) readonly buffer Means { float means[]; };
-layout(std430, binding = FWD_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
+layout(std430, binding = FWD_BINDING_DEPTHS) readonly buffer Depths { float depths[]; };
+layout(std430, binding = FWD_BINDING_OPACITIES) readonly buffer Opacities { float opacities[]; };
 layout(std430, binding = FWD_BINDING_COLORS) readonly buffer Colors { float colors[]; };
 layout(std430, binding = FWD_BINDING_IMAGE) buffer Image { float image[]; };
 layout(std430, binding = FWD_BINDING_DEPTH) buffer Depth { float depth_out[]; };
@@ -73,7 +73,7 @@ void main() {
     if (entry < end) {
       const uint g = isect_gaussian[isect_ids[entry]];
       const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
-      const float opacity = opacity_from_logit(opacity_logits[g]);
+      const float opacity = opacities[g];
       mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
       conic_opacity = vec4(conic, opacity);
       // The bounding box only: the backward's exact ellipse test (footprint_touches_box) costs the forward
@@ -82,7 +82,7 @@ void main() {
       // A per-lane load is the forward's main cost on lavapipe: colour and depth only for the entries kept.
       if (relevant) {
         for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
-        depth = camera_depth(view_geometry(), vec3(means[3 * g], means[3 * g + 1], means[3 * g + 2]));
+        depth = depths[g];
       }
     }
     uvec4 todo = subgroupBallot(relevant);

@@ -88,7 +88,7 @@ SplatView make_splat_view(const SplatCamera& camera, uint32_t count, uint32_t sh
 
 struct Rasterizer::Buffers {
   // Per Gaussian.
-  std::unique_ptr<DeviceArray<float>> means2d, conics, colors, grad2d;
+  std::unique_ptr<DeviceArray<float>> means2d, conics, depths, opacities, colors, grad2d;
   std::unique_ptr<DeviceArray<uint32_t>> rects, order;
   // [N + 1]: first the depth keys, sorted in place with `order` (then dead), then the tile counts in depth
   // order, scanned in place into offsets: one buffer for two lifetimes that do not overlap.
@@ -269,6 +269,8 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
 
   grow(ctx, b.means2d, 2 * size_t{n}, "splat: means2d");
   grow(ctx, b.conics, 3 * size_t{n}, "splat: conics");
+  grow(ctx, b.depths, n, "splat: depths");
+  grow(ctx, b.opacities, n, "splat: opacities");
   grow(ctx, b.colors, size_t{n} * channels_, "splat: colors");
   grow(ctx, b.rects, 2 * size_t{n}, "splat: tile rects");  // packed 16-bit (splat/tile_rect.glsl)
   grow(ctx, b.order, n, "splat: depth order");
@@ -291,6 +293,8 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
                {PROJECT_BINDING_SH, &g.sh.buffer(), Access::kRead},
                {PROJECT_BINDING_MEANS2D, &b.means2d->buffer(), Access::kWrite},
                {PROJECT_BINDING_CONICS, &b.conics->buffer(), Access::kWrite},
+               {PROJECT_BINDING_DEPTHS, &b.depths->buffer(), Access::kWrite},
+               {PROJECT_BINDING_OPACITIES, &b.opacities->buffer(), Access::kWrite},
                {PROJECT_BINDING_COLORS, &b.colors->buffer(), Access::kWrite},
                {PROJECT_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kWrite},
                {PROJECT_BINDING_DEPTH_KEYS, &b.keys_then_offsets->buffer(), Access::kWrite},
@@ -363,8 +367,8 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
                  {FWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
                  {FWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
                  {FWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
-                 {FWD_BINDING_MEANS, &g.means.buffer(), Access::kRead},
-                 {FWD_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kRead},
+                 {FWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
+                 {FWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
                  {FWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
                  {FWD_BINDING_IMAGE, &b.image->buffer(), Access::kReadWrite},
                  {FWD_BINDING_DEPTH, &b.depth->buffer(), Access::kReadWrite},
@@ -466,8 +470,8 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
                 {BWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
                 {BWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
                 {BWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
-                {BWD_BINDING_MEANS, &g.means.buffer(), Access::kRead},
-                {BWD_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kRead},
+                {BWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
+                {BWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
                 {BWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
                 {BWD_BINDING_DEPTH, &b.depth->buffer(), Access::kRead},
                 {BWD_BINDING_ALPHA, &b.alpha->buffer(), Access::kRead},

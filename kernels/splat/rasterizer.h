@@ -122,8 +122,7 @@ class Rasterizer {
     const engine::Buffer* grad2d;
   };
   // Records the backward from the upstream buffers into `sequence` (no submit), for a training step that
-  // records loss kernels before it and the optimizer after it. The Gaussians must be as the forward saw them
-  // (it reads their parameters again: depth, opacity and the projection's gradients).
+  // records loss kernels before it and the optimizer after it.
   DeviceGrads record_backward(engine::Sequence& sequence);
 
   // The counters (one small readback: call it when reporting, not every step).

@@ -190,15 +190,6 @@ SM_FN mat3 covariance_world(vec3 log_scale, vec4 quat_raw) {
   return M * transpose(M);
 }
 
-// The camera z of a world point, and a Gaussian's opacity from its logit: project_gaussian's values, which
-// the rasterize kernels recompute instead of storing them per Gaussian.
-SM_FN real camera_depth(ViewGeometry v, vec3 mean) {
-  return (v.R * mean + v.t).z;
-}
-SM_FN real opacity_from_logit(real logit) {
-  return real(1.0) / (real(1.0) + exp(-logit));
-}
-
 SM_FN Projected project_gaussian(ViewGeometry v, vec3 mean, vec3 log_scale, vec4 quat_raw,
                                  real opacity_logit) {
   Projected o;
@@ -212,7 +203,7 @@ SM_FN Projected project_gaussian(ViewGeometry v, vec3 mean, vec3 log_scale, vec4
       is_finite3(mean) && is_finite3(log_scale) && is_finite4(quat_raw) && is_finite_real(opacity_logit);
   if (!o.finite) return o;
   const vec3 p = v.R * mean + v.t;
-  o.depth = camera_depth(v, mean);
+  o.depth = p.z;
   if (!(p.z >= v.near_m)) return o;
   bool cx, cy;
   const mat3x2 J = projection_jacobian(v, p, cx, cy);
@@ -225,7 +216,7 @@ SM_FN Projected project_gaussian(ViewGeometry v, vec3 mean, vec3 log_scale, vec4
   if (!(det > real(0.0)) || !is_finite_real(det)) return o;
   o.conic = vec3(cov2[1][1] / det, -cov2[0][1] / det, cov2[0][0] / det);
   o.mean2d = vec2(v.fx * p.x / p.z + v.cx, v.fy * p.y / p.z + v.cy);
-  o.opacity = opacity_from_logit(opacity_logit);
+  o.opacity = real(1.0) / (real(1.0) + exp(-opacity_logit));
   if (!(o.opacity * real(255.0) > real(1.0))) return o;
   // Opacity-aware extent: alpha = opacity * exp(-d^2/2) reaches 1/255 at d^2 = 2 ln(255 opacity).
   const real k = sqrt(real(2.0) * log(o.opacity * real(255.0)));

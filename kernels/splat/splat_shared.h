@@ -36,15 +36,15 @@ using uint = uint32_t;
 #define PROJECT_BINDING_SH 4              // [N][K][C] K = (max degree + 1)^2 of the model
 #define PROJECT_BINDING_MEANS2D 5         // [N][2] pixels (out)
 #define PROJECT_BINDING_CONICS 6          // [N][3] inverse 2D covariance a b c (out)
-// Depth and opacity are not stored: the rasterize kernels take them from the means and logits
-// (camera_depth, opacity_from_logit in splat_math.h), 8 bytes per Gaussian less in training.
-#define PROJECT_BINDING_COLORS 7  // [N][C] (out)
+#define PROJECT_BINDING_DEPTHS 7          // [N] camera z (out)
+#define PROJECT_BINDING_OPACITIES 8       // [N] sigmoid(logit) (out)
+#define PROJECT_BINDING_COLORS 9          // [N][C] (out)
 #define PROJECT_BINDING_TILE_RECTS \
-  8  // [N][2] tile x0 y0 x1 y1, half-open, 16 bits each (tile_rect.glsl); empty if culled (out)
-#define PROJECT_BINDING_DEPTH_KEYS 9  // [N] sortable depth bits, 0xFFFFFFFF if culled (out)
-#define PROJECT_BINDING_ORDER 10      // [N] identity permutation, the depth sort's values (out)
-#define PROJECT_BINDING_COUNTERS 11   // [SPLAT_COUNTER_COUNT] uint, see SPLAT_COUNTER_*
-#define PROJECT_BINDING_COUNT 12
+  10  // [N][2] tile x0 y0 x1 y1, half-open, 16 bits each (tile_rect.glsl); empty if culled (out)
+#define PROJECT_BINDING_DEPTH_KEYS 11  // [N] sortable depth bits, 0xFFFFFFFF if culled (out)
+#define PROJECT_BINDING_ORDER 12       // [N] identity permutation, the depth sort's values (out)
+#define PROJECT_BINDING_COUNTERS 13    // [SPLAT_COUNTER_COUNT] uint, see SPLAT_COUNTER_*
+#define PROJECT_BINDING_COUNT 14
 
 // ---- The rasterizer's counters buffer: [SPLAT_COUNTER_COUNT] uint ----
 // Zeroed by every forward: culls, the intersection total and the longest tile list of that render.
@@ -107,8 +107,8 @@ using uint = uint32_t;
 #define FWD_BINDING_ISECT_GAUSSIAN 2  // [M]
 #define FWD_BINDING_MEANS2D 3
 #define FWD_BINDING_CONICS 4
-#define FWD_BINDING_MEANS 5           // [N][3] world: the depth (camera_depth)
-#define FWD_BINDING_OPACITY_LOGITS 6  // [N]: the opacity (opacity_from_logit)
+#define FWD_BINDING_DEPTHS 5
+#define FWD_BINDING_OPACITIES 6
 #define FWD_BINDING_COLORS 7
 #define FWD_BINDING_IMAGE 8      // [C][H][W] (out)
 #define FWD_BINDING_DEPTH 9      // [H][W] expected depth sum(w z)/sum(w) (out)
@@ -126,8 +126,8 @@ using uint = uint32_t;
 #define BWD_BINDING_ISECT_GAUSSIAN 2
 #define BWD_BINDING_MEANS2D 3
 #define BWD_BINDING_CONICS 4
-#define BWD_BINDING_MEANS 5  // as the forward's
-#define BWD_BINDING_OPACITY_LOGITS 6
+#define BWD_BINDING_DEPTHS 5
+#define BWD_BINDING_OPACITIES 6
 #define BWD_BINDING_COLORS 7
 #define BWD_BINDING_DEPTH 8  // forward expected depth
 #define BWD_BINDING_ALPHA 9  // forward accumulated alpha
