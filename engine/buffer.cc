@@ -77,6 +77,22 @@ std::vector<std::pair<std::string, uint64_t>> Buffer::peak_breakdown() {
   return out;
 }
 
+uint32_t texel_format_bytes(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R32_UINT:
+    case VK_FORMAT_R32_SFLOAT:
+      return 4;
+    case VK_FORMAT_R32G32_SFLOAT:
+      return 8;
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+      return 16;
+    default:
+      throw std::invalid_argument("texel format " + std::to_string(format) +
+                                  " is not one the engine binds (R32_UINT, R32_SFLOAT, R32G32_SFLOAT, "
+                                  "R32G32B32A32_SFLOAT)");
+  }
+}
+
 Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKind kind)
     : context_(&context), name_(std::move(name)), size_bytes_(size_bytes) {
   const DeviceInfo& info = context.info();
@@ -87,8 +103,9 @@ Buffer::Buffer(Context& context, std::string name, uint64_t size_bytes, MemoryKi
   const VkDeviceSize alloc_size = size_bytes == 0 ? 16 : (size_bytes + 3) & ~VkDeviceSize{3};
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bci.size = alloc_size;
-  bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-              VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+  bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT |
+              VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+              VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
   bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   VkDevice dev = context.device();
   LITGS_VK_CHECK(vkCreateBuffer(dev, &bci, nullptr, &buffer_));
@@ -133,7 +150,8 @@ Buffer::Buffer(Buffer&& other) noexcept
       buffer_(std::exchange(other.buffer_, VK_NULL_HANDLE)),
       memory_(std::exchange(other.memory_, VK_NULL_HANDLE)),
       mapped_(std::exchange(other.mapped_, nullptr)),
-      allocated_bytes_(std::exchange(other.allocated_bytes_, 0)) {}
+      allocated_bytes_(std::exchange(other.allocated_bytes_, 0)),
+      texel_views_(std::exchange(other.texel_views_, {})) {}
 
 Buffer& Buffer::operator=(Buffer&& other) noexcept {
   if (this != &other) {
@@ -145,6 +163,7 @@ Buffer& Buffer::operator=(Buffer&& other) noexcept {
     memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
     mapped_ = std::exchange(other.mapped_, nullptr);
     allocated_bytes_ = std::exchange(other.allocated_bytes_, 0);
+    texel_views_ = std::exchange(other.texel_views_, {});
   }
   return *this;
 }
@@ -152,6 +171,8 @@ Buffer& Buffer::operator=(Buffer&& other) noexcept {
 void Buffer::release() {
   if (!context_) return;
   VkDevice dev = context_->device();
+  for (const auto& [format, view] : texel_views_) vkDestroyBufferView(dev, view, nullptr);
+  texel_views_.clear();
   if (mapped_) vkUnmapMemory(dev, memory_);
   if (buffer_) vkDestroyBuffer(dev, buffer_, nullptr);
   if (allocated_bytes_) count_release(memory_, allocated_bytes_);
@@ -160,6 +181,32 @@ void Buffer::release() {
   mapped_ = nullptr;
   buffer_ = VK_NULL_HANDLE;
   memory_ = VK_NULL_HANDLE;
+}
+
+VkBufferView Buffer::texel_view(VkFormat format) const {
+  for (const auto& [f, view] : texel_views_)
+    if (f == format) return view;
+  const uint32_t element_bytes = texel_format_bytes(format);
+  // The buffer as created (a multiple of 4 bytes, 16 when empty): the view ends at its last whole element.
+  const uint64_t elements = (size_bytes_ == 0 ? 16 : (size_bytes_ + 3) & ~uint64_t{3}) / element_bytes;
+  const DeviceInfo& info = context_->info();
+  if (elements == 0)
+    throw std::invalid_argument("buffer '" + name_ + "' of " + std::to_string(size_bytes_) +
+                                " bytes is smaller than one texel element of " +
+                                std::to_string(element_bytes));
+  if (elements > info.max_texel_buffer_elements)
+    throw std::length_error("buffer '" + name_ + "' of " + std::to_string(size_bytes_) + " bytes holds " +
+                            std::to_string(elements) + " texel elements, more than maxTexelBufferElements " +
+                            std::to_string(info.max_texel_buffer_elements) + " of " + info.name);
+  VkBufferViewCreateInfo vci{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+  vci.buffer = buffer_;
+  vci.format = format;
+  vci.offset = 0;
+  vci.range = VK_WHOLE_SIZE;
+  VkBufferView view = VK_NULL_HANDLE;
+  LITGS_VK_CHECK(vkCreateBufferView(context_->device(), &vci, nullptr, &view));
+  texel_views_.emplace_back(format, view);
+  return view;
 }
 
 void Buffer::check_range(uint64_t bytes, uint64_t offset, const char* what) const {

@@ -22,7 +22,12 @@ enum class MemoryKind {
                  // staging (as they do on a discrete GPU; tests use it to run that path on lavapipe)
 };
 
-// One VkBuffer with its own memory, usable as a storage buffer and as a transfer source and destination.
+// Bytes of one element of a texel format the engine binds (engine/kernel.h TexelBinding); throws
+// std::invalid_argument for any other format.
+uint32_t texel_format_bytes(VkFormat format);
+
+// One VkBuffer with its own memory, usable as a storage buffer, a uniform texel buffer (through the views it
+// makes) and a transfer source and destination.
 class Buffer {
  public:
   // Throws std::length_error naming the buffer and the limit when `size_bytes` exceeds the device's
@@ -52,6 +57,10 @@ class Buffer {
   void upload(const void* data, uint64_t bytes, uint64_t offset = 0);
   void download(void* data, uint64_t bytes, uint64_t offset = 0) const;
 
+  // A view of the whole buffer as elements of `format`, made on first use and kept as long as the buffer.
+  // Throws std::length_error naming the buffer when it holds more elements than maxTexelBufferElements.
+  VkBufferView texel_view(VkFormat format) const;
+
  private:
   void release();
   void check_range(uint64_t bytes, uint64_t offset, const char* what) const;
@@ -63,6 +72,7 @@ class Buffer {
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   void* mapped_ = nullptr;
   uint64_t allocated_bytes_ = 0;
+  mutable std::vector<std::pair<VkFormat, VkBufferView>> texel_views_;  // made by texel_view()
 };
 
 // A typed array on the device: `count` elements of T (trivially copyable).

@@ -146,6 +146,8 @@ Candidate describe(VkPhysicalDevice pd) {
   d.max_push_constants_size = base.limits.maxPushConstantsSize;
   d.max_compute_shared_memory_size = base.limits.maxComputeSharedMemorySize;
   d.max_per_stage_storage_buffers = base.limits.maxPerStageDescriptorStorageBuffers;
+  d.max_per_stage_sampled_images = base.limits.maxPerStageDescriptorSampledImages;
+  d.max_texel_buffer_elements = base.limits.maxTexelBufferElements;
   d.max_compute_workgroup_invocations = base.limits.maxComputeWorkGroupInvocations;
   for (int i = 0; i < 3; ++i) d.max_compute_workgroup_count[i] = base.limits.maxComputeWorkGroupCount[i];
   d.timestamp_period_ns = base.limits.timestampPeriod;

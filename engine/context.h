@@ -56,6 +56,8 @@ struct DeviceInfo {
   uint32_t max_push_constants_size = 0;
   uint32_t max_compute_shared_memory_size = 0;
   uint32_t max_per_stage_storage_buffers = 0;  // storage-buffer bindings one kernel may have
+  uint32_t max_per_stage_sampled_images = 0;   // uniform-texel-buffer bindings one kernel may have
+  uint64_t max_texel_buffer_elements = 0;      // elements one uniform-texel-buffer binding may span
   uint32_t max_compute_workgroup_invocations = 0;
   uint32_t max_compute_workgroup_count[3] = {0, 0, 0};
   bool timestamps = false;           // compute queue supports timestamps

@@ -2,10 +2,33 @@
 
 #include <stdexcept>
 
+#include "engine/buffer.h"
 #include "engine/context.h"
 #include "engine/vk_check.h"
 
 namespace litgs::engine {
+
+namespace {
+
+// Each texel binding names a binding of the kernel once, with a format the device reads as uniform texels.
+void check_texel_bindings(const Context& context, const KernelDesc& desc) {
+  std::vector<bool> seen(desc.binding_count, false);
+  for (const TexelBinding& t : desc.texel_bindings) {
+    if (t.index >= desc.binding_count || seen[t.index])
+      throw std::invalid_argument("kernel '" + desc.name + "': texel binding " + std::to_string(t.index) +
+                                  " is out of range or repeated");
+    seen[t.index] = true;
+    texel_format_bytes(t.format);  // throws for a format the engine does not size
+    VkFormatProperties props{};
+    vkGetPhysicalDeviceFormatProperties(context.physical_device(), t.format, &props);
+    if (!(props.bufferFeatures & VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT))
+      throw std::invalid_argument("kernel '" + desc.name + "': binding " + std::to_string(t.index) +
+                                  ": format " + std::to_string(t.format) +
+                                  " is not a uniform texel format on " + context.info().name);
+  }
+}
+
+}  // namespace
 
 Kernel::Kernel(Context& context, KernelDesc desc) : context_(&context), desc_(std::move(desc)) {
   const DeviceInfo& info = context.info();
@@ -15,10 +38,17 @@ Kernel::Kernel(Context& context, KernelDesc desc) : context_(&context), desc_(st
     throw std::invalid_argument(
         "kernel '" + desc_.name + "': push constants of " + std::to_string(desc_.push_constant_bytes) +
         " bytes exceed maxPushConstantsSize " + std::to_string(info.max_push_constants_size));
-  if (desc_.binding_count > info.max_per_stage_storage_buffers)
-    throw std::invalid_argument("kernel '" + desc_.name + "': " + std::to_string(desc_.binding_count) +
+  check_texel_bindings(context, desc_);
+  const uint32_t texel_count = static_cast<uint32_t>(desc_.texel_bindings.size());
+  const uint32_t storage_count = desc_.binding_count - texel_count;
+  if (storage_count > info.max_per_stage_storage_buffers)
+    throw std::invalid_argument("kernel '" + desc_.name + "': " + std::to_string(storage_count) +
                                 " storage buffers exceed maxPerStageDescriptorStorageBuffers " +
                                 std::to_string(info.max_per_stage_storage_buffers) + " of " + info.name);
+  if (texel_count > info.max_per_stage_sampled_images)
+    throw std::invalid_argument("kernel '" + desc_.name + "': " + std::to_string(texel_count) +
+                                " uniform texel buffers exceed maxPerStageDescriptorSampledImages " +
+                                std::to_string(info.max_per_stage_sampled_images) + " of " + info.name);
   const uint32_t sg = desc_.required_subgroup_size;
   const bool fixed_size = info.min_subgroup_size == info.max_subgroup_size && sg == info.subgroup_size;
   if (sg != 0 && !fixed_size &&
@@ -39,7 +69,9 @@ Kernel::Kernel(Context& context, KernelDesc desc) : context_(&context), desc_(st
     std::vector<VkDescriptorSetLayoutBinding> bindings(desc_.binding_count);
     for (uint32_t i = 0; i < desc_.binding_count; ++i) {
       bindings[i].binding = i;
-      bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      bindings[i].descriptorType = texel_format(i) != VK_FORMAT_UNDEFINED
+                                       ? VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER
+                                       : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
       bindings[i].descriptorCount = 1;
       bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
     }
@@ -84,6 +116,12 @@ Kernel::Kernel(Context& context, KernelDesc desc) : context_(&context), desc_(st
     release();
     throw;
   }
+}
+
+VkFormat Kernel::texel_format(uint32_t index) const {
+  for (const TexelBinding& t : desc_.texel_bindings)
+    if (t.index == index) return t.format;
+  return VK_FORMAT_UNDEFINED;
 }
 
 Kernel::~Kernel() {

@@ -139,6 +139,9 @@ void Sequence::dispatch_raw(const Kernel& kernel, Groups groups, std::initialize
       throw std::invalid_argument("dispatch of '" + kernel.name() + "': binding " + std::to_string(b.index) +
                                   " is out of range, repeated or null");
     seen[b.index] = true;
+    if (kernel.texel_format(b.index) != VK_FORMAT_UNDEFINED && b.access != Access::kRead)
+      throw std::invalid_argument("dispatch of '" + kernel.name() + "': binding " + std::to_string(b.index) +
+                                  " is a uniform texel buffer, which the kernel can only read");
   }
   const uint32_t g[3] = {groups.x, groups.y, groups.z};
   for (int i = 0; i < 3; ++i)
@@ -156,16 +159,24 @@ void Sequence::dispatch_raw(const Kernel& kernel, Groups groups, std::initialize
 
   VkDescriptorSet set = allocate_set(kernel);
   std::vector<VkDescriptorBufferInfo> infos(bindings.size());
+  std::vector<VkBufferView> views(bindings.size(), VK_NULL_HANDLE);
   std::vector<VkWriteDescriptorSet> writes_(bindings.size());
   size_t i = 0;
   for (const Binding& b : bindings) {
-    infos[i] = {b.buffer->handle(), 0, VK_WHOLE_SIZE};
     writes_[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     writes_[i].dstSet = set;
     writes_[i].dstBinding = b.index;
     writes_[i].descriptorCount = 1;
-    writes_[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes_[i].pBufferInfo = &infos[i];
+    const VkFormat texel_format = kernel.texel_format(b.index);
+    if (texel_format != VK_FORMAT_UNDEFINED) {
+      views[i] = b.buffer->texel_view(texel_format);
+      writes_[i].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+      writes_[i].pTexelBufferView = &views[i];
+    } else {
+      infos[i] = {b.buffer->handle(), 0, VK_WHOLE_SIZE};
+      writes_[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+      writes_[i].pBufferInfo = &infos[i];
+    }
     ++i;
   }
   vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes_.size()), writes_.data(), 0,

@@ -56,11 +56,14 @@ VkFence SequencePools::take_fence() {
 
 VkDescriptorPool SequencePools::take_descriptor_pool() {
   return take_or_make(mutex_, descriptor_pools_, [&] {
-    VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSetsPerPool * kMaxBindingsPerKernel};
+    // Any of a kernel's bindings may be either kind (engine/kernel.h).
+    const VkDescriptorPoolSize sizes[] = {
+        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSetsPerPool * kMaxBindingsPerKernel},
+        {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, kSetsPerPool * kMaxBindingsPerKernel}};
     VkDescriptorPoolCreateInfo pci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     pci.maxSets = kSetsPerPool;
-    pci.poolSizeCount = 1;
-    pci.pPoolSizes = &size;
+    pci.poolSizeCount = 2;
+    pci.pPoolSizes = sizes;
     VkDescriptorPool pool = VK_NULL_HANDLE;
     LITGS_VK_CHECK(vkCreateDescriptorPool(device_, &pci, nullptr, &pool));
     return pool;

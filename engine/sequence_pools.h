@@ -17,8 +17,9 @@ class SequencePools {
   SequencePools(const SequencePools&) = delete;
   SequencePools& operator=(const SequencePools&) = delete;
 
-  // The sizes of the pools it makes: storage-buffer descriptor sets of up to kMaxBindingsPerKernel bindings
-  // (lavapipe allows 32 storage buffers per stage), timestamp queries (two per dispatch).
+  // The sizes of the pools it makes: descriptor sets of up to kMaxBindingsPerKernel bindings, storage or
+  // uniform texel buffers (lavapipe allows 32 storage buffers per stage), timestamp queries (two per
+  // dispatch).
   static constexpr uint32_t kSetsPerPool = 128;
   static constexpr uint32_t kMaxBindingsPerKernel = 32;
   static constexpr uint32_t kQueriesPerPool = 512;

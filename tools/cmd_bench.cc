@@ -10,6 +10,7 @@ void add_bench_command(CLI::App& app) {
   bench->require_subcommand(1);
   add_bench_sort_command(*bench);
   add_bench_render_command(*bench);
+  add_bench_gather_command(*bench);
   add_bench_loss_command(*bench);
   add_bench_serve_command(*bench);
   add_bench_frontend_command(*bench);

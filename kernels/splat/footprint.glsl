@@ -1,10 +1,14 @@
 // A Gaussian's footprint in a tile, for skipping whole subgroups of pixels at once.
 
-// Half-extents (x, y) of the region where opacity * exp(-sigma) >= 1/255, from the conic: the same
-// axis-aligned box project_gaussian computes from the covariance.
-vec2 alpha_extent(vec3 conic, float opacity) {
+// ln(max(255 opacity, 1)): opacity * exp(-sigma) >= 1/255 where sigma is at most this. project.comp stores
+// it beside the conic, so that the rasterize kernels take no logarithm per list entry.
+float alpha_reach(float opacity) { return log(max(opacity * 255.0, 1.0)); }
+
+// Half-extents (x, y) of the region where opacity * exp(-sigma) >= 1/255, from the conic and
+// alpha_reach(opacity): the same axis-aligned box project_gaussian computes from the covariance.
+vec2 alpha_extent(vec3 conic, float reach) {
   const float det = conic.x * conic.z - conic.y * conic.y;
-  const float k2 = 2.0 * log(max(opacity * 255.0, 1.0));
+  const float k2 = 2.0 * reach;
   return sqrt(max(k2 * vec2(conic.z, conic.x) / det, vec2(0.0)));
 }
 
@@ -46,7 +50,7 @@ float edge_min_sigma(float a, float b, float c, float b_over_c, float dx, float 
 // 0.02 of margin for the rounding of exp, log and the walk's pixel offsets (sigma changes by under 1e-3 for
 // a 1e-4 pixel offset within the footprint). Conservative: true for a conic that is not positive definite.
 // An entry this rejects adds exactly nothing in the walk (alpha < 1/255 at every pixel of the box).
-bool footprint_touches_box(vec4 mean_extent, vec4 conic_opacity, vec2 lo, vec2 hi) {
+bool footprint_touches_box(vec4 mean_extent, vec4 conic_opacity, float reach, vec2 lo, vec2 hi) {
   const float a = conic_opacity.x, b = conic_opacity.y, c = conic_opacity.z;
   const vec2 d_lo = lo - mean_extent.xy, d_hi = hi - mean_extent.xy;
   const bool definite = a > 0.0 && c > 0.0 && a * c - b * b > 0.0;
@@ -57,8 +61,8 @@ bool footprint_touches_box(vec4 mean_extent, vec4 conic_opacity, vec2 lo, vec2 h
                               edge_min_sigma(a_s, b, c_s, b_over_c, d_hi.x, d_lo.y, d_hi.y)),
                           min(edge_min_sigma(c_s, b, a_s, b_over_a, d_lo.y, d_lo.x, d_hi.x),
                               edge_min_sigma(c_s, b, a_s, b_over_a, d_hi.y, d_lo.x, d_hi.x)));
-  // The logarithm alpha_extent takes (the compiler computes it once): below opacity 1/255 nothing hits
-  // anyway, and the limit 0.02 keeps the entry only where sigma <= 0.02.
-  const float limit = log(max(conic_opacity.w * 255.0, 1.0)) + 0.02;
+  // alpha_reach(opacity): below opacity 1/255 nothing hits anyway, and the limit 0.02 keeps the entry only
+  // where sigma <= 0.02.
+  const float limit = reach + 0.02;
   return !definite || inside || !(least > limit);
 }

@@ -6,6 +6,7 @@
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
+#include "splat/footprint.glsl"
 
 
 layout(std430, binding = PROJECT_BINDING_MEANS) readonly buffer Means { float means[]; };
@@ -13,10 +14,8 @@ layout(std430, binding = PROJECT_BINDING_LOG_SCALES) readonly buffer LogScales {
 layout(std430, binding = PROJECT_BINDING_QUATS) readonly buffer Quats { float quats[]; };
 layout(std430, binding = PROJECT_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
 layout(std430, binding = PROJECT_BINDING_SH) readonly buffer Sh { float sh[]; };
-layout(std430, binding = PROJECT_BINDING_MEANS2D) writeonly buffer Means2d { float means2d[]; };
-layout(std430, binding = PROJECT_BINDING_CONICS) writeonly buffer Conics { float conics[]; };
-layout(std430, binding = PROJECT_BINDING_DEPTHS) writeonly buffer Depths { float depths[]; };
-layout(std430, binding = PROJECT_BINDING_OPACITIES) writeonly buffer Opacities { float opacities[]; };
+layout(std430, binding = PROJECT_BINDING_CENTRES) writeonly buffer Centres { vec4 centres[]; };
+layout(std430, binding = PROJECT_BINDING_CONICS) writeonly buffer Conics { vec4 conics[]; };
 layout(std430, binding = PROJECT_BINDING_COLORS) writeonly buffer Colors { float colors[]; };
 layout(std430, binding = PROJECT_BINDING_TILE_RECTS) writeonly buffer Rects { uvec2 rects[]; };
 #include "splat/tile_rect.glsl"
@@ -50,13 +49,8 @@ void main() {
   order[i] = i;
   // Camera z >= near > 0: the bits of a positive float sort like the float. Culled Gaussians go last.
   depth_keys[i] = kept ? floatBitsToUint(pr.depth) : 0xFFFFFFFFu;
-  means2d[2 * i] = pr.mean2d.x;
-  means2d[2 * i + 1] = pr.mean2d.y;
-  conics[3 * i] = pr.conic.x;
-  conics[3 * i + 1] = pr.conic.y;
-  conics[3 * i + 2] = pr.conic.z;
-  depths[i] = pr.depth;
-  opacities[i] = pr.opacity;
+  centres[i] = vec4(pr.mean2d, pr.depth, pr.opacity);
+  conics[i] = vec4(pr.conic, alpha_reach(pr.opacity));
 
   float basis[SPLAT_MAX_SH_COEFFS];
   sh_basis(view.sh_degree, normalize(mean - camera_centre()), basis);

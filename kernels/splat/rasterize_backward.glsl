@@ -22,13 +22,12 @@
 layout(local_size_x = SPLAT_TILE_SIZE, local_size_y = SPLAT_TILE_SIZE) in;
 
 layout(std430, binding = BWD_BINDING_RANGES) readonly buffer Ranges { uvec2 ranges[]; };
-layout(std430, binding = BWD_BINDING_ISECT_IDS) readonly buffer IsectIds { uint isect_ids[]; };
-layout(std430, binding = BWD_BINDING_ISECT_GAUSSIAN) readonly buffer IsectGaussian { uint isect_gaussian[]; };
-layout(std430, binding = BWD_BINDING_MEANS2D) readonly buffer Means2d { float means2d[]; };
-layout(std430, binding = BWD_BINDING_CONICS) readonly buffer Conics { float conics[]; };
-layout(std430, binding = BWD_BINDING_DEPTHS) readonly buffer Depths { float depths[]; };
-layout(std430, binding = BWD_BINDING_OPACITIES) readonly buffer Opacities { float opacities[]; };
-layout(std430, binding = BWD_BINDING_COLORS) readonly buffer Colors { float colors[]; };
+// The per-entry reads, as texels (splat_shared.h).
+layout(binding = BWD_BINDING_ISECT_IDS) uniform usamplerBuffer isect_ids;
+layout(binding = BWD_BINDING_ISECT_GAUSSIAN) uniform usamplerBuffer isect_gaussian;
+layout(binding = BWD_BINDING_CENTRES) uniform samplerBuffer centres;
+layout(binding = BWD_BINDING_CONICS) uniform samplerBuffer conics;
+layout(binding = BWD_BINDING_COLORS) uniform samplerBuffer colors;
 layout(std430, binding = BWD_BINDING_DEPTH) readonly buffer FwdDepth { float fwd_depth[]; };
 layout(std430, binding = BWD_BINDING_ALPHA) readonly buffer FwdAlpha { float fwd_alpha[]; };
 layout(std430, binding = BWD_BINDING_LAST) readonly buffer FwdLast { uint fwd_last[]; };
@@ -92,20 +91,23 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
   return r;
 }
 
-// Loads list entry `i`'s Gaussian: its footprint (colour and depth: load_entry_shading, for kept entries only,
-// as a per-lane load is the main cost on lavapipe).
-void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity) {
-  g = isect_gaussian[isect_ids[i]];
-  const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
-  const float opacity = opacities[g];
-  mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
-  conic_opacity = vec4(conic, opacity);
+// Loads list entry `i`'s Gaussian: its footprint, depth and alpha_reach(opacity) (the colour:
+// load_entry_color, for kept entries only).
+void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity, out float depth,
+                out float reach) {
+  g = texelFetch(isect_gaussian, int(texelFetch(isect_ids, int(i)).x)).x;
+  const vec4 centre_g = texelFetch(centres, int(g));  // mean2d, depth, opacity
+  const vec4 conic_g = texelFetch(conics, int(g));    // conic, alpha_reach(opacity)
+  mean_extent = vec4(centre_g.xy, alpha_extent(conic_g.xyz, conic_g.w));
+  conic_opacity = vec4(conic_g.xyz, centre_g.w);
+  depth = centre_g.z;
+  reach = conic_g.w;
 }
 
-void load_entry_shading(uint g, out vec4 color, out float depth) {
-  color = vec4(0.0);
-  for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
-  depth = depths[g];
+vec4 load_entry_color(uint g) {
+  vec4 color = vec4(0.0);
+  for (uint c = 0u; c < CHANNELS; ++c) color[c] = texelFetch(colors, int(g * CHANNELS + c)).x;
+  return color;
 }
 
 // Sums of three vectors over the subgroup, as a butterfly of XOR shuffles: on CPU drivers a shuffle with a
@@ -171,10 +173,11 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 cent
   float depth = 0.0;
   relevant = false;
   if (rel < chunk_end) {
-    load_entry(list_start + rel, g, mean_extent, conic_opacity);
+    float reach;
+    load_entry(list_start + rel, g, mean_extent, conic_opacity, depth, reach);
     relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi) &&
-               footprint_touches_box(mean_extent, conic_opacity, subgroup_lo, subgroup_hi);
-    if (relevant) load_entry_shading(g, color, depth);
+               footprint_touches_box(mean_extent, conic_opacity, reach, subgroup_lo, subgroup_hi);
+    if (relevant) color = load_entry_color(g);
   }
   a0 = vec4(0.0);
   a1 = vec4(0.0);
@@ -266,7 +269,7 @@ void main() {
       if (chunk_start + k >= chunk_end) continue;
       vec4 total = vec4(0.0);
       for (uint sg = 0u; sg < gl_NumSubgroups; ++sg) total += s_partial[(sg * S + k) * 3u + part];
-      const uint base = isect_ids[range.x + chunk_start + k] * GRAD2D_STRIDE;
+      const uint base = texelFetch(isect_ids, int(range.x + chunk_start + k)).x * GRAD2D_STRIDE;
       if (part == 0u)
         for (uint v = 0u; v < 4u; ++v) grad2d[base + v] = total[v];
       else if (part == 1u)

@@ -17,13 +17,12 @@
 layout(local_size_x = SPLAT_TILE_SIZE, local_size_y = SPLAT_TILE_SIZE) in;
 
 layout(std430, binding = FWD_BINDING_RANGES) readonly buffer Ranges { uvec2 ranges[]; };
-layout(std430, binding = FWD_BINDING_ISECT_IDS) readonly buffer IsectIds { uint isect_ids[]; };
-layout(std430, binding = FWD_BINDING_ISECT_GAUSSIAN) readonly buffer IsectGaussian { uint isect_gaussian[]; };
-layout(std430, binding = FWD_BINDING_MEANS2D) readonly buffer Means2d { float means2d[]; };
-layout(std430, binding = FWD_BINDING_CONICS) readonly buffer Conics { float conics[]; };
-layout(std430, binding = FWD_BINDING_DEPTHS) readonly buffer Depths { float depths[]; };
-layout(std430, binding = FWD_BINDING_OPACITIES) readonly buffer Opacities { float opacities[]; };
-layout(std430, binding = FWD_BINDING_COLORS) readonly buffer Colors { float colors[]; };
+// The per-entry reads, as texels (splat_shared.h).
+layout(binding = FWD_BINDING_ISECT_IDS) uniform usamplerBuffer isect_ids;
+layout(binding = FWD_BINDING_ISECT_GAUSSIAN) uniform usamplerBuffer isect_gaussian;
+layout(binding = FWD_BINDING_CENTRES) uniform samplerBuffer centres;
+layout(binding = FWD_BINDING_CONICS) uniform samplerBuffer conics;
+layout(binding = FWD_BINDING_COLORS) uniform samplerBuffer colors;
 layout(std430, binding = FWD_BINDING_IMAGE) buffer Image { float image[]; };
 layout(std430, binding = FWD_BINDING_DEPTH) buffer Depth { float depth_out[]; };
 layout(std430, binding = FWD_BINDING_ALPHA) buffer Alpha { float alpha_out[]; };
@@ -31,9 +30,9 @@ layout(std430, binding = FWD_BINDING_LAST) buffer Last { uint last_out[]; };
 layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]; };
 
 // Each subgroup walks the tile's list on its own, SUBGROUP-wide chunk by chunk: lane k loads entry k of the
-// chunk (one vector load per field), a ballot keeps the entries whose 1/255 footprint reaches the subgroup's
-// pixels, and every lane then reads those entries from lane k by shuffle, in list order. No shared memory,
-// no barriers; on CPU drivers a shuffle is a register permute, far cheaper than a load per entry.
+// chunk (two index fetches, two four-float fetches and the colour), a ballot keeps the entries whose 1/255
+// footprint reaches the subgroup's pixels, and every lane then reads those entries from lane k by shuffle,
+// in list order. No shared memory, no barriers; on CPU drivers a shuffle is a register permute.
 void main() {
   const uvec2 pixel = tile_pixel();
   const bool inside = pixel.x < view.width && pixel.y < view.height;
@@ -71,19 +70,17 @@ void main() {
     float depth = 0.0;
     bool relevant = false;
     if (entry < end) {
-      const uint g = isect_gaussian[isect_ids[entry]];
-      const vec3 conic = vec3(conics[3 * g], conics[3 * g + 1], conics[3 * g + 2]);
-      const float opacity = opacities[g];
-      mean_extent = vec4(means2d[2 * g], means2d[2 * g + 1], alpha_extent(conic, opacity));
-      conic_opacity = vec4(conic, opacity);
+      const int g = int(texelFetch(isect_gaussian, int(texelFetch(isect_ids, int(entry)).x)).x);
+      const vec4 centre_g = texelFetch(centres, g);  // mean2d, depth, opacity
+      const vec4 conic_g = texelFetch(conics, g);    // conic, alpha_reach(opacity)
+      mean_extent = vec4(centre_g.xy, alpha_extent(conic_g.xyz, conic_g.w));
+      conic_opacity = vec4(conic_g.xyz, centre_g.w);
+      depth = centre_g.z;
       // The bounding box only: the backward's exact ellipse test (footprint_touches_box) costs the forward
       // more than the cheap blends it skips (measured on lavapipe, docs/experiments.md).
       relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
-      // A per-lane load is the forward's main cost on lavapipe: colour and depth only for the entries kept.
-      if (relevant) {
-        for (uint c = 0u; c < CHANNELS; ++c) color[c] = colors[g * CHANNELS + c];
-        depth = depths[g];
-      }
+      if (relevant)
+        for (uint c = 0u; c < CHANNELS; ++c) color[c] = texelFetch(colors, g * int(CHANNELS) + int(c)).x;
     }
     uvec4 todo = subgroupBallot(relevant);
     for (uint word = 0u; word < 4u; ++word) {

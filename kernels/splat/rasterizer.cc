@@ -1,6 +1,7 @@
 #include "kernels/splat/rasterizer.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <stdexcept>
 #include <string>
@@ -86,9 +87,27 @@ SplatView make_splat_view(const SplatCamera& camera, uint32_t count, uint32_t sh
   return make_view(camera, count, sh_coeffs);
 }
 
+namespace {
+
+// One four-float record per Gaussian (splat_shared.h PROJECT_BINDING_CENTRES, _CONICS).
+using Float4 = std::array<float, 4>;
+
+// The rasterize kernels' per-entry reads, as texels (splat_shared.h).
+std::vector<engine::TexelBinding> rasterize_texel_bindings(uint32_t ids, uint32_t gaussians, uint32_t centres,
+                                                           uint32_t conics, uint32_t colors) {
+  return {{ids, VK_FORMAT_R32_UINT},
+          {gaussians, VK_FORMAT_R32_UINT},
+          {centres, VK_FORMAT_R32G32B32A32_SFLOAT},
+          {conics, VK_FORMAT_R32G32B32A32_SFLOAT},
+          {colors, VK_FORMAT_R32_SFLOAT}};
+}
+
+}  // namespace
+
 struct Rasterizer::Buffers {
   // Per Gaussian.
-  std::unique_ptr<DeviceArray<float>> means2d, conics, depths, opacities, colors, grad2d;
+  std::unique_ptr<DeviceArray<Float4>> centres, conics;  // [N] each
+  std::unique_ptr<DeviceArray<float>> colors, grad2d;
   std::unique_ptr<DeviceArray<uint32_t>> rects, order;
   // [N + 1]: first the depth keys, sorted in place with `order` (then dead), then the tile counts in depth
   // order, scanned in place into offsets: one buffer for two lifetimes that do not overlap.
@@ -172,12 +191,16 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   lengths_ = make("splat/tile_list_lengths", LENGTHS_BINDING_COUNT, sizeof(SplatView));
   emit_ = make("splat/emit_intersections", EMIT_BINDING_COUNT, sizeof(SplatView));
   ranges_ = make("splat/tile_ranges", RANGES_BINDING_COUNT, sizeof(SplatView));
-  forward_ = make("splat/rasterize_forward", FWD_BINDING_COUNT, sizeof(RasterizeParams));
+  forward_ = make("splat/rasterize_forward", FWD_BINDING_COUNT, sizeof(RasterizeParams), {},
+                  rasterize_texel_bindings(FWD_BINDING_ISECT_IDS, FWD_BINDING_ISECT_GAUSSIAN,
+                                           FWD_BINDING_CENTRES, FWD_BINDING_CONICS, FWD_BINDING_COLORS));
   const char* backward = options_.deterministic ? "splat/rasterize_backward_deterministic"
                          : uses_float_atomics() ? "splat/rasterize_backward_float_atomics"
                                                 : "splat/rasterize_backward_cas_atomics";
   backward_ = make(backward, BWD_BINDING_COUNT, sizeof(RasterizeParams),
-                   {{2, options_.depth_gradient_to_opacity ? 1u : 0u}});
+                   {{2, options_.depth_gradient_to_opacity ? 1u : 0u}},
+                   rasterize_texel_bindings(BWD_BINDING_ISECT_IDS, BWD_BINDING_ISECT_GAUSSIAN,
+                                            BWD_BINDING_CENTRES, BWD_BINDING_CONICS, BWD_BINDING_COLORS));
   reduce_ = make("splat/reduce_isect_grads", REDUCE_BINDING_COUNT, sizeof(SplatView));
   project_backward_ = make("splat/project_backward", PBWD_BINDING_COUNT, sizeof(SplatView),
                            {{2, options_.sh_gradient ? 1u : 0u}});
@@ -222,12 +245,14 @@ bool Rasterizer::uses_float_atomics() const {
 
 std::unique_ptr<engine::Kernel> Rasterizer::make(const char* name, uint32_t bindings,
                                                  uint32_t push_constant_bytes,
-                                                 std::vector<engine::SpecConstant> extra_constants) {
+                                                 std::vector<engine::SpecConstant> extra_constants,
+                                                 std::vector<engine::TexelBinding> texel_bindings) {
   engine::KernelDesc desc;
   desc.name = name;
   desc.spirv = spirv(name);
   desc.binding_count = bindings;
   desc.push_constant_bytes = push_constant_bytes;
+  desc.texel_bindings = std::move(texel_bindings);
   desc.spec_constants = {{1, channels_}};
   desc.spec_constants.insert(desc.spec_constants.end(), extra_constants.begin(), extra_constants.end());
   return std::make_unique<engine::Kernel>(*context_, std::move(desc));
@@ -267,10 +292,8 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
                                 std::to_string(camera.height) + " pixels is more than 2^24 tiles");
   const size_t corner_cells = static_cast<size_t>(view.tiles_x + 1) * (view.tiles_y + 1);
 
-  grow(ctx, b.means2d, 2 * size_t{n}, "splat: means2d");
-  grow(ctx, b.conics, 3 * size_t{n}, "splat: conics");
-  grow(ctx, b.depths, n, "splat: depths");
-  grow(ctx, b.opacities, n, "splat: opacities");
+  grow(ctx, b.centres, n, "splat: centres");  // mean2d, depth, opacity
+  grow(ctx, b.conics, n, "splat: conics");    // conic, alpha reach
   grow(ctx, b.colors, size_t{n} * channels_, "splat: colors");
   grow(ctx, b.rects, 2 * size_t{n}, "splat: tile rects");  // packed 16-bit (splat/tile_rect.glsl)
   grow(ctx, b.order, n, "splat: depth order");
@@ -291,10 +314,8 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
                {PROJECT_BINDING_QUATS, &g.quats.buffer(), Access::kRead},
                {PROJECT_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kRead},
                {PROJECT_BINDING_SH, &g.sh.buffer(), Access::kRead},
-               {PROJECT_BINDING_MEANS2D, &b.means2d->buffer(), Access::kWrite},
+               {PROJECT_BINDING_CENTRES, &b.centres->buffer(), Access::kWrite},
                {PROJECT_BINDING_CONICS, &b.conics->buffer(), Access::kWrite},
-               {PROJECT_BINDING_DEPTHS, &b.depths->buffer(), Access::kWrite},
-               {PROJECT_BINDING_OPACITIES, &b.opacities->buffer(), Access::kWrite},
                {PROJECT_BINDING_COLORS, &b.colors->buffer(), Access::kWrite},
                {PROJECT_BINDING_TILE_RECTS, &b.rects->buffer(), Access::kWrite},
                {PROJECT_BINDING_DEPTH_KEYS, &b.keys_then_offsets->buffer(), Access::kWrite},
@@ -365,10 +386,8 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
                 {{FWD_BINDING_RANGES, &b.ranges->buffer(), Access::kRead},
                  {FWD_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kRead},
                  {FWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
-                 {FWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
+                 {FWD_BINDING_CENTRES, &b.centres->buffer(), Access::kRead},
                  {FWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
-                 {FWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
-                 {FWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
                  {FWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
                  {FWD_BINDING_IMAGE, &b.image->buffer(), Access::kReadWrite},
                  {FWD_BINDING_DEPTH, &b.depth->buffer(), Access::kReadWrite},
@@ -468,10 +487,8 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
                {{BWD_BINDING_RANGES, &b.ranges->buffer(), Access::kRead},
                 {BWD_BINDING_ISECT_IDS, &b.isect_ids->buffer(), Access::kRead},
                 {BWD_BINDING_ISECT_GAUSSIAN, &b.isect_gaussian->buffer(), Access::kRead},
-                {BWD_BINDING_MEANS2D, &b.means2d->buffer(), Access::kRead},
+                {BWD_BINDING_CENTRES, &b.centres->buffer(), Access::kRead},
                 {BWD_BINDING_CONICS, &b.conics->buffer(), Access::kRead},
-                {BWD_BINDING_DEPTHS, &b.depths->buffer(), Access::kRead},
-                {BWD_BINDING_OPACITIES, &b.opacities->buffer(), Access::kRead},
                 {BWD_BINDING_COLORS, &b.colors->buffer(), Access::kRead},
                 {BWD_BINDING_DEPTH, &b.depth->buffer(), Access::kRead},
                 {BWD_BINDING_ALPHA, &b.alpha->buffer(), Access::kRead},

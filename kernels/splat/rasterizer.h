@@ -140,7 +140,8 @@ class Rasterizer {
  private:
   struct Buffers;
   std::unique_ptr<engine::Kernel> make(const char* name, uint32_t bindings, uint32_t push_constant_bytes,
-                                       std::vector<engine::SpecConstant> extra_constants = {});
+                                       std::vector<engine::SpecConstant> extra_constants = {},
+                                       std::vector<engine::TexelBinding> texel_bindings = {});
   uint32_t passes_for(uint32_t entries_per_pass) const;
   void append_profile(const engine::Sequence& sequence);
 

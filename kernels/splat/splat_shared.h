@@ -34,17 +34,17 @@ using uint = uint32_t;
 #define PROJECT_BINDING_QUATS 2           // [N][4] w x y z, unnormalized
 #define PROJECT_BINDING_OPACITY_LOGITS 3  // [N]
 #define PROJECT_BINDING_SH 4              // [N][K][C] K = (max degree + 1)^2 of the model
-#define PROJECT_BINDING_MEANS2D 5         // [N][2] pixels (out)
-#define PROJECT_BINDING_CONICS 6          // [N][3] inverse 2D covariance a b c (out)
-#define PROJECT_BINDING_DEPTHS 7          // [N] camera z (out)
-#define PROJECT_BINDING_OPACITIES 8       // [N] sigmoid(logit) (out)
-#define PROJECT_BINDING_COLORS 9          // [N][C] (out)
+// The projected Gaussian as two four-float records, so that the rasterize kernels read each with one texel
+// fetch (engine/kernel.h TexelBinding: on CPU drivers one vector gather instead of a loop over the lanes).
+#define PROJECT_BINDING_CENTRES 5  // [N][4] mean2d x, y (pixels), camera z, opacity (out)
+#define PROJECT_BINDING_CONICS 6   // [N][4] inverse 2D covariance a b c, ln(max(255 opacity, 1)) (out)
+#define PROJECT_BINDING_COLORS 7   // [N][C] (out)
 #define PROJECT_BINDING_TILE_RECTS \
-  10  // [N][2] tile x0 y0 x1 y1, half-open, 16 bits each (tile_rect.glsl); empty if culled (out)
-#define PROJECT_BINDING_DEPTH_KEYS 11  // [N] sortable depth bits, 0xFFFFFFFF if culled (out)
-#define PROJECT_BINDING_ORDER 12       // [N] identity permutation, the depth sort's values (out)
-#define PROJECT_BINDING_COUNTERS 13    // [SPLAT_COUNTER_COUNT] uint, see SPLAT_COUNTER_*
-#define PROJECT_BINDING_COUNT 14
+  8  // [N][2] tile x0 y0 x1 y1, half-open, 16 bits each (tile_rect.glsl); empty if culled (out)
+#define PROJECT_BINDING_DEPTH_KEYS 9  // [N] sortable depth bits, 0xFFFFFFFF if culled (out)
+#define PROJECT_BINDING_ORDER 10      // [N] identity permutation, the depth sort's values (out)
+#define PROJECT_BINDING_COUNTERS 11   // [SPLAT_COUNTER_COUNT] uint, see SPLAT_COUNTER_*
+#define PROJECT_BINDING_COUNT 12
 
 // ---- The rasterizer's counters buffer: [SPLAT_COUNTER_COUNT] uint ----
 // Zeroed by every forward: culls, the intersection total and the longest tile list of that render.
@@ -102,43 +102,40 @@ using uint = uint32_t;
 // w * z, alpha = the transmittance T, last = the walk length | FWD_LAST_DONE once the pixel has stopped.
 // A tile's final pass (its list ends within the segment) writes the outputs proper.
 #define FWD_LAST_DONE 0x80000000u
+// The bindings marked (texels) are read as uniform texel buffers, in the format named.
 #define FWD_BINDING_RANGES 0
-#define FWD_BINDING_ISECT_IDS 1       // [M] sorted by tile, depth order within a tile
-#define FWD_BINDING_ISECT_GAUSSIAN 2  // [M]
-#define FWD_BINDING_MEANS2D 3
-#define FWD_BINDING_CONICS 4
-#define FWD_BINDING_DEPTHS 5
-#define FWD_BINDING_OPACITIES 6
-#define FWD_BINDING_COLORS 7
-#define FWD_BINDING_IMAGE 8      // [C][H][W] (out)
-#define FWD_BINDING_DEPTH 9      // [H][W] expected depth sum(w z)/sum(w) (out)
-#define FWD_BINDING_ALPHA 10     // [H][W] accumulated alpha = 1 - T (out)
-#define FWD_BINDING_LAST 11      // [H][W] number of list entries the pixel walked (out)
-#define FWD_BINDING_COUNTERS 12  // SPLAT_COUNTER_FORWARD_WALKS_CUT (atomic)
-#define FWD_BINDING_COUNT 13
+#define FWD_BINDING_ISECT_IDS 1       // [M] sorted by tile, depth order within a tile (texels, R32_UINT)
+#define FWD_BINDING_ISECT_GAUSSIAN 2  // [M] (texels, R32_UINT)
+#define FWD_BINDING_CENTRES 3         // [N][4] (texels, R32G32B32A32_SFLOAT)
+#define FWD_BINDING_CONICS 4          // [N][4] (texels, R32G32B32A32_SFLOAT)
+#define FWD_BINDING_COLORS 5          // [N][C] (texels, R32_SFLOAT)
+#define FWD_BINDING_IMAGE 6           // [C][H][W] (out)
+#define FWD_BINDING_DEPTH 7           // [H][W] expected depth sum(w z)/sum(w) (out)
+#define FWD_BINDING_ALPHA 8           // [H][W] accumulated alpha = 1 - T (out)
+#define FWD_BINDING_LAST 9            // [H][W] number of list entries the pixel walked (out)
+#define FWD_BINDING_COUNTERS 10       // SPLAT_COUNTER_FORWARD_WALKS_CUT (atomic)
+#define FWD_BINDING_COUNT 11
 
 // ---- rasterize_backward.comp: one workgroup per tile and pass ----
 // Passes run from the last list segment to the first. A pixel's running state (transmittance, the colour
 // and depth sums of what lies behind) is stored in BWD_BINDING_STATE by the pass that walks past it and
 // loaded by the next; a pixel whose walk ends before a pass's segment starts from the forward's results.
 #define BWD_BINDING_RANGES 0
-#define BWD_BINDING_ISECT_IDS 1
-#define BWD_BINDING_ISECT_GAUSSIAN 2
-#define BWD_BINDING_MEANS2D 3
-#define BWD_BINDING_CONICS 4
-#define BWD_BINDING_DEPTHS 5
-#define BWD_BINDING_OPACITIES 6
-#define BWD_BINDING_COLORS 7
-#define BWD_BINDING_DEPTH 8  // forward expected depth
-#define BWD_BINDING_ALPHA 9  // forward accumulated alpha
-#define BWD_BINDING_LAST 10
-#define BWD_BINDING_GRAD_IMAGE 11  // [C][H][W]
-#define BWD_BINDING_GRAD_DEPTH 12  // [H][W]
-#define BWD_BINDING_GRAD_ALPHA 13  // [H][W]
-#define BWD_BINDING_GRAD2D 14      // atomic mode: [N][7 + C] float; deterministic: [M][7 + C]
-#define BWD_BINDING_STATE 15       // [2 + C][H][W]: T, depth sum, colour sums (single pass: unused)
-#define BWD_BINDING_COUNTERS 16    // SPLAT_COUNTER_BACKWARD_WALKS_CUT (atomic)
-#define BWD_BINDING_COUNT 17
+#define BWD_BINDING_ISECT_IDS 1       // (texels, R32_UINT)
+#define BWD_BINDING_ISECT_GAUSSIAN 2  // (texels, R32_UINT)
+#define BWD_BINDING_CENTRES 3         // (texels, R32G32B32A32_SFLOAT)
+#define BWD_BINDING_CONICS 4          // (texels, R32G32B32A32_SFLOAT)
+#define BWD_BINDING_COLORS 5          // (texels, R32_SFLOAT)
+#define BWD_BINDING_DEPTH 6           // forward expected depth
+#define BWD_BINDING_ALPHA 7           // forward accumulated alpha
+#define BWD_BINDING_LAST 8
+#define BWD_BINDING_GRAD_IMAGE 9   // [C][H][W]
+#define BWD_BINDING_GRAD_DEPTH 10  // [H][W]
+#define BWD_BINDING_GRAD_ALPHA 11  // [H][W]
+#define BWD_BINDING_GRAD2D 12      // atomic mode: [N][7 + C] float; deterministic: [M][7 + C]
+#define BWD_BINDING_STATE 13       // [2 + C][H][W]: T, depth sum, colour sums (single pass: unused)
+#define BWD_BINDING_COUNTERS 14    // SPLAT_COUNTER_BACKWARD_WALKS_CUT (atomic)
+#define BWD_BINDING_COUNT 15
 
 // ---- reduce_isect_grads.comp (deterministic mode): one invocation per depth-sorted position ----
 #define REDUCE_BINDING_ORDER 0

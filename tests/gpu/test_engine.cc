@@ -8,6 +8,7 @@
 #include "engine/sequence.h"
 #include "engine/vk_check.h"
 #include "gpu_test.h"
+#include "kernels/bench/gather_bench.h"
 #include "kernels/scan/scan_shared.h"
 #include "kernels/spirv_registry.h"
 #include "kernels/subgroup_kernel.h"
@@ -201,6 +202,92 @@ TEST_F(EngineTest, SequenceReplays) {
   seq.fill(a.buffer(), 5u, 32);
   seq.submit_and_wait();
   EXPECT_EQ(a.download(), std::vector<uint32_t>(8, 5u));
+}
+
+// The three ways of reading records (storage floats, storage vec4, texel fetches) return the same sums, equal
+// to the reference: a texel binding reads the buffer it is given, element by element.
+TEST_F(EngineTest, TexelReadsReturnWhatTheBufferHolds) {
+  const kernels::GatherBenchParams params{1001, 37};  // not a power of two: indices wrap unevenly
+  const uint32_t invocations = 2 * GATHER_BENCH_GROUP_SIZE;
+  std::vector<float> records(size_t{params.records} * 4);
+  for (size_t k = 0; k < records.size(); ++k) records[k] = static_cast<float>((k * 7) % 97) - 40.0f;
+  engine::DeviceArray<float> d_records(context(), "records", records.size());
+  d_records.upload(records);
+  const std::vector<double> expected = kernels::gather_bench_reference(records, invocations, params);
+  for (auto read : {kernels::GatherRead::kStorageFloats, kernels::GatherRead::kStorageVec4,
+                    kernels::GatherRead::kTexelVec4}) {
+    engine::DeviceArray<float> sums(context(), "sums", size_t{invocations} * 4);
+    kernels::GatherBench bench(context(), read);
+    engine::Sequence seq(context());
+    bench.record(seq, d_records, sums, params);
+    seq.submit_and_wait();
+    const std::vector<float> got = sums.download();
+    for (size_t k = 0; k < got.size(); ++k)
+      ASSERT_EQ(static_cast<double>(got[k]), expected[k])
+          << kernels::gather_read_name(read) << ", value " << k;
+  }
+}
+
+TEST_F(EngineTest, TexelBindingsAreCheckedWhenTheKernelIsBuilt) {
+  const auto desc_with = [&](std::vector<engine::TexelBinding> texels) {
+    engine::KernelDesc desc;
+    desc.name = "bench/gather_texel";
+    desc.spirv = kernels::spirv(desc.name);
+    desc.binding_count = GATHER_BENCH_BINDING_COUNT;
+    desc.push_constant_bytes = sizeof(kernels::GatherBenchParams);
+    desc.texel_bindings = std::move(texels);
+    return desc;
+  };
+  const VkFormat rgba = VK_FORMAT_R32G32B32A32_SFLOAT;
+  EXPECT_NO_THROW(engine::Kernel(context(), desc_with({{GATHER_BENCH_BINDING_RECORDS, rgba}})));
+  EXPECT_THROW(engine::Kernel(context(), desc_with({{GATHER_BENCH_BINDING_COUNT, rgba}})),
+               std::invalid_argument)
+      << "index out of range";
+  EXPECT_THROW(engine::Kernel(context(), desc_with({{0, rgba}, {0, rgba}})), std::invalid_argument)
+      << "repeated";
+  try {
+    engine::Kernel kernel(context(), desc_with({{0, VK_FORMAT_R8G8B8A8_UNORM}}));
+    FAIL() << "a format the engine does not size";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("R32G32B32A32_SFLOAT"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(EngineTest, TexelBindingsAreReadOnlyAndViewWholeElements) {
+  kernels::GatherBench bench(context(), kernels::GatherRead::kTexelVec4);
+  engine::DeviceArray<float> one_float(context(), "one float", 1), sums(context(), "sums", 4 * 64);
+  engine::Sequence seq(context());
+  try {  // 4 bytes hold no four-float element: the view is refused, naming the buffer
+    bench.record(seq, one_float, sums, {1, 1});
+    FAIL() << "the record check should refuse one float as a record";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("1 records"), std::string::npos) << e.what();
+  }
+  try {
+    (void)one_float.buffer().texel_view(VK_FORMAT_R32G32B32A32_SFLOAT);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("one float"), std::string::npos) << e.what();
+  }
+  EXPECT_NE(one_float.buffer().texel_view(VK_FORMAT_R32_SFLOAT), VkBufferView{VK_NULL_HANDLE});
+  EXPECT_EQ(one_float.buffer().texel_view(VK_FORMAT_R32_SFLOAT),
+            one_float.buffer().texel_view(VK_FORMAT_R32_SFLOAT))
+      << "a view is made once per format";
+
+  engine::KernelDesc desc;
+  desc.name = "bench/gather_texel";
+  desc.spirv = kernels::spirv(desc.name);
+  desc.binding_count = GATHER_BENCH_BINDING_COUNT;
+  desc.push_constant_bytes = sizeof(kernels::GatherBenchParams);
+  desc.texel_bindings = {{GATHER_BENCH_BINDING_RECORDS, VK_FORMAT_R32G32B32A32_SFLOAT}};
+  engine::Kernel kernel(context(), std::move(desc));
+  engine::DeviceArray<float> records(context(), "records", 4);
+  EXPECT_THROW(seq.dispatch(kernel, {1},
+                            {{GATHER_BENCH_BINDING_RECORDS, &records.buffer(), Access::kReadWrite},
+                             {GATHER_BENCH_BINDING_SUMS, &sums.buffer(), Access::kWrite}},
+                            kernels::GatherBenchParams{1, 1}),
+               std::invalid_argument)
+      << "a texel binding is read-only";
 }
 
 TEST(EngineNoDevice, SelectorThatMatchesNothingIsNamed) {
