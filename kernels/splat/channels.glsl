@@ -11,6 +11,9 @@ vec4 channels_fma(vec4 acc, float w, vec4 c) {
   return CHANNELS == 1u ? vec4(acc.x + w * c.x, 0.0, 0.0, 0.0) : acc + w * c;
 }
 
+// a + b
+vec4 channels_add(vec4 a, vec4 b) { return CHANNELS == 1u ? vec4(a.x + b.x, 0.0, 0.0, 0.0) : a + b; }
+
 // w * c
 vec4 channels_scale(float w, vec4 c) { return CHANNELS == 1u ? vec4(w * c.x, 0.0, 0.0, 0.0) : w * c; }
 

@@ -23,17 +23,17 @@ bool footprint_reaches(vec4 mean_extent, vec2 lo, vec2 hi) {
 // no result and keeps exp() away from denormals, which are very slow on CPUs.
 const float SIGMA_CUTOFF = 30.0;
 
-// The pixel of this invocation. A tile's pixels are numbered in Z (Morton) order, so that a subgroup of S
-// consecutive invocations covers a compact block (S = 8: 4x2, 16: 4x4, 32: 8x4) instead of a one-pixel-high
-// strip: fewer of the tile's footprints reach a compact block, and the subgroup skips the rest.
-#if SPLAT_TILE_SIZE != 16
-#error "tile_pixel() numbers the pixels of a 16x16 tile"
+// The origin of this invocation's 2x2 pixels: invocation i of the tile's SPLAT_QUAD_GRID^2 grid of quads,
+// in Z (Morton) order, so that a subgroup of S invocations covers a compact block (S = 8: 8x4 pixels, 32:
+// 16x8) and skips the footprints that miss it.
+#if SPLAT_TILE_SIZE != 16 || SPLAT_QUAD_GRID != 8
+#error "quad_origin() numbers the 2x2 quads of a 16x16 tile"
 #endif
-uvec2 tile_pixel() {
+uvec2 quad_origin() {
   const uint i = gl_LocalInvocationIndex;
-  const uint x = (i & 1u) | ((i >> 1u) & 2u) | ((i >> 2u) & 4u) | ((i >> 3u) & 8u);
-  const uint y = ((i >> 1u) & 1u) | ((i >> 2u) & 2u) | ((i >> 3u) & 4u) | ((i >> 4u) & 8u);
-  return gl_WorkGroupID.xy * uint(SPLAT_TILE_SIZE) + uvec2(x, y);
+  const uint x = (i & 1u) | ((i >> 1u) & 2u) | ((i >> 2u) & 4u);
+  const uint y = ((i >> 1u) & 1u) | ((i >> 2u) & 2u) | ((i >> 3u) & 4u);
+  return gl_WorkGroupID.xy * uint(SPLAT_TILE_SIZE) + 2u * uvec2(x, y);
 }
 
 // sigma along the edge x = dx (relative to the mean) of a box, at its smallest: dy = -(b / c) dx clamped

@@ -1,5 +1,5 @@
-// One workgroup per tile, one invocation per pixel: walk the tile's list back to front from each pixel's
-// last contributor, recovering transmittance by division (alpha <= 0.99 keeps it stable), and turn the
+// One workgroup per tile, one invocation per 2x2 pixels (as rasterize_forward.comp, for the same reason):
+// walk the tile's list back to front from each pixel's last contributor, recovering transmittance by division (alpha <= 0.99 keeps it stable), and turn the
 // pixel's upstream gradients into per-Gaussian gradients of (mean2d, conic, opacity, depth, colour).
 //
 // The including .comp defines SPLAT_BWD_MODE:
@@ -19,7 +19,7 @@
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
 
-layout(local_size_x = SPLAT_TILE_SIZE, local_size_y = SPLAT_TILE_SIZE) in;
+layout(local_size_x = SPLAT_QUAD_GRID, local_size_y = SPLAT_QUAD_GRID) in;
 
 layout(std430, binding = BWD_BINDING_RANGES) readonly buffer Ranges { uvec2 ranges[]; };
 // The per-entry reads, as texels (splat_shared.h).
@@ -54,11 +54,28 @@ struct EntryGrad {
   vec4 g0, g1, g2;
 };
 
-// One list entry, walked back to front. `in_walk`: the entry lies within this pixel's forward walk.
-// Updates the running transmittance and the sums of what lies behind. Predicated, not branched.
-EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4 color, float depth,
-                         bool in_walk, float T_final, vec4 dL_dC, float dL_dN, float dL_dA, inout float T,
-                         inout vec4 acc_c, inout float acc_z) {
+// One pixel's backward state: its upstream gradients and, walking back to front, the transmittance and the
+// sums of what lies behind. Four per invocation, as separate variables (CPU drivers spill arrays).
+struct PixelGrad {
+  uint pix;    // index in the [H][W] planes
+  uint last;   // entries the forward walked (0 outside the image)
+  vec2 centre;
+  float T_final;
+  vec4 dL_dC;
+  float dL_dN, dL_dA;
+  float T;
+  vec4 acc_c;
+  float acc_z;
+};
+
+// One list entry (`entry`, counted from the list start), walked back to front, for one pixel: updates the
+// pixel's running state. Predicated, not branched.
+EntryGrad entry_backward(inout PixelGrad p, vec4 mean_extent, vec4 conic_opacity, vec4 color, float depth,
+                         uint entry) {
+  const bool in_walk = entry < p.last;  // the entry lies within this pixel's forward walk
+  const vec2 centre = p.centre;
+  const float T_final = p.T_final, dL_dN = p.dL_dN, dL_dA = p.dL_dA, T = p.T, acc_z = p.acc_z;
+  const vec4 dL_dC = p.dL_dC, acc_c = p.acc_c;
   const vec2 d = centre - mean_extent.xy;
   const float sigma = gaussian_sigma(conic_opacity.xyz, d);
   const float vis = exp(-min(sigma, SIGMA_CUTOFF));
@@ -85,9 +102,9 @@ EntryGrad entry_backward(vec2 centre, vec4 mean_extent, vec4 conic_opacity, vec4
               dL_dsigma * d.x * d.y);
   r.g1 = vec4(dL_dsigma * 0.5 * d.y * d.y, dL_dopacity * vis, w * dL_dN, 0.0);
   r.g2 = channels_scale(w, dL_dC);
-  acc_c = channels_fma(acc_c, w, color);
-  acc_z += w * depth;
-  T = hit ? Ti : T;
+  p.acc_c = channels_fma(acc_c, w, color);
+  p.acc_z = acc_z + w * depth;
+  p.T = hit ? Ti : T;
   return r;
 }
 
@@ -132,8 +149,8 @@ void subgroup_sum3(inout vec4 a, inout vec4 b, inout vec4 c) {
 }
 
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
-// Per chunk, each lane's entry sums of each subgroup: [subgroup * S + lane][3] (subgroups x S = 256).
-const uint WORKGROUP_INVOCATIONS = SPLAT_TILE_SIZE * SPLAT_TILE_SIZE;
+// Per chunk, each lane's entry sums of each subgroup: [subgroup * S + lane][3] (subgroups x S = 64).
+const uint WORKGROUP_INVOCATIONS = SPLAT_QUAD_GRID * SPLAT_QUAD_GRID;
 shared vec4 s_partial[WORKGROUP_INVOCATIONS * 3];
 shared uint s_walk;
 #else
@@ -162,11 +179,11 @@ void add_entry_grads(uint g, vec4 a0, vec4 a1, vec4 a2) {
 
 // The entry sums of one chunk of the list, [chunk_start, chunk_end) relative to the list start, walked back
 // to front: lane k loads entry chunk_start + k, a ballot keeps entries whose footprint reaches the subgroup,
-// and the lanes take them from lane k by shuffle, last to first. Lane k returns its entry's subgroup sums.
-void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 centre, vec2 subgroup_lo,
-                    vec2 subgroup_hi, uint my_last, float T_final, vec4 dL_dC, float dL_dN, float dL_dA,
-                    inout float T, inout vec4 acc_c, inout float acc_z, out uint g, out bool relevant,
-                    out vec4 a0, out vec4 a1, out vec4 a2) {
+// and the lanes take them from lane k by shuffle, last to first, each for its four pixels. Lane k returns its
+// entry's sums over the subgroup's pixels.
+void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 subgroup_lo, vec2 subgroup_hi,
+                    inout PixelGrad p0, inout PixelGrad p1, inout PixelGrad p2, inout PixelGrad p3, out uint g,
+                    out bool relevant, out vec4 a0, out vec4 a1, out vec4 a2) {
   const uint rel = chunk_start + gl_SubgroupInvocationID;
   g = 0u;
   vec4 mean_extent = vec4(0.0), conic_opacity = vec4(0.0), color = vec4(0.0);
@@ -188,11 +205,16 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 cent
       const uint bit = uint(findMSB(todo[word]));
       todo[word] &= ~(1u << bit);
       const uint k = 32u * uint(word) + bit;
-      const EntryGrad r =
-          entry_backward(centre, subgroupShuffle(mean_extent, k), subgroupShuffle(conic_opacity, k),
-                         channels_shuffle(color, k), subgroupShuffle(depth, k), chunk_start + k < my_last,
-                         T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z);
-      vec4 s0 = r.g0, s1 = r.g1, s2 = r.g2;
+      const vec4 me = subgroupShuffle(mean_extent, k), co = subgroupShuffle(conic_opacity, k);
+      const vec4 col = channels_shuffle(color, k);
+      const float dep = subgroupShuffle(depth, k);
+      const uint entry = chunk_start + k;
+      const EntryGrad r0 = entry_backward(p0, me, co, col, dep, entry);
+      const EntryGrad r1 = entry_backward(p1, me, co, col, dep, entry);
+      const EntryGrad r2 = entry_backward(p2, me, co, col, dep, entry);
+      const EntryGrad r3 = entry_backward(p3, me, co, col, dep, entry);
+      vec4 s0 = (r0.g0 + r1.g0) + (r2.g0 + r3.g0), s1 = (r0.g1 + r1.g1) + (r2.g1 + r3.g1);
+      vec4 s2 = channels_add(channels_add(r0.g2, r1.g2), channels_add(r2.g2, r3.g2));
       subgroup_sum3(s0, s1, s2);
       if (gl_SubgroupInvocationID == k) {
         a0 = s0;
@@ -208,39 +230,56 @@ uint chunk_start_below(uint chunk_end) {
   return chunk_end > segment.begin + gl_SubgroupSize ? chunk_end - gl_SubgroupSize : segment.begin;
 }
 
-void main() {
-  const uvec2 pixel = tile_pixel();
+// The pixel's upstream gradients and its state at the start of this pass: the forward's results, or, for a
+// pixel whose walk reaches past this segment, the state the previous pass (the segment after) stored.
+PixelGrad start_pixel(uvec2 pixel, uint plane) {
+  PixelGrad p;
   const bool inside = pixel.x < view.width && pixel.y < view.height;
+  p.pix = pixel.y * view.width + pixel.x;
+  p.centre = vec2(pixel) + 0.5;
+  p.last = inside ? fwd_last[p.pix] : 0u;
+  const float A = inside ? fwd_alpha[p.pix] : 0.0;
+  p.T_final = 1.0 - A;
+  const bool has_depth = A >= float(SPLAT_MIN_DEPTH_WEIGHT);
+  const float g_depth = inside ? grad_depth[p.pix] : 0.0;
+  const float D = inside ? fwd_depth[p.pix] : 0.0;
+  p.dL_dN = has_depth ? g_depth / A : 0.0;
+  p.dL_dA = (inside ? grad_alpha[p.pix] : 0.0) - (has_depth ? g_depth * D / A : 0.0);
+  p.dL_dC = vec4(0.0);
+  for (uint c = 0u; c < CHANNELS; ++c) p.dL_dC[c] = inside ? grad_image[c * plane + p.pix] : 0.0;
+  p.T = p.T_final;
+  p.acc_c = vec4(0.0);
+  p.acc_z = 0.0;
+  if (p.last > segment.end) {
+    p.T = state[p.pix];
+    p.acc_z = state[plane + p.pix];
+    for (uint c = 0u; c < CHANNELS; ++c) p.acc_c[c] = state[(2u + c) * plane + p.pix];
+  }
+  return p;
+}
+
+// A pixel walked in this pass whose walk goes on in the next pass (the segment before) hands over its state.
+void hand_over(PixelGrad p, uint plane) {
+  if (segment.begin == 0u || p.last <= segment.begin) return;
+  state[p.pix] = p.T;
+  state[plane + p.pix] = p.acc_z;
+  for (uint c = 0u; c < CHANNELS; ++c) state[(2u + c) * plane + p.pix] = p.acc_c[c];
+}
+
+void main() {
+  const uvec2 base = quad_origin();
   const uint tile = gl_WorkGroupID.y * view.tiles_x + gl_WorkGroupID.x;
   const uvec2 range = ranges[tile];
-  const uint pix = pixel.y * view.width + pixel.x;
   const uint plane = view.width * view.height;
-
-  const vec2 centre = vec2(pixel) + 0.5;
-  const uint my_last = inside ? fwd_last[pix] : 0u;
+  PixelGrad p0 = start_pixel(base, plane);
+  PixelGrad p1 = start_pixel(base + uvec2(1u, 0u), plane);
+  PixelGrad p2 = start_pixel(base + uvec2(0u, 1u), plane);
+  PixelGrad p3 = start_pixel(base + uvec2(1u, 1u), plane);
+  const uint my_last = max(max(p0.last, p1.last), max(p2.last, p3.last));
 #if SPLAT_BWD_MODE != SPLAT_BWD_DETERMINISTIC
   if (subgroupAll(my_last <= segment.begin)) return;  // nothing of this subgroup's walks lies in this pass
 #endif
-  const float A = inside ? fwd_alpha[pix] : 0.0;
-  const float T_final = 1.0 - A;
-  const bool has_depth = A >= float(SPLAT_MIN_DEPTH_WEIGHT);
-  const float g_depth = inside ? grad_depth[pix] : 0.0;
-  const float D = inside ? fwd_depth[pix] : 0.0;
-  const float dL_dN = has_depth ? g_depth / A : 0.0;
-  const float dL_dA = (inside ? grad_alpha[pix] : 0.0) - (has_depth ? g_depth * D / A : 0.0);
-  vec4 dL_dC = vec4(0.0);
-  for (uint c = 0u; c < CHANNELS; ++c) dL_dC[c] = inside ? grad_image[c * plane + pix] : 0.0;
-
-  // A pixel whose walk reaches past this segment was walked by the previous pass, which stored its state.
-  float T = T_final;
-  vec4 acc_c = vec4(0.0);
-  float acc_z = 0.0;
-  if (my_last > segment.end) {
-    T = state[pix];
-    acc_z = state[plane + pix];
-    for (uint c = 0u; c < CHANNELS; ++c) acc_c[c] = state[(2u + c) * plane + pix];
-  }
-  const vec2 subgroup_lo = subgroupMin(centre), subgroup_hi = subgroupMax(centre);
+  const vec2 subgroup_lo = subgroupMin(p0.centre), subgroup_hi = subgroupMax(p3.centre);
   uint chunk_end;
 
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
@@ -257,8 +296,8 @@ void main() {
     uint g;
     bool relevant;
     vec4 a0, a1, a2;
-    chunk_backward(range.x, chunk_start, chunk_end, centre, subgroup_lo, subgroup_hi, my_last, T_final, dL_dC,
-                   dL_dN, dL_dA, T, acc_c, acc_z, g, relevant, a0, a1, a2);
+    chunk_backward(range.x, chunk_start, chunk_end, subgroup_lo, subgroup_hi, p0, p1, p2, p3, g, relevant, a0,
+                   a1, a2);
     const uint slot = (gl_SubgroupID * S + gl_SubgroupInvocationID) * 3u;
     s_partial[slot] = a0;
     s_partial[slot + 1u] = a1;
@@ -289,18 +328,15 @@ void main() {
     uint g;
     bool relevant;
     vec4 a0, a1, a2;
-    chunk_backward(range.x, chunk_start_below(chunk_end), chunk_end, centre, subgroup_lo, subgroup_hi,
-                   my_last, T_final, dL_dC, dL_dN, dL_dA, T, acc_c, acc_z, g, relevant, a0, a1, a2);
+    chunk_backward(range.x, chunk_start_below(chunk_end), chunk_end, subgroup_lo, subgroup_hi, p0, p1, p2, p3, g,
+                   relevant, a0, a1, a2);
     if (relevant) add_entry_grads(g, a0, a1, a2);
   }
   if (chunk_end > segment.begin && subgroupElect()) atomicAdd(counters[SPLAT_COUNTER_BACKWARD_WALKS_CUT], 1u);
 #endif
 
-  // Pixels walked in this pass whose walk goes on in the next pass (the segment before) hand over their
-  // state.
-  if (segment.begin > 0u && my_last > segment.begin) {
-    state[pix] = T;
-    state[plane + pix] = acc_z;
-    for (uint c = 0u; c < CHANNELS; ++c) state[(2u + c) * plane + pix] = acc_c[c];
-  }
+  hand_over(p0, plane);
+  hand_over(p1, plane);
+  hand_over(p2, plane);
+  hand_over(p3, plane);
 }

@@ -4,8 +4,8 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_shuffle : require
-// One workgroup per 16x16 tile, one invocation per pixel: alpha-blend the tile's list front to back, one list
-// segment per pass (splat_shared.h: a long list takes several passes, carrying the blend state).
+// One workgroup per 16x16 tile, one invocation per 2x2 pixels: alpha-blend the tile's list front to back, one
+// list segment per pass (splat_shared.h: a long list takes several passes, carrying the blend state).
 #define SPLAT_RASTERIZE_PASS
 #include "limits.h"
 #include "splat/splat_shared.h"
@@ -14,7 +14,7 @@
 #include "splat/footprint.glsl"
 #include "splat/channels.glsl"
 
-layout(local_size_x = SPLAT_TILE_SIZE, local_size_y = SPLAT_TILE_SIZE) in;
+layout(local_size_x = SPLAT_QUAD_GRID, local_size_y = SPLAT_QUAD_GRID) in;
 
 layout(std430, binding = FWD_BINDING_RANGES) readonly buffer Ranges { uvec2 ranges[]; };
 // The per-entry reads, as texels (splat_shared.h).
@@ -29,50 +29,112 @@ layout(std430, binding = FWD_BINDING_ALPHA) buffer Alpha { float alpha_out[]; };
 layout(std430, binding = FWD_BINDING_LAST) buffer Last { uint last_out[]; };
 layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]; };
 
+
 // Each subgroup walks the tile's list on its own, SUBGROUP-wide chunk by chunk: lane k loads entry k of the
 // chunk (two index fetches, two four-float fetches and the colour), a ballot keeps the entries whose 1/255
 // footprint reaches the subgroup's pixels, and every lane then reads those entries from lane k by shuffle,
-// in list order. No shared memory, no barriers; on CPU drivers a shuffle is a register permute.
+// in list order, and blends each into its four pixels. No shared memory, no barriers; on CPU drivers a
+// shuffle is a register permute. Why four pixels per invocation: every subgroup reads the tile's whole list,
+// so a quarter of the subgroups is a quarter of the reads and tests, and each entry taken by shuffle serves
+// four pixels (lavapipe, 100k Gaussians at 640x512: 82 -> 48 ms; docs/experiments.md 2026-11-26).
+
+// One pixel's blend state. Four per invocation, as separate variables (CPU drivers spill arrays).
+struct PixelState {
+  uvec2 pixel;
+  bool inside;
+  vec2 centre;
+  float T;     // transmittance
+  vec4 accum;  // a vector, not an array: CPU drivers spill dynamically indexed arrays
+  float depth_sum;
+  uint last;
+  uint contributions;
+  bool done;
+};
+
+// The state at the start of this pass: empty, or the previous pass's (held in the output buffers).
+PixelState start_pixel(uvec2 pixel, uint plane) {
+  PixelState s;
+  s.pixel = pixel;
+  s.inside = pixel.x < view.width && pixel.y < view.height;
+  s.centre = vec2(pixel) + 0.5;
+  s.T = 1.0;
+  s.accum = vec4(0.0);
+  s.depth_sum = 0.0;
+  s.last = 0u;
+  s.contributions = 0u;
+  s.done = !s.inside;
+  if (segment.begin > 0u && s.inside) {
+    const uint pix = pixel.y * view.width + pixel.x;
+    s.T = alpha_out[pix];
+    for (uint c = 0u; c < CHANNELS; ++c) s.accum[c] = image[c * plane + pix];
+    s.depth_sum = depth_out[pix];
+    s.last = last_out[pix];
+    s.done = (s.last & FWD_LAST_DONE) != 0u;
+    s.last &= ~FWD_LAST_DONE;
+  }
+  return s;
+}
+
+// Blends list entry `position` (1-based within the tile's list) into the pixel. Predicated rather than
+// branched: CPU drivers run the lanes as one SIMD register.
+void blend(inout PixelState s, vec4 me, vec4 co, vec4 color, float depth, uint position) {
+  const vec2 d = s.centre - me.xy;
+  const float sigma = gaussian_sigma(co.xyz, d);
+  const float alpha = min(float(SPLAT_ALPHA_MAX), co.w * exp(-min(sigma, SIGMA_CUTOFF)));
+  const float next_T = s.T * (1.0 - alpha);
+  const bool hit = !s.done && sigma >= 0.0 && alpha >= float(SPLAT_ALPHA_MIN);
+  const bool stop = hit && next_T < float(SPLAT_T_MIN);
+  s.done = s.done || stop;
+  const float w = hit && !stop ? alpha * s.T : 0.0;
+  s.accum = channels_fma(s.accum, w, color);
+  s.depth_sum += w * depth;
+  s.T = hit && !stop ? next_T : s.T;
+  s.last = hit && !stop ? position : s.last;
+  s.contributions += hit && !stop ? 1u : 0u;
+}
+
+// Writes the outputs, or the state the next pass continues from.
+void finish_pixel(PixelState s, uint plane, bool final_pass) {
+  if (!s.inside) return;
+  const uint pix = s.pixel.y * view.width + s.pixel.x;
+  for (uint c = 0u; c < CHANNELS; ++c) image[c * plane + pix] = s.accum[c];
+  if (!final_pass) {  // more of the list follows in the next pass
+    alpha_out[pix] = s.T;
+    depth_out[pix] = s.depth_sum;
+    last_out[pix] = s.last | (s.done ? FWD_LAST_DONE : 0u);
+    return;
+  }
+  const float a = 1.0 - s.T;
+  alpha_out[pix] = a;
+  depth_out[pix] = a >= float(SPLAT_MIN_DEPTH_WEIGHT) ? s.depth_sum / a : 0.0;
+  last_out[pix] = s.last;
+}
+
 void main() {
-  const uvec2 pixel = tile_pixel();
-  const bool inside = pixel.x < view.width && pixel.y < view.height;
+  const uvec2 base = quad_origin();
   const uint tile = gl_WorkGroupID.y * view.tiles_x + gl_WorkGroupID.x;
   const uvec2 range = ranges[tile];
   const uint length = range.y - range.x;
   if (segment.begin >= length && segment.begin > 0u) return;  // the tile's list ended in an earlier pass
   const uint end = range.x + min(length, segment.end);
   const bool final_pass = length <= segment.end;
-  const uint pix = pixel.y * view.width + pixel.x;
   const uint plane = view.width * view.height;
-
-  const vec2 centre = vec2(pixel) + 0.5;
-  const vec2 subgroup_lo = subgroupMin(centre), subgroup_hi = subgroupMax(centre);
-  float T = 1.0;
-  vec4 accum = vec4(0.0);  // a vector, not an array: CPU drivers spill dynamically indexed arrays
-  float depth_sum = 0.0;
-  uint last = 0u;
-  uint contributions = 0u;
-  bool done = !inside;
-  if (segment.begin > 0u && inside) {  // continue from the previous pass's state
-    T = alpha_out[pix];
-    for (uint c = 0u; c < CHANNELS; ++c) accum[c] = image[c * plane + pix];
-    depth_sum = depth_out[pix];
-    last = last_out[pix];
-    done = (last & FWD_LAST_DONE) != 0u;
-    last &= ~FWD_LAST_DONE;
-  }
+  PixelState s0 = start_pixel(base, plane);
+  PixelState s1 = start_pixel(base + uvec2(1u, 0u), plane);
+  PixelState s2 = start_pixel(base + uvec2(0u, 1u), plane);
+  PixelState s3 = start_pixel(base + uvec2(1u, 1u), plane);
+  const vec2 subgroup_lo = subgroupMin(s0.centre), subgroup_hi = subgroupMax(s3.centre);
   uint chunk = range.x + segment.begin;
   for (; chunk < end; chunk += gl_SubgroupSize) {
-    if (subgroupAll(done)) break;
-    // Lane k loads entry chunk + k.
+    if (subgroupAll(s0.done && s1.done && s2.done && s3.done)) break;
     const uint entry = chunk + gl_SubgroupInvocationID;
     vec4 mean_extent = vec4(0.0), conic_opacity = vec4(0.0), color = vec4(0.0);
     float depth = 0.0;
     bool relevant = false;
     if (entry < end) {
       const int g = int(texelFetch(isect_gaussian, int(texelFetch(isect_ids, int(entry)).x)).x);
-      const vec4 centre_g = texelFetch(centres, g);  // mean2d, depth, opacity
-      const vec4 conic_g = texelFetch(conics, g);    // conic, alpha_reach(opacity)
+      const vec4 centre_g = texelFetch(centres, g);
+      const vec4 conic_g = texelFetch(conics, g);
       mean_extent = vec4(centre_g.xy, alpha_extent(conic_g.xyz, conic_g.w));
       conic_opacity = vec4(conic_g.xyz, centre_g.w);
       depth = centre_g.z;
@@ -89,40 +151,25 @@ void main() {
         todo[word] &= todo[word] - 1u;
         const vec4 me = subgroupShuffle(mean_extent, k);
         const vec4 co = subgroupShuffle(conic_opacity, k);
-        const vec2 d = centre - me.xy;
-        const float sigma = gaussian_sigma(co.xyz, d);
-        const float alpha = min(float(SPLAT_ALPHA_MAX), co.w * exp(-min(sigma, SIGMA_CUTOFF)));
-        const float next_T = T * (1.0 - alpha);
-        // Predicated rather than branched: CPU drivers run the lanes as one SIMD register.
-        const bool hit = !done && sigma >= 0.0 && alpha >= float(SPLAT_ALPHA_MIN);
-        const bool stop = hit && next_T < float(SPLAT_T_MIN);
-        done = done || stop;
-        const float w = hit && !stop ? alpha * T : 0.0;
-        accum = channels_fma(accum, w, channels_shuffle(color, k));
-        depth_sum += w * subgroupShuffle(depth, k);
-        T = hit && !stop ? next_T : T;
-        last = hit && !stop ? chunk + k - range.x + 1u : last;
-        contributions += hit && !stop ? 1u : 0u;
+        const vec4 col = channels_shuffle(color, k);
+        const float dep = subgroupShuffle(depth, k);
+        const uint position = chunk + k - range.x + 1u;
+        blend(s0, me, co, col, dep, position);
+        blend(s1, me, co, col, dep, position);
+        blend(s2, me, co, col, dep, position);
+        blend(s3, me, co, col, dep, position);
       }
     }
   }
   // A driver's loop limit (lavapipe: 65535 iterations per invocation) ends the walk early without an error:
   // count it, so that a pass sized wrongly for a device is seen (SPLAT_COUNTER_FORWARD_WALKS_CUT).
-  if (chunk < end && !subgroupAll(done) && subgroupElect())
+  if (chunk < end && !subgroupAll(s0.done && s1.done && s2.done && s3.done) && subgroupElect())
     atomicAdd(counters[SPLAT_COUNTER_FORWARD_WALKS_CUT], 1u);
-  const uint subgroup_contributions = subgroupAdd(contributions);
+  const uint subgroup_contributions = subgroupAdd(s0.contributions + s1.contributions + s2.contributions + s3.contributions);
   if (subgroupElect() && subgroup_contributions > 0u)
     atomicAdd(counters[SPLAT_COUNTER_CONTRIBUTIONS], subgroup_contributions);
-  if (!inside) return;
-  for (uint c = 0u; c < CHANNELS; ++c) image[c * plane + pix] = accum[c];
-  if (!final_pass) {  // more of the list follows in the next pass
-    alpha_out[pix] = T;
-    depth_out[pix] = depth_sum;
-    last_out[pix] = last | (done ? FWD_LAST_DONE : 0u);
-    return;
-  }
-  const float a = 1.0 - T;
-  alpha_out[pix] = a;
-  depth_out[pix] = a >= float(SPLAT_MIN_DEPTH_WEIGHT) ? depth_sum / a : 0.0;
-  last_out[pix] = last;
+  finish_pixel(s0, plane, final_pass);
+  finish_pixel(s1, plane, final_pass);
+  finish_pixel(s2, plane, final_pass);
+  finish_pixel(s3, plane, final_pass);
 }

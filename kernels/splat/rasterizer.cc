@@ -35,9 +35,9 @@ uint32_t forward_loops_per_chunk(uint32_t S, uint32_t C) {
 uint32_t backward_loops_per_chunk(uint32_t S, uint32_t C, bool deterministic) {
   const uint32_t walk = 1 + (C + 1) + 5 + (S + 4) + S * (log2_ceil(S) + 1);
   if (!deterministic) return walk + 3 + 4 + 5 + (C + 1) + 2 * (SPLAT_GRAD2D_FIXED + C);
-  const uint32_t subgroups = (SPLAT_TILE_SIZE * SPLAT_TILE_SIZE + S - 1) / S;
-  const uint32_t sums_per_invocation =
-      (3 * S + SPLAT_TILE_SIZE * SPLAT_TILE_SIZE - 1) / (SPLAT_TILE_SIZE * SPLAT_TILE_SIZE);
+  const uint32_t invocations = SPLAT_QUAD_GRID * SPLAT_QUAD_GRID;  // per tile, each 2x2 pixels
+  const uint32_t subgroups = (invocations + S - 1) / S;
+  const uint32_t sums_per_invocation = (3 * S + invocations - 1) / invocations;
   return walk + (sums_per_invocation + 1) * ((subgroups + 1) + 5);
 }
 

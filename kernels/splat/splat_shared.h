@@ -12,6 +12,7 @@ using uint = uint32_t;
 
 // ---- Numerics ----
 #define SPLAT_TILE_SIZE 16             // pixels per tile side; a forward/backward workgroup is one tile
+#define SPLAT_QUAD_GRID 8              // ... of 8x8 invocations, each blending 2x2 pixels (footprint.glsl)
 #define SPLAT_ALPHA_MAX 0.99           // per-Gaussian alpha clamp: keeps 1 - alpha >= 0.01 for backward
 #define SPLAT_ALPHA_MIN (1.0 / 255.0)  // contributions below this are skipped (and set the extent)
 #define SPLAT_T_MIN 1e-4               // a pixel stops once its transmittance would fall below this
