@@ -28,9 +28,11 @@ engine::KernelDesc kernel_desc(const std::string& name, uint32_t binding_count,
 
 std::unique_ptr<engine::Kernel> make_kernel(engine::Context& context, const std::string& name,
                                             uint32_t binding_count, uint32_t push_constant_bytes,
-                                            std::vector<engine::SpecConstant> spec_constants) {
+                                            std::vector<engine::SpecConstant> spec_constants,
+                                            std::vector<engine::TexelBinding> texel_bindings) {
   engine::KernelDesc desc = kernel_desc(name, binding_count, push_constant_bytes);
   desc.spec_constants = std::move(spec_constants);
+  desc.texel_bindings = std::move(texel_bindings);
   return std::make_unique<engine::Kernel>(context, std::move(desc));
 }
 

@@ -25,14 +25,25 @@ PhotometricLoss::PhotometricLoss(engine::Context& context, uint32_t channels, Ph
   if (channels < 1 || channels > SPLAT_MAX_CHANNELS)
     throw std::invalid_argument("PhotometricLoss: channels = " + std::to_string(channels) + ", must be 1.." +
                                 std::to_string(SPLAT_MAX_CHANNELS));
+  // The window taps read their inputs as texels (loss_shared.h): on CPU drivers a fetch is a vector gather,
+  // a storage-buffer load a loop over the lanes.
+  const VkFormat f1 = VK_FORMAT_R32_SFLOAT, f4 = VK_FORMAT_R32G32B32A32_SFLOAT;
   moments_ = loss_detail::make_kernel(context, "loss/ssim_moments_h", SSIM_MOMENTS_BINDING_COUNT,
-                                      sizeof(PhotometricParams));
+                                      sizeof(PhotometricParams), {},
+                                      {{SSIM_MOMENTS_BINDING_IMAGE, f1}, {SSIM_MOMENTS_BINDING_TARGET, f1}});
   pixel_ = loss_detail::make_kernel(context, "loss/ssim_pixel", SSIM_PIXEL_BINDING_COUNT,
-                                    sizeof(PhotometricParams));
+                                    sizeof(PhotometricParams), {},
+                                    {{SSIM_PIXEL_BINDING_IMAGE, f1},
+                                     {SSIM_PIXEL_BINDING_TARGET, f1},
+                                     {SSIM_PIXEL_BINDING_MOMENTS4, f4},
+                                     {SSIM_PIXEL_BINDING_MOMENTS1, f1}});
   partials_h_ = loss_detail::make_kernel(context, "loss/ssim_partials_h", SSIM_PARTIALS_BINDING_COUNT,
-                                         sizeof(PhotometricParams));
+                                         sizeof(PhotometricParams), {}, {{SSIM_PARTIALS_BINDING_IN, f4}});
   backward_ = loss_detail::make_kernel(context, "loss/ssim_backward", SSIM_BACKWARD_BINDING_COUNT,
-                                       sizeof(PhotometricParams));
+                                       sizeof(PhotometricParams), {},
+                                       {{SSIM_BACKWARD_BINDING_IMAGE, f1},
+                                        {SSIM_BACKWARD_BINDING_TARGET, f1},
+                                        {SSIM_BACKWARD_BINDING_PARTIALS, f4}});
 }
 
 PhotometricLoss::~PhotometricLoss() = default;

@@ -6,8 +6,8 @@
 #include "loss/loss_shared.h"
 #include "loss/ssim_window.glsl"
 
-layout(std430, binding = SSIM_MOMENTS_BINDING_IMAGE) readonly buffer Image { float image[]; };
-layout(std430, binding = SSIM_MOMENTS_BINDING_TARGET) readonly buffer Target { float target[]; };
+layout(binding = SSIM_MOMENTS_BINDING_IMAGE) uniform samplerBuffer image;    // texels (loss_shared.h)
+layout(binding = SSIM_MOMENTS_BINDING_TARGET) uniform samplerBuffer target;
 layout(std430, binding = SSIM_MOMENTS_BINDING_OUT4) writeonly buffer Moments4 { vec4 moments4[]; };
 layout(std430, binding = SSIM_MOMENTS_BINDING_OUT1) writeonly buffer Moments1 { float moments1[]; };
 layout(push_constant) uniform Push { PhotometricParams p; };
@@ -23,8 +23,8 @@ void main() {
   {                                                      \
     const int i = int(e) + SSIM_TAP_OFFSET(x, k, w);     \
     const float wt = SSIM_TAP_WEIGHT(x, k, w, wk);       \
-    const float a = image[i];                            \
-    const float b = target[i];                           \
+    const float a = texelFetch(image, i).x;              \
+    const float b = texelFetch(target, i).x;             \
     m += wt * vec4(a, b, a * a, b * b);                  \
     mxy += wt * (a * b);                                 \
   }

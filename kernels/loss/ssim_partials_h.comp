@@ -7,7 +7,7 @@
 #include "loss/loss_shared.h"
 #include "loss/ssim_window.glsl"
 
-layout(std430, binding = SSIM_PARTIALS_BINDING_IN) readonly buffer In { vec4 partials[]; };
+layout(binding = SSIM_PARTIALS_BINDING_IN) uniform samplerBuffer partials;  // texels (loss_shared.h)
 layout(std430, binding = SSIM_PARTIALS_BINDING_OUT) writeonly buffer Out { vec4 blurred[]; };
 layout(push_constant) uniform Push { PhotometricParams p; };
 
@@ -17,7 +17,7 @@ void main() {
   const int x = int(e % p.width);
   const int w = int(p.width);
   vec4 s = vec4(0.0);
-#define TAP(k, wk) s += SSIM_TAP_WEIGHT(x, k, w, wk) * partials[int(e) + SSIM_TAP_OFFSET(x, k, w)];
+#define TAP(k, wk) s += SSIM_TAP_WEIGHT(x, k, w, wk) * texelFetch(partials, int(e) + SSIM_TAP_OFFSET(x, k, w));
   SSIM_WINDOW(TAP)
 #undef TAP
   blurred[e] = s;

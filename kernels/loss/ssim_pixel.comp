@@ -7,10 +7,10 @@
 #include "loss/loss_shared.h"
 #include "loss/ssim_window.glsl"
 
-layout(std430, binding = SSIM_PIXEL_BINDING_IMAGE) readonly buffer Image { float image[]; };
-layout(std430, binding = SSIM_PIXEL_BINDING_TARGET) readonly buffer Target { float target[]; };
-layout(std430, binding = SSIM_PIXEL_BINDING_MOMENTS4) readonly buffer Moments4 { vec4 moments4[]; };
-layout(std430, binding = SSIM_PIXEL_BINDING_MOMENTS1) readonly buffer Moments1 { float moments1[]; };
+layout(binding = SSIM_PIXEL_BINDING_IMAGE) uniform samplerBuffer image;  // texels (loss_shared.h)
+layout(binding = SSIM_PIXEL_BINDING_TARGET) uniform samplerBuffer target;
+layout(binding = SSIM_PIXEL_BINDING_MOMENTS4) uniform samplerBuffer moments4;
+layout(binding = SSIM_PIXEL_BINDING_MOMENTS1) uniform samplerBuffer moments1;
 layout(std430, binding = SSIM_PIXEL_BINDING_PARTIALS) writeonly buffer Partials { vec4 partials[]; };
 layout(std430, binding = SSIM_PIXEL_BINDING_TERMS) writeonly buffer Terms { vec2 terms[]; };
 layout(push_constant) uniform Push { PhotometricParams p; };
@@ -27,8 +27,8 @@ void main() {
   {                                                          \
     const int i = int(e) + SSIM_TAP_OFFSET(y, k, h) * w;     \
     const float wt = SSIM_TAP_WEIGHT(y, k, h, wk);           \
-    m += wt * moments4[i];                                   \
-    exy += wt * moments1[i];                                 \
+    m += wt * texelFetch(moments4, i);                       \
+    exy += wt * texelFetch(moments1, i).x;                   \
   }
   SSIM_WINDOW(TAP)
 #undef TAP
@@ -48,5 +48,5 @@ void main() {
   const float d_exy = 2.0 * a1 * inv_b;
   const float g = -p.lambda_ssim * p.inv_count;
   partials[e] = vec4(g * d_mux, g * d_ex2, g * d_exy, 0.0);
-  terms[e] = vec2(1.0 - ssim, abs(image[e] - target[e]));
+  terms[e] = vec2(1.0 - ssim, abs(texelFetch(image, int(e)).x - texelFetch(target, int(e)).x));
 }
