@@ -27,7 +27,8 @@ using uint = uint32_t;
 #define SSIM_W5 0.00102838008
 
 // The SSIM kernels read their inputs (every binding not marked "out") as uniform texel buffers, R32_SFLOAT
-// for the [C][H][W] maps and R32G32B32A32_SFLOAT for the [C][H][W][4] ones (kernels/loss/photometric_loss.cc).
+// for the [C][H][W] maps and R32G32B32A32_SFLOAT for the [C][H][W][4] ones
+// (kernels/loss/photometric_loss.cc).
 
 // ---- ssim_moments_h.comp: one invocation per element, horizontal blur of the five moment maps ----
 #define SSIM_MOMENTS_BINDING_IMAGE 0   // [C][H][W] x
