@@ -23,18 +23,26 @@ bool footprint_reaches(vec4 mean_extent, vec2 lo, vec2 hi) {
 // no result and keeps exp() away from denormals, which are very slow on CPUs.
 const float SIGMA_CUTOFF = 30.0;
 
-// The origin of this invocation's 2x2 pixels: invocation i of the tile's SPLAT_QUAD_GRID^2 grid of quads,
-// in Z (Morton) order, so that a subgroup of S invocations covers a compact block (S = 8: 8x4 pixels, 32:
-// 16x8) and skips the footprints that miss it.
-#if SPLAT_TILE_SIZE != 16 || SPLAT_QUAD_GRID != 8
-#error "quad_origin() numbers the 2x2 quads of a 16x16 tile"
+// The origin of this invocation's 2x4 block of pixels: invocation i of the tile's 8x4 grid of blocks, in Z
+// (Morton) order, so that a subgroup of S invocations covers a compact region (S = 8: 8x8 pixels, 32: the
+// tile) and skips the footprints that miss it. Why eight pixels per invocation: every subgroup reads its
+// tile's whole list, so fewer subgroups per tile mean fewer reads, tests, butterfly sums and atomic adds per
+// pixel (docs/design.md, how the rasterizer works).
+#if SPLAT_TILE_SIZE != 16 || SPLAT_GROUP_X != 8 || SPLAT_GROUP_Y != 4
+#error "block_origin() numbers the 2x4 blocks of a 16x16 tile"
 #endif
-uvec2 quad_origin() {
+uvec2 block_origin() {
   const uint i = gl_LocalInvocationIndex;
   const uint x = (i & 1u) | ((i >> 1u) & 2u) | ((i >> 2u) & 4u);
-  const uint y = ((i >> 1u) & 1u) | ((i >> 2u) & 2u) | ((i >> 3u) & 4u);
-  return gl_WorkGroupID.xy * uint(SPLAT_TILE_SIZE) + 2u * uvec2(x, y);
+  const uint y = ((i >> 1u) & 1u) | ((i >> 2u) & 2u);
+  return gl_WorkGroupID.xy * uint(SPLAT_TILE_SIZE) + uvec2(2u * x, 4u * y);
 }
+
+#ifdef SPLAT_RASTERIZE_PASS
+// The subgroup's lanes that exist: a device whose subgroups are wider than the workgroup (64-wide AMD waves)
+// runs it as one partial subgroup, whose chunks of list entries and butterfly sums must not reach past it.
+uint subgroup_lanes() { return min(gl_SubgroupSize, uint(SPLAT_GROUP_INVOCATIONS)); }
+#endif
 
 // sigma along the edge x = dx (relative to the mean) of a box, at its smallest: dy = -(b / c) dx clamped
 // to [dy_lo, dy_hi] (sigma is a convex quadratic). Lowered by 1e-5 of the terms' magnitudes, so that float

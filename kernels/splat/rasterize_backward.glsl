@@ -1,4 +1,4 @@
-// One workgroup per tile, one invocation per 2x2 pixels (as rasterize_forward.comp, for the same reason):
+// One workgroup per tile, one invocation per 2x4 pixels (as rasterize_forward.comp, for the same reason):
 // walk the tile's list back to front from each pixel's last contributor, recovering transmittance by division (alpha <= 0.99 keeps it stable), and turn the
 // pixel's upstream gradients into per-Gaussian gradients of (mean2d, conic, opacity, depth, colour).
 //
@@ -19,7 +19,7 @@
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
 
-layout(local_size_x = SPLAT_QUAD_GRID, local_size_y = SPLAT_QUAD_GRID) in;
+layout(local_size_x = SPLAT_GROUP_X, local_size_y = SPLAT_GROUP_Y) in;
 
 layout(std430, binding = BWD_BINDING_RANGES) readonly buffer Ranges { uvec2 ranges[]; };
 // The per-entry reads, as texels (splat_shared.h).
@@ -55,7 +55,7 @@ struct EntryGrad {
 };
 
 // One pixel's backward state: its upstream gradients and, walking back to front, the transmittance and the
-// sums of what lies behind. Four per invocation, as separate variables (CPU drivers spill arrays).
+// sums of what lies behind. Eight per invocation, as separate variables (CPU drivers spill arrays).
 struct PixelGrad {
   uint pix;    // index in the [H][W] planes
   uint last;   // entries the forward walked (0 outside the image)
@@ -133,7 +133,7 @@ vec4 load_entry_color(uint g) {
 void subgroup_sum3(inout vec4 a, inout vec4 b, inout vec4 c) {
   if (CHANNELS == 1u) {
     b.w = c.x;
-    for (uint mask = 1u; mask < gl_SubgroupSize; mask <<= 1u) {
+    for (uint mask = 1u; mask < subgroup_lanes(); mask <<= 1u) {
       a += subgroupShuffleXor(a, mask);
       b += subgroupShuffleXor(b, mask);
     }
@@ -141,7 +141,7 @@ void subgroup_sum3(inout vec4 a, inout vec4 b, inout vec4 c) {
     b.w = 0.0;
     return;
   }
-  for (uint mask = 1u; mask < gl_SubgroupSize; mask <<= 1u) {
+  for (uint mask = 1u; mask < subgroup_lanes(); mask <<= 1u) {
     a += subgroupShuffleXor(a, mask);
     b += subgroupShuffleXor(b, mask);
     c += subgroupShuffleXor(c, mask);
@@ -149,8 +149,8 @@ void subgroup_sum3(inout vec4 a, inout vec4 b, inout vec4 c) {
 }
 
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
-// Per chunk, each lane's entry sums of each subgroup: [subgroup * S + lane][3] (subgroups x S = 64).
-const uint WORKGROUP_INVOCATIONS = SPLAT_QUAD_GRID * SPLAT_QUAD_GRID;
+// Per chunk, each lane's entry sums of each subgroup: [subgroup * S + lane][3] (subgroups x S = 32).
+const uint WORKGROUP_INVOCATIONS = SPLAT_GROUP_INVOCATIONS;
 shared vec4 s_partial[WORKGROUP_INVOCATIONS * 3];
 shared uint s_walk;
 #else
@@ -179,10 +179,11 @@ void add_entry_grads(uint g, vec4 a0, vec4 a1, vec4 a2) {
 
 // The entry sums of one chunk of the list, [chunk_start, chunk_end) relative to the list start, walked back
 // to front: lane k loads entry chunk_start + k, a ballot keeps entries whose footprint reaches the subgroup,
-// and the lanes take them from lane k by shuffle, last to first, each for its four pixels. Lane k returns its
+// and the lanes take them from lane k by shuffle, last to first, each for its eight pixels. Lane k returns its
 // entry's sums over the subgroup's pixels.
 void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 subgroup_lo, vec2 subgroup_hi,
-                    inout PixelGrad p0, inout PixelGrad p1, inout PixelGrad p2, inout PixelGrad p3, out uint g,
+                    inout PixelGrad p0, inout PixelGrad p1, inout PixelGrad p2, inout PixelGrad p3,
+                    inout PixelGrad p4, inout PixelGrad p5, inout PixelGrad p6, inout PixelGrad p7, out uint g,
                     out bool relevant, out vec4 a0, out vec4 a1, out vec4 a2) {
   const uint rel = chunk_start + gl_SubgroupInvocationID;
   g = 0u;
@@ -213,8 +214,14 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 subg
       const EntryGrad r1 = entry_backward(p1, me, co, col, dep, entry);
       const EntryGrad r2 = entry_backward(p2, me, co, col, dep, entry);
       const EntryGrad r3 = entry_backward(p3, me, co, col, dep, entry);
-      vec4 s0 = (r0.g0 + r1.g0) + (r2.g0 + r3.g0), s1 = (r0.g1 + r1.g1) + (r2.g1 + r3.g1);
-      vec4 s2 = channels_add(channels_add(r0.g2, r1.g2), channels_add(r2.g2, r3.g2));
+      const EntryGrad r4 = entry_backward(p4, me, co, col, dep, entry);
+      const EntryGrad r5 = entry_backward(p5, me, co, col, dep, entry);
+      const EntryGrad r6 = entry_backward(p6, me, co, col, dep, entry);
+      const EntryGrad r7 = entry_backward(p7, me, co, col, dep, entry);
+      vec4 s0 = ((r0.g0 + r1.g0) + (r2.g0 + r3.g0)) + ((r4.g0 + r5.g0) + (r6.g0 + r7.g0));
+      vec4 s1 = ((r0.g1 + r1.g1) + (r2.g1 + r3.g1)) + ((r4.g1 + r5.g1) + (r6.g1 + r7.g1));
+      vec4 s2 = channels_add(channels_add(channels_add(r0.g2, r1.g2), channels_add(r2.g2, r3.g2)),
+                             channels_add(channels_add(r4.g2, r5.g2), channels_add(r6.g2, r7.g2)));
       subgroup_sum3(s0, s1, s2);
       if (gl_SubgroupInvocationID == k) {
         a0 = s0;
@@ -227,7 +234,8 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 subg
 
 // The next chunk's start going back from chunk_end, not below the segment's begin.
 uint chunk_start_below(uint chunk_end) {
-  return chunk_end > segment.begin + gl_SubgroupSize ? chunk_end - gl_SubgroupSize : segment.begin;
+  const uint lanes = subgroup_lanes();
+  return chunk_end > segment.begin + lanes ? chunk_end - lanes : segment.begin;
 }
 
 // The pixel's upstream gradients and its state at the start of this pass: the forward's results, or, for a
@@ -267,7 +275,7 @@ void hand_over(PixelGrad p, uint plane) {
 }
 
 void main() {
-  const uvec2 base = quad_origin();
+  const uvec2 base = block_origin();
   const uint tile = gl_WorkGroupID.y * view.tiles_x + gl_WorkGroupID.x;
   const uvec2 range = ranges[tile];
   const uint plane = view.width * view.height;
@@ -275,11 +283,16 @@ void main() {
   PixelGrad p1 = start_pixel(base + uvec2(1u, 0u), plane);
   PixelGrad p2 = start_pixel(base + uvec2(0u, 1u), plane);
   PixelGrad p3 = start_pixel(base + uvec2(1u, 1u), plane);
-  const uint my_last = max(max(p0.last, p1.last), max(p2.last, p3.last));
+  PixelGrad p4 = start_pixel(base + uvec2(0u, 2u), plane);
+  PixelGrad p5 = start_pixel(base + uvec2(1u, 2u), plane);
+  PixelGrad p6 = start_pixel(base + uvec2(0u, 3u), plane);
+  PixelGrad p7 = start_pixel(base + uvec2(1u, 3u), plane);
+  const uint my_last = max(max(max(p0.last, p1.last), max(p2.last, p3.last)),
+                           max(max(p4.last, p5.last), max(p6.last, p7.last)));
 #if SPLAT_BWD_MODE != SPLAT_BWD_DETERMINISTIC
   if (subgroupAll(my_last <= segment.begin)) return;  // nothing of this subgroup's walks lies in this pass
 #endif
-  const vec2 subgroup_lo = subgroupMin(p0.centre), subgroup_hi = subgroupMax(p3.centre);
+  const vec2 subgroup_lo = subgroupMin(p0.centre), subgroup_hi = subgroupMax(p7.centre);
   uint chunk_end;
 
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
@@ -290,13 +303,13 @@ void main() {
   atomicMax(s_walk, my_last);
   barrier();
   const uint walk = min(s_walk, segment.end);
-  const uint S = gl_SubgroupSize;
+  const uint S = subgroup_lanes();
   for (chunk_end = walk; chunk_end > segment.begin; chunk_end = chunk_start_below(chunk_end)) {
     const uint chunk_start = chunk_start_below(chunk_end);
     uint g;
     bool relevant;
     vec4 a0, a1, a2;
-    chunk_backward(range.x, chunk_start, chunk_end, subgroup_lo, subgroup_hi, p0, p1, p2, p3, g, relevant, a0,
+    chunk_backward(range.x, chunk_start, chunk_end, subgroup_lo, subgroup_hi, p0, p1, p2, p3, p4, p5, p6, p7, g, relevant, a0,
                    a1, a2);
     const uint slot = (gl_SubgroupID * S + gl_SubgroupInvocationID) * 3u;
     s_partial[slot] = a0;
@@ -328,7 +341,7 @@ void main() {
     uint g;
     bool relevant;
     vec4 a0, a1, a2;
-    chunk_backward(range.x, chunk_start_below(chunk_end), chunk_end, subgroup_lo, subgroup_hi, p0, p1, p2, p3, g,
+    chunk_backward(range.x, chunk_start_below(chunk_end), chunk_end, subgroup_lo, subgroup_hi, p0, p1, p2, p3, p4, p5, p6, p7, g,
                    relevant, a0, a1, a2);
     if (relevant) add_entry_grads(g, a0, a1, a2);
   }
@@ -339,4 +352,8 @@ void main() {
   hand_over(p1, plane);
   hand_over(p2, plane);
   hand_over(p3, plane);
+  hand_over(p4, plane);
+  hand_over(p5, plane);
+  hand_over(p6, plane);
+  hand_over(p7, plane);
 }

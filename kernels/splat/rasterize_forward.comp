@@ -4,7 +4,7 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_shuffle : require
-// One workgroup per 16x16 tile, one invocation per 2x2 pixels: alpha-blend the tile's list front to back, one
+// One workgroup per 16x16 tile, one invocation per 2x4 pixels: alpha-blend the tile's list front to back, one
 // list segment per pass (splat_shared.h: a long list takes several passes, carrying the blend state).
 #define SPLAT_RASTERIZE_PASS
 #include "limits.h"
@@ -14,7 +14,7 @@
 #include "splat/footprint.glsl"
 #include "splat/channels.glsl"
 
-layout(local_size_x = SPLAT_QUAD_GRID, local_size_y = SPLAT_QUAD_GRID) in;
+layout(local_size_x = SPLAT_GROUP_X, local_size_y = SPLAT_GROUP_Y) in;
 
 layout(std430, binding = FWD_BINDING_RANGES) readonly buffer Ranges { uvec2 ranges[]; };
 // The per-entry reads, as texels (splat_shared.h).
@@ -33,12 +33,12 @@ layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]
 // Each subgroup walks the tile's list on its own, SUBGROUP-wide chunk by chunk: lane k loads entry k of the
 // chunk (two index fetches, two four-float fetches and the colour), a ballot keeps the entries whose 1/255
 // footprint reaches the subgroup's pixels, and every lane then reads those entries from lane k by shuffle,
-// in list order, and blends each into its four pixels. No shared memory, no barriers; on CPU drivers a
-// shuffle is a register permute. Why four pixels per invocation: every subgroup reads the tile's whole list,
-// so a quarter of the subgroups is a quarter of the reads and tests, and each entry taken by shuffle serves
-// four pixels (lavapipe, 100k Gaussians at 640x512: 82 -> 48 ms; docs/experiments.md 2026-11-26).
+// in list order, and blends each into its eight pixels. No shared memory, no barriers; on CPU drivers a
+// shuffle is a register permute. Eight pixels per invocation (footprint.glsl block_origin): an eighth of the
+// subgroups reads the tile's list, and each entry taken by shuffle serves eight pixels (lavapipe, 100k
+// Gaussians at 640x512: 82 ms with one pixel, 48 with four, 45 with eight; docs/experiments.md 2026-11-26).
 
-// One pixel's blend state. Four per invocation, as separate variables (CPU drivers spill arrays).
+// One pixel's blend state. Eight per invocation, as separate variables (CPU drivers spill arrays).
 struct PixelState {
   uvec2 pixel;
   bool inside;
@@ -111,7 +111,7 @@ void finish_pixel(PixelState s, uint plane, bool final_pass) {
 }
 
 void main() {
-  const uvec2 base = quad_origin();
+  const uvec2 base = block_origin();
   const uint tile = gl_WorkGroupID.y * view.tiles_x + gl_WorkGroupID.x;
   const uvec2 range = ranges[tile];
   const uint length = range.y - range.x;
@@ -123,10 +123,15 @@ void main() {
   PixelState s1 = start_pixel(base + uvec2(1u, 0u), plane);
   PixelState s2 = start_pixel(base + uvec2(0u, 1u), plane);
   PixelState s3 = start_pixel(base + uvec2(1u, 1u), plane);
-  const vec2 subgroup_lo = subgroupMin(s0.centre), subgroup_hi = subgroupMax(s3.centre);
+  PixelState s4 = start_pixel(base + uvec2(0u, 2u), plane);
+  PixelState s5 = start_pixel(base + uvec2(1u, 2u), plane);
+  PixelState s6 = start_pixel(base + uvec2(0u, 3u), plane);
+  PixelState s7 = start_pixel(base + uvec2(1u, 3u), plane);
+  const vec2 subgroup_lo = subgroupMin(s0.centre), subgroup_hi = subgroupMax(s7.centre);
   uint chunk = range.x + segment.begin;
-  for (; chunk < end; chunk += gl_SubgroupSize) {
-    if (subgroupAll(s0.done && s1.done && s2.done && s3.done)) break;
+  const uint lanes = subgroup_lanes();
+  for (; chunk < end; chunk += lanes) {
+    if (subgroupAll(s0.done && s1.done && s2.done && s3.done && s4.done && s5.done && s6.done && s7.done)) break;
     const uint entry = chunk + gl_SubgroupInvocationID;
     vec4 mean_extent = vec4(0.0), conic_opacity = vec4(0.0), color = vec4(0.0);
     float depth = 0.0;
@@ -158,18 +163,26 @@ void main() {
         blend(s1, me, co, col, dep, position);
         blend(s2, me, co, col, dep, position);
         blend(s3, me, co, col, dep, position);
+        blend(s4, me, co, col, dep, position);
+        blend(s5, me, co, col, dep, position);
+        blend(s6, me, co, col, dep, position);
+        blend(s7, me, co, col, dep, position);
       }
     }
   }
   // A driver's loop limit (lavapipe: 65535 iterations per invocation) ends the walk early without an error:
   // count it, so that a pass sized wrongly for a device is seen (SPLAT_COUNTER_FORWARD_WALKS_CUT).
-  if (chunk < end && !subgroupAll(s0.done && s1.done && s2.done && s3.done) && subgroupElect())
+  if (chunk < end && !subgroupAll(s0.done && s1.done && s2.done && s3.done && s4.done && s5.done && s6.done && s7.done) && subgroupElect())
     atomicAdd(counters[SPLAT_COUNTER_FORWARD_WALKS_CUT], 1u);
-  const uint subgroup_contributions = subgroupAdd(s0.contributions + s1.contributions + s2.contributions + s3.contributions);
+  const uint subgroup_contributions = subgroupAdd(s0.contributions + s1.contributions + s2.contributions + s3.contributions + s4.contributions + s5.contributions + s6.contributions + s7.contributions);
   if (subgroupElect() && subgroup_contributions > 0u)
     atomicAdd(counters[SPLAT_COUNTER_CONTRIBUTIONS], subgroup_contributions);
   finish_pixel(s0, plane, final_pass);
   finish_pixel(s1, plane, final_pass);
   finish_pixel(s2, plane, final_pass);
   finish_pixel(s3, plane, final_pass);
+  finish_pixel(s4, plane, final_pass);
+  finish_pixel(s5, plane, final_pass);
+  finish_pixel(s6, plane, final_pass);
+  finish_pixel(s7, plane, final_pass);
 }

@@ -35,7 +35,7 @@ uint32_t forward_loops_per_chunk(uint32_t S, uint32_t C) {
 uint32_t backward_loops_per_chunk(uint32_t S, uint32_t C, bool deterministic) {
   const uint32_t walk = 1 + (C + 1) + 5 + (S + 4) + S * (log2_ceil(S) + 1);
   if (!deterministic) return walk + 3 + 4 + 5 + (C + 1) + 2 * (SPLAT_GRAD2D_FIXED + C);
-  const uint32_t invocations = SPLAT_QUAD_GRID * SPLAT_QUAD_GRID;  // per tile, each 2x2 pixels
+  const uint32_t invocations = SPLAT_GROUP_INVOCATIONS;  // per tile, each 2x4 pixels
   const uint32_t subgroups = (invocations + S - 1) / S;
   const uint32_t sums_per_invocation = (3 * S + invocations - 1) / invocations;
   return walk + (sums_per_invocation + 1) * ((subgroups + 1) + 5);
@@ -47,7 +47,8 @@ template <class LoopsPerChunk>
 uint32_t entries_within_budget(const engine::DeviceInfo& info, LoopsPerChunk loops_per_chunk) {
   uint32_t entries = 0xFFFFFFFFu;
   for (uint32_t S : {info.min_subgroup_size, info.subgroup_size, info.max_subgroup_size}) {
-    S = std::max(S, 1u);
+    // A subgroup wider than the workgroup walks chunks of the lanes that exist (footprint.glsl).
+    S = std::clamp(S, 1u, uint32_t{SPLAT_GROUP_INVOCATIONS});
     entries = std::min(entries, RASTERIZE_PASS_LOOP_BUDGET / loops_per_chunk(S) * S);
   }
   return std::max(entries, 1u);

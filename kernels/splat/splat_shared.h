@@ -11,8 +11,10 @@ using uint = uint32_t;
 #endif
 
 // ---- Numerics ----
-#define SPLAT_TILE_SIZE 16             // pixels per tile side; a forward/backward workgroup is one tile
-#define SPLAT_QUAD_GRID 8              // ... of 8x8 invocations, each blending 2x2 pixels (footprint.glsl)
+#define SPLAT_TILE_SIZE 16  // pixels per tile side; a forward/backward workgroup is one tile
+#define SPLAT_GROUP_X 8     // ... of 8x4 invocations, each blending a 2x4 block of pixels
+#define SPLAT_GROUP_Y 4     // (footprint.glsl block_origin)
+#define SPLAT_GROUP_INVOCATIONS (SPLAT_GROUP_X * SPLAT_GROUP_Y)
 #define SPLAT_ALPHA_MAX 0.99           // per-Gaussian alpha clamp: keeps 1 - alpha >= 0.01 for backward
 #define SPLAT_ALPHA_MIN (1.0 / 255.0)  // contributions below this are skipped (and set the extent)
 #define SPLAT_T_MIN 1e-4               // a pixel stops once its transmittance would fall below this
