@@ -72,6 +72,24 @@ ImageInfo layout(const std::filesystem::path& path, TIFF* tif) {
   return {static_cast<int>(width), static_cast<int>(height), samples, bits};
 }
 
+// Refuses a file whose strips cannot hold the image it declares, before the image is allocated (a 214-byte
+// file declaring 9477x65277 pixels once asked for 3.7 GB): uncompressed strips hold their bytes, compressed
+// ones expand at most 4096-fold (LZW's longest code string; deflate's limit is about 1032).
+void check_stored_bytes(const std::filesystem::path& path, TIFF* tif, uint64_t decoded_bytes) {
+  const uint64_t* counts = nullptr;
+  if (!TIFFGetField(tif, TIFFTAG_STRIPBYTECOUNTS, &counts) || counts == nullptr)
+    fail(path, 0, "no StripByteCounts tag");
+  uint64_t stored = 0;
+  for (uint32_t s = 0; s < TIFFNumberOfStrips(tif); ++s) stored += counts[s];
+  uint16_t compression = COMPRESSION_NONE;
+  TIFFGetFieldDefaulted(tif, TIFFTAG_COMPRESSION, &compression);
+  const uint64_t expansion = compression == COMPRESSION_NONE ? 1 : 4096;
+  if (decoded_bytes / expansion > stored)
+    fail(path, 0,
+         "declares " + std::to_string(decoded_bytes) + " bytes of pixels but its strips hold " +
+             std::to_string(stored) + " bytes" + (expansion > 1 ? " (compressed at most 4096-fold)" : ""));
+}
+
 }  // namespace
 
 ImageInfo read_tiff_info(const std::filesystem::path& path) {
@@ -91,6 +109,7 @@ Image read_tiff(const std::filesystem::path& path) {
   const tmsize_t scanline = TIFFScanlineSize(tif.tif);
   if (scanline < static_cast<tmsize_t>(row_values * (info.bit_depth / 8)))
     fail(path, 0, "scanline size " + std::to_string(scanline) + " is smaller than the image row");
+  check_stored_bytes(path, tif.tif, static_cast<uint64_t>(scanline) * static_cast<uint64_t>(info.height));
   std::vector<unsigned char> row(static_cast<size_t>(scanline));
   image.data.resize(row_values * info.height);
   for (int y = 0; y < info.height; ++y) {

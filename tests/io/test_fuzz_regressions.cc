@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "io/error.h"
+#include "io/image.h"
 #include "io/metashape.h"
 
 namespace litgs::io {
@@ -18,6 +19,17 @@ TEST(FuzzRegression, MetashapeCalibrationWithAHundredDigitHeight) {
     FAIL() << "expected IoError";
   } catch (const IoError& e) {
     EXPECT_NE(std::string(e.what()).find("height"), std::string::npos) << e.what();
+  }
+}
+
+TEST(FuzzRegression, TiffDeclaringGigabytesInATinyFile) {
+  // libFuzzer out-of-memory: 214 bytes declaring 9477x65277 pixels of three 16-bit samples, deflated; the
+  // reader allocated the 3.7 GB image before decoding the first row.
+  try {
+    read_tiff(kRegressions / "tiff-declares-gigabytes.tiff");
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("strips hold"), std::string::npos) << e.what();
   }
 }
 
