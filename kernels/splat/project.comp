@@ -9,11 +9,12 @@
 #include "splat/footprint.glsl"
 
 
-layout(std430, binding = PROJECT_BINDING_MEANS) readonly buffer Means { float means[]; };
-layout(std430, binding = PROJECT_BINDING_LOG_SCALES) readonly buffer LogScales { float log_scales[]; };
-layout(std430, binding = PROJECT_BINDING_QUATS) readonly buffer Quats { float quats[]; };
-layout(std430, binding = PROJECT_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
-layout(std430, binding = PROJECT_BINDING_SH) readonly buffer Sh { float sh[]; };
+// The parameters, read as texels (splat_shared.h): R32_SFLOAT, the quaternions R32G32B32A32_SFLOAT.
+layout(binding = PROJECT_BINDING_MEANS) uniform samplerBuffer means;
+layout(binding = PROJECT_BINDING_LOG_SCALES) uniform samplerBuffer log_scales;
+layout(binding = PROJECT_BINDING_QUATS) uniform samplerBuffer quats;
+layout(binding = PROJECT_BINDING_OPACITY_LOGITS) uniform samplerBuffer opacity_logits;
+layout(binding = PROJECT_BINDING_SH) uniform samplerBuffer sh;
 layout(std430, binding = PROJECT_BINDING_CENTRES) writeonly buffer Centres { vec4 centres[]; };
 layout(std430, binding = PROJECT_BINDING_CONICS) writeonly buffer Conics { vec4 conics[]; };
 layout(std430, binding = PROJECT_BINDING_COLORS) writeonly buffer Colors { float colors[]; };
@@ -26,13 +27,22 @@ layout(std430, binding = PROJECT_BINDING_COUNTERS) buffer Counters { uint counte
 void main() {
   const uint i = elementwise_index();
   if (i >= view.count) return;
-  const vec3 mean = vec3(means[3 * i], means[3 * i + 1], means[3 * i + 2]);
-  const vec3 log_scale = vec3(log_scales[3 * i], log_scales[3 * i + 1], log_scales[3 * i + 2]);
-  const vec4 quat = vec4(quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]);
-  const Projected pr = project_gaussian(view_geometry(), mean, log_scale, quat, opacity_logits[i]);
+  const vec3 mean = fetch3(means, i);
+  const vec3 log_scale = fetch3(log_scales, i);
+  const vec4 quat = texelFetch(quats, int(i));
+  const Projected pr = project_gaussian(view_geometry(), mean, log_scale, quat, fetch1(opacity_logits, i));
+  // One pass over the SH coefficients: their finiteness and the colour sums (used only if the Gaussian is
+  // kept, so a non-finite coefficient never reaches a colour).
+  float basis[SPLAT_MAX_SH_COEFFS];
+  sh_basis(view.sh_degree, normalize(mean - camera_centre()), basis);
   bool sh_finite = true;
-  for (uint k = 0u; k < view.sh_coeffs * CHANNELS; ++k)
-    sh_finite = sh_finite && is_finite_real(sh[i * view.sh_coeffs * CHANNELS + k]);
+  vec4 sums = vec4(0.5);
+  for (uint c = 0u; c < CHANNELS; ++c)
+    for (uint k = 0u; k < view.sh_coeffs; ++k) {
+      const float v = fetch1(sh, (i * view.sh_coeffs + k) * CHANNELS + c);
+      sh_finite = sh_finite && is_finite_real(v);
+      sums[c] += basis[k] * v;
+    }
   if (!pr.finite || !sh_finite) atomicAdd(counters[SPLAT_COUNTER_CULLED_NONFINITE], 1u);
 
   uvec4 rect = uvec4(0u);
@@ -52,13 +62,5 @@ void main() {
   centres[i] = vec4(pr.mean2d, pr.depth, pr.opacity);
   conics[i] = vec4(pr.conic, alpha_reach(pr.opacity));
 
-  float basis[SPLAT_MAX_SH_COEFFS];
-  sh_basis(view.sh_degree, normalize(mean - camera_centre()), basis);
-  for (uint c = 0u; c < CHANNELS; ++c) {
-    float sum = 0.5;
-    if (kept)
-      for (uint k = 0u; k < view.sh_coeffs; ++k)
-        sum += basis[k] * sh[(i * view.sh_coeffs + k) * CHANNELS + c];
-    colors[i * CHANNELS + c] = max(sum, 0.0);
-  }
+  for (uint c = 0u; c < CHANNELS; ++c) colors[i * CHANNELS + c] = max(kept ? sums[c] : 0.5, 0.0);
 }

@@ -7,14 +7,16 @@
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
 
-layout(std430, binding = PBWD_BINDING_MEANS) readonly buffer Means { float means[]; };
-layout(std430, binding = PBWD_BINDING_LOG_SCALES) readonly buffer LogScales { float log_scales[]; };
-layout(std430, binding = PBWD_BINDING_QUATS) readonly buffer Quats { float quats[]; };
-layout(std430, binding = PBWD_BINDING_OPACITY_LOGITS) readonly buffer Logits { float opacity_logits[]; };
-layout(std430, binding = PBWD_BINDING_SH) readonly buffer Sh { float sh[]; };
+// The parameters and the gradient rows, read as texels (splat_shared.h): R32_SFLOAT, the quaternions
+// R32G32B32A32_SFLOAT.
+layout(binding = PBWD_BINDING_MEANS) uniform samplerBuffer means;
+layout(binding = PBWD_BINDING_LOG_SCALES) uniform samplerBuffer log_scales;
+layout(binding = PBWD_BINDING_QUATS) uniform samplerBuffer quats;
+layout(binding = PBWD_BINDING_OPACITY_LOGITS) uniform samplerBuffer opacity_logits;
+layout(binding = PBWD_BINDING_SH) uniform samplerBuffer sh;
 layout(std430, binding = PBWD_BINDING_TILE_RECTS) readonly buffer Rects { uvec2 rects[]; };
 #include "splat/tile_rect.glsl"
-layout(std430, binding = PBWD_BINDING_GRAD2D) readonly buffer Grad2d { float grad2d[]; };
+layout(binding = PBWD_BINDING_GRAD2D) uniform samplerBuffer grad2d;
 layout(std430, binding = PBWD_BINDING_GRAD_MEANS) writeonly buffer GMeans { float g_means[]; };
 layout(std430, binding = PBWD_BINDING_GRAD_LOG_SCALES) writeonly buffer GLogScales { float g_log_scales[]; };
 layout(std430, binding = PBWD_BINDING_GRAD_QUATS) writeonly buffer GQuats { float g_quats[]; };
@@ -41,16 +43,16 @@ void main() {
   }
   const uint base = i * GRAD2D_STRIDE;
   ProjectedGrad pg;
-  pg.mean2d = vec2(grad2d[base], grad2d[base + 1]);
-  pg.conic = vec3(grad2d[base + 2], grad2d[base + 3], grad2d[base + 4]);
-  pg.opacity = grad2d[base + 5];
-  pg.depth = grad2d[base + 6];
+  pg.mean2d = vec2(fetch1(grad2d, base), fetch1(grad2d, base + 1));
+  pg.conic = vec3(fetch1(grad2d, base + 2), fetch1(grad2d, base + 3), fetch1(grad2d, base + 4));
+  pg.opacity = fetch1(grad2d, base + 5);
+  pg.depth = fetch1(grad2d, base + 6);
 
-  const vec3 mean = vec3(means[3 * i], means[3 * i + 1], means[3 * i + 2]);
-  const vec3 log_scale = vec3(log_scales[3 * i], log_scales[3 * i + 1], log_scales[3 * i + 2]);
-  const vec4 quat = vec4(quats[4 * i], quats[4 * i + 1], quats[4 * i + 2], quats[4 * i + 3]);
+  const vec3 mean = fetch3(means, i);
+  const vec3 log_scale = fetch3(log_scales, i);
+  const vec4 quat = texelFetch(quats, int(i));
   const ParamGrad p =
-      project_gaussian_backward(view_geometry(), mean, log_scale, quat, opacity_logits[i], pg);
+      project_gaussian_backward(view_geometry(), mean, log_scale, quat, fetch1(opacity_logits, i), pg);
 
   // Colour = sum_k basis_k c_k + 0.5, clamped at 0; its direction depends on the mean.
   const vec3 ray = mean - camera_centre();
@@ -60,14 +62,14 @@ void main() {
   float weights[SPLAT_MAX_SH_COEFFS];
   for (uint k = 0u; k < uint(SPLAT_MAX_SH_COEFFS); ++k) weights[k] = 0.0;
   for (uint c = 0u; c < CHANNELS; ++c) {
-    const float g_color = grad2d[base + SPLAT_GRAD2D_FIXED + c];
+    const float g_color = fetch1(grad2d, base + SPLAT_GRAD2D_FIXED + c);
     float sum = 0.5;
-    for (uint k = 0u; k < K; ++k) sum += basis[k] * sh[(i * K + k) * CHANNELS + c];
+    for (uint k = 0u; k < K; ++k) sum += basis[k] * fetch1(sh, (i * K + k) * CHANNELS + c);
     const bool clamped = sum < 0.0;
     for (uint k = 0u; k < K; ++k) {
       const uint idx = (i * K + k) * CHANNELS + c;
       if (WRITE_SH_GRAD != 0u) g_sh[idx] = clamped ? 0.0 : basis[k] * g_color;
-      if (!clamped) weights[k] += g_color * sh[idx];
+      if (!clamped) weights[k] += g_color * fetch1(sh, idx);
     }
   }
   const vec3 ddir = sh_basis_dir_grad(view.sh_degree, dir, weights);

@@ -187,7 +187,13 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   if (channels < 1 || channels > SPLAT_MAX_CHANNELS)
     throw std::invalid_argument("Rasterizer: channels = " + std::to_string(channels) + ", must be 1.." +
                                 std::to_string(SPLAT_MAX_CHANNELS));
-  project_ = make("splat/project", PROJECT_BINDING_COUNT, sizeof(SplatView));
+  const VkFormat f1 = VK_FORMAT_R32_SFLOAT, f4 = VK_FORMAT_R32G32B32A32_SFLOAT;
+  project_ = make("splat/project", PROJECT_BINDING_COUNT, sizeof(SplatView), {},
+                  {{PROJECT_BINDING_MEANS, f1},
+                   {PROJECT_BINDING_LOG_SCALES, f1},
+                   {PROJECT_BINDING_QUATS, f4},
+                   {PROJECT_BINDING_OPACITY_LOGITS, f1},
+                   {PROJECT_BINDING_SH, f1}});
   gather_ = make("splat/gather_counts", GATHER_BINDING_COUNT, sizeof(SplatView));
   lengths_ = make("splat/tile_list_lengths", LENGTHS_BINDING_COUNT, sizeof(SplatView));
   emit_ = make("splat/emit_intersections", EMIT_BINDING_COUNT, sizeof(SplatView));
@@ -204,7 +210,13 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
                                             BWD_BINDING_CENTRES, BWD_BINDING_CONICS, BWD_BINDING_COLORS));
   reduce_ = make("splat/reduce_isect_grads", REDUCE_BINDING_COUNT, sizeof(SplatView));
   project_backward_ = make("splat/project_backward", PBWD_BINDING_COUNT, sizeof(SplatView),
-                           {{2, options_.sh_gradient ? 1u : 0u}});
+                           {{2, options_.sh_gradient ? 1u : 0u}},
+                           {{PBWD_BINDING_MEANS, f1},
+                            {PBWD_BINDING_LOG_SCALES, f1},
+                            {PBWD_BINDING_QUATS, f4},
+                            {PBWD_BINDING_OPACITY_LOGITS, f1},
+                            {PBWD_BINDING_SH, f1},
+                            {PBWD_BINDING_GRAD2D, f1}});
   buffers_->counters =
       std::make_unique<DeviceArray<uint32_t>>(context, "splat: counters", SPLAT_COUNTER_COUNT);
   buffers_->counters->upload(std::vector<uint32_t>(SPLAT_COUNTER_COUNT, 0u));

@@ -32,6 +32,7 @@ using uint = uint32_t;
 #define SPLAT_GRAD2D_FIXED 7
 
 // ---- project.comp: one invocation per Gaussian ----
+// The parameters (bindings 0-4) are read as texels: R32_SFLOAT, the quaternions R32G32B32A32_SFLOAT.
 #define PROJECT_BINDING_MEANS 0           // [N][3] world
 #define PROJECT_BINDING_LOG_SCALES 1      // [N][3]
 #define PROJECT_BINDING_QUATS 2           // [N][4] w x y z, unnormalized
@@ -148,6 +149,8 @@ using uint = uint32_t;
 #define REDUCE_BINDING_COUNT 4
 
 // ---- project_backward.comp: one invocation per Gaussian ----
+// The parameters (bindings 0-4) and the gradient rows are read as texels: R32_SFLOAT, the quaternions
+// R32G32B32A32_SFLOAT.
 #define PBWD_BINDING_MEANS 0
 #define PBWD_BINDING_LOG_SCALES 1
 #define PBWD_BINDING_QUATS 2

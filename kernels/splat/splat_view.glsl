@@ -29,6 +29,10 @@ vec3 camera_centre() {
   return -(transpose(v.R) * v.t);
 }
 
+// Element i of a one-float texel buffer, and elements 3i .. 3i + 2 (a [N][3] array).
+float fetch1(samplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
+vec3 fetch3(samplerBuffer b, uint i) { return vec3(fetch1(b, 3u * i), fetch1(b, 3u * i + 1u), fetch1(b, 3u * i + 2u)); }
+
 // Model channel count (1 thermal, 3 RGB): a specialization constant so buffers and loops fit the model.
 layout(constant_id = 1) const uint CHANNELS = 1;
 // Gradient values per Gaussian (or intersection) between the per-pixel and per-Gaussian passes.
