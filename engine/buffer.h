@@ -59,6 +59,7 @@ class Buffer {
 
   // A view of the whole buffer as elements of `format`, made on first use and kept as long as the buffer.
   // Throws std::length_error naming the buffer when it holds more elements than maxTexelBufferElements.
+  // Not thread-safe (the view cache is unguarded): a buffer is bound from one recording thread at a time.
   VkBufferView texel_view(VkFormat format) const;
 
  private:

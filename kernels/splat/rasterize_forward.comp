@@ -29,8 +29,7 @@ layout(std430, binding = FWD_BINDING_ALPHA) buffer Alpha { float alpha_out[]; };
 layout(std430, binding = FWD_BINDING_LAST) buffer Last { uint last_out[]; };
 layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]; };
 
-
-// Each subgroup walks the tile's list on its own, SUBGROUP-wide chunk by chunk: lane k loads entry k of the
+// Each subgroup walks the tile's list on its own, a chunk of subgroup_lanes() entries at a time: lane k loads entry k of the
 // chunk (two index fetches, two four-float fetches and the colour), a ballot keeps the entries whose 1/255
 // footprint reaches the subgroup's pixels, and every lane then reads those entries from lane k by shuffle,
 // in list order, and blends each into its eight pixels. No shared memory, no barriers; on CPU drivers a
