@@ -361,6 +361,12 @@ void Rasterizer::forward(const DeviceGaussians& g, const SplatCamera& camera) {
         "Rasterizer::forward: " + std::to_string(m) + " tile intersections (" + std::to_string(n) +
         " Gaussians on " + std::to_string(tiles) +
         " tiles) exceed the 2^32 an intersection id can index; render fewer or smaller Gaussians");
+  // The rasterize kernels read the intersection lists as texels (one element per intersection).
+  if (m > ctx.info().max_texel_buffer_elements)
+    throw std::length_error("Rasterizer::forward: " + std::to_string(m) + " tile intersections exceed " +
+                            ctx.info().name + "'s maxTexelBufferElements " +
+                            std::to_string(ctx.info().max_texel_buffer_elements) +
+                            "; render fewer or smaller Gaussians, or at a lower resolution");
   intersections_ = m;
   longest_tile_list_ = c[SPLAT_COUNTER_MAX_LIST];
   forward_walks_cut_before_ = c[SPLAT_COUNTER_FORWARD_WALKS_CUT];
