@@ -82,14 +82,11 @@ uint32_t texel_format_bytes(VkFormat format) {
     case VK_FORMAT_R32_UINT:
     case VK_FORMAT_R32_SFLOAT:
       return 4;
-    case VK_FORMAT_R32G32_SFLOAT:
-      return 8;
     case VK_FORMAT_R32G32B32A32_SFLOAT:
       return 16;
     default:
       throw std::invalid_argument("texel format " + std::to_string(format) +
-                                  " is not one the engine binds (R32_UINT, R32_SFLOAT, R32G32_SFLOAT, "
-                                  "R32G32B32A32_SFLOAT)");
+                                  " is not one the engine binds (R32_UINT, R32_SFLOAT, R32G32B32A32_SFLOAT)");
   }
 }
 

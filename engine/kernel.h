@@ -25,8 +25,8 @@ struct SpecConstant {
 // four-component texel fetches 16 bytes per lane at once (docs/experiments.md, 2026-11-26).
 struct TexelBinding {
   uint32_t index = 0;                     // binding index, < KernelDesc::binding_count
-  VkFormat format = VK_FORMAT_UNDEFINED;  // element format: R32_UINT, R32_SFLOAT, R32G32_SFLOAT or
-                                          // R32G32B32A32_SFLOAT (uniform texel support is mandatory for them)
+  VkFormat format = VK_FORMAT_UNDEFINED;  // element format: R32_UINT, R32_SFLOAT or R32G32B32A32_SFLOAT
+                                          // (uniform texel support is mandatory for them)
 };
 
 struct KernelDesc {

@@ -3,7 +3,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "kernels/spirv_registry.h"
+#include "kernels/subgroup_kernel.h"
 
 namespace litgs::kernels {
 
@@ -20,17 +20,13 @@ const char* gather_read_name(GatherRead read) {
 }
 
 GatherBench::GatherBench(engine::Context& context, GatherRead read) {
-  engine::KernelDesc desc;
-  const bool texel = read == GatherRead::kTexelVec4;
-  desc.name = texel ? "bench/gather_texel" : "bench/gather_storage";
-  desc.spirv = spirv(desc.name);
-  desc.binding_count = GATHER_BENCH_BINDING_COUNT;
-  desc.push_constant_bytes = sizeof(GatherBenchParams);
-  if (texel)
-    desc.texel_bindings = {{GATHER_BENCH_BINDING_RECORDS, VK_FORMAT_R32G32B32A32_SFLOAT}};
+  if (read == GatherRead::kTexelVec4)
+    kernel_ =
+        make_kernel(context, "bench/gather_texel", GATHER_BENCH_BINDING_COUNT, sizeof(GatherBenchParams), {},
+                    {{GATHER_BENCH_BINDING_RECORDS, VK_FORMAT_R32G32B32A32_SFLOAT}});
   else
-    desc.spec_constants = {{0, read == GatherRead::kStorageVec4 ? 1u : 0u}};
-  kernel_ = std::make_unique<engine::Kernel>(context, std::move(desc));
+    kernel_ = make_kernel(context, "bench/gather_storage", GATHER_BENCH_BINDING_COUNT,
+                          sizeof(GatherBenchParams), {{0, read == GatherRead::kStorageVec4 ? 1u : 0u}});
 }
 
 void GatherBench::record(engine::Sequence& sequence, const engine::DeviceArray<float>& records,

@@ -108,24 +108,7 @@ EntryGrad entry_backward(inout PixelGrad p, vec4 mean_extent, vec4 conic_opacity
   return r;
 }
 
-// Loads list entry `i`'s Gaussian: its footprint, depth and alpha_reach(opacity) (the colour:
-// load_entry_color, for kept entries only).
-void load_entry(uint i, out uint g, out vec4 mean_extent, out vec4 conic_opacity, out float depth,
-                out float reach) {
-  g = texelFetch(isect_gaussian, int(texelFetch(isect_ids, int(i)).x)).x;
-  const vec4 centre_g = texelFetch(centres, int(g));  // mean2d, depth, opacity
-  const vec4 conic_g = texelFetch(conics, int(g));    // conic, alpha_reach(opacity)
-  mean_extent = vec4(centre_g.xy, alpha_extent(conic_g.xyz, conic_g.w));
-  conic_opacity = vec4(conic_g.xyz, centre_g.w);
-  depth = centre_g.z;
-  reach = conic_g.w;
-}
-
-vec4 load_entry_color(uint g) {
-  vec4 color = vec4(0.0);
-  for (uint c = 0u; c < CHANNELS; ++c) color[c] = texelFetch(colors, int(g * CHANNELS + c)).x;
-  return color;
-}
+#include "splat/list_entry.glsl"
 
 // Sums of three vectors over the subgroup, as a butterfly of XOR shuffles: on CPU drivers a shuffle with a
 // uniform mask is a register permute, several times cheaper than subgroupAdd.

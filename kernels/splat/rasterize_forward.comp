@@ -28,6 +28,7 @@ layout(std430, binding = FWD_BINDING_DEPTH) buffer Depth { float depth_out[]; };
 layout(std430, binding = FWD_BINDING_ALPHA) buffer Alpha { float alpha_out[]; };
 layout(std430, binding = FWD_BINDING_LAST) buffer Last { uint last_out[]; };
 layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]; };
+#include "splat/list_entry.glsl"
 
 // Each subgroup walks the tile's list on its own, a chunk of subgroup_lanes() entries at a time: lane k loads entry k of the
 // chunk (two index fetches, two four-float fetches and the colour), a ballot keeps the entries whose 1/255
@@ -136,17 +137,13 @@ void main() {
     float depth = 0.0;
     bool relevant = false;
     if (entry < end) {
-      const int g = int(texelFetch(isect_gaussian, int(texelFetch(isect_ids, int(entry)).x)).x);
-      const vec4 centre_g = texelFetch(centres, g);
-      const vec4 conic_g = texelFetch(conics, g);
-      mean_extent = vec4(centre_g.xy, alpha_extent(conic_g.xyz, conic_g.w));
-      conic_opacity = vec4(conic_g.xyz, centre_g.w);
-      depth = centre_g.z;
+      uint g;
+      float reach;  // for the ellipse test, which the forward does not take
+      load_entry(entry, g, mean_extent, conic_opacity, depth, reach);
       // The bounding box only: the backward's exact ellipse test (footprint_touches_box) costs the forward
       // more than the cheap blends it skips (measured on lavapipe, docs/experiments.md).
       relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
-      if (relevant)
-        for (uint c = 0u; c < CHANNELS; ++c) color[c] = texelFetch(colors, g * int(CHANNELS) + int(c)).x;
+      if (relevant) color = load_entry_color(g);
     }
     uvec4 todo = subgroupBallot(relevant);
     for (uint word = 0u; word < 4u; ++word) {

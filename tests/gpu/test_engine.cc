@@ -228,25 +228,21 @@ TEST_F(EngineTest, TexelReadsReturnWhatTheBufferHolds) {
   }
 }
 
+// The gather benchmark's texel kernel with the given texel bindings.
+std::unique_ptr<engine::Kernel> gather_texel_kernel(engine::Context& context,
+                                                    std::vector<engine::TexelBinding> texels) {
+  return kernels::make_kernel(context, "bench/gather_texel", GATHER_BENCH_BINDING_COUNT,
+                              sizeof(kernels::GatherBenchParams), {}, std::move(texels));
+}
+
 TEST_F(EngineTest, TexelBindingsAreCheckedWhenTheKernelIsBuilt) {
-  const auto desc_with = [&](std::vector<engine::TexelBinding> texels) {
-    engine::KernelDesc desc;
-    desc.name = "bench/gather_texel";
-    desc.spirv = kernels::spirv(desc.name);
-    desc.binding_count = GATHER_BENCH_BINDING_COUNT;
-    desc.push_constant_bytes = sizeof(kernels::GatherBenchParams);
-    desc.texel_bindings = std::move(texels);
-    return desc;
-  };
   const VkFormat rgba = VK_FORMAT_R32G32B32A32_SFLOAT;
-  EXPECT_NO_THROW(engine::Kernel(context(), desc_with({{GATHER_BENCH_BINDING_RECORDS, rgba}})));
-  EXPECT_THROW(engine::Kernel(context(), desc_with({{GATHER_BENCH_BINDING_COUNT, rgba}})),
-               std::invalid_argument)
+  EXPECT_NO_THROW(gather_texel_kernel(context(), {{GATHER_BENCH_BINDING_RECORDS, rgba}}));
+  EXPECT_THROW(gather_texel_kernel(context(), {{GATHER_BENCH_BINDING_COUNT, rgba}}), std::invalid_argument)
       << "index out of range";
-  EXPECT_THROW(engine::Kernel(context(), desc_with({{0, rgba}, {0, rgba}})), std::invalid_argument)
-      << "repeated";
+  EXPECT_THROW(gather_texel_kernel(context(), {{0, rgba}, {0, rgba}}), std::invalid_argument) << "repeated";
   try {
-    engine::Kernel kernel(context(), desc_with({{0, VK_FORMAT_R8G8B8A8_UNORM}}));
+    gather_texel_kernel(context(), {{0, VK_FORMAT_R8G8B8A8_UNORM}});
     FAIL() << "a format the engine does not size";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("R32G32B32A32_SFLOAT"), std::string::npos) << e.what();
@@ -257,13 +253,13 @@ TEST_F(EngineTest, TexelBindingsAreReadOnlyAndViewWholeElements) {
   kernels::GatherBench bench(context(), kernels::GatherRead::kTexelVec4);
   engine::DeviceArray<float> one_float(context(), "one float", 1), sums(context(), "sums", 4 * 64);
   engine::Sequence seq(context());
-  try {  // 4 bytes hold no four-float element: the view is refused, naming the buffer
+  try {  // the benchmark's own size check: one float is not a four-float record
     bench.record(seq, one_float, sums, {1, 1});
     FAIL() << "the record check should refuse one float as a record";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("1 records"), std::string::npos) << e.what();
   }
-  try {
+  try {  // the engine's: 4 bytes hold no four-float texel, and the refusal names the buffer
     (void)one_float.buffer().texel_view(VK_FORMAT_R32G32B32A32_SFLOAT);
     FAIL();
   } catch (const std::invalid_argument& e) {
@@ -274,15 +270,10 @@ TEST_F(EngineTest, TexelBindingsAreReadOnlyAndViewWholeElements) {
             one_float.buffer().texel_view(VK_FORMAT_R32_SFLOAT))
       << "a view is made once per format";
 
-  engine::KernelDesc desc;
-  desc.name = "bench/gather_texel";
-  desc.spirv = kernels::spirv(desc.name);
-  desc.binding_count = GATHER_BENCH_BINDING_COUNT;
-  desc.push_constant_bytes = sizeof(kernels::GatherBenchParams);
-  desc.texel_bindings = {{GATHER_BENCH_BINDING_RECORDS, VK_FORMAT_R32G32B32A32_SFLOAT}};
-  engine::Kernel kernel(context(), std::move(desc));
+  const auto kernel =
+      gather_texel_kernel(context(), {{GATHER_BENCH_BINDING_RECORDS, VK_FORMAT_R32G32B32A32_SFLOAT}});
   engine::DeviceArray<float> records(context(), "records", 4);
-  EXPECT_THROW(seq.dispatch(kernel, {1},
+  EXPECT_THROW(seq.dispatch(*kernel, {1},
                             {{GATHER_BENCH_BINDING_RECORDS, &records.buffer(), Access::kReadWrite},
                              {GATHER_BENCH_BINDING_SUMS, &sums.buffer(), Access::kWrite}},
                             kernels::GatherBenchParams{1, 1}),
