@@ -2,7 +2,6 @@
 // float loads, one vec4 load) against a uniform texel buffer (one fetch), in one run on one device. The
 // rasterize kernels' per-entry reads are such gathers; on CPU drivers the way they are read sets their cost.
 #include <CLI/CLI.hpp>
-#include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <memory>
