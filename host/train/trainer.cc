@@ -215,7 +215,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   kernels::RasterizerOptions ropt;
   ropt.deterministic = o.deterministic;
   ropt.depth_gradient_to_opacity = o.geo_gradient_to_opacity;
-  ropt.sh_gradient = false;  // the SH step computes it from the colour gradient (kernels/optim/sh_adam.h)
+  ropt.parameter_gradients = false;  // the fused Adam step computes them (kernels/optim/gaussian_adam.h)
   kernels::Rasterizer rasterizer(ctx, 1, ropt);
   TrainingStep training_step(ctx, data, planes, o, rasterizer);
   Evaluator evaluator(data, o, gt_planes, rasterizer);

@@ -100,16 +100,17 @@ void TrainingStep::run(kernels::TrainableGaussians& model, kernels::McmcStrategy
   const auto grads = rasterizer.record_backward(s);
   // After the backward, so that its walks cut short are in this step's copy.
   s.copy(*out.counters, render_counters_.buffer(), SPLAT_COUNTER_COUNT * sizeof(uint32_t));
-  if (mcmc)
-    mcmc->record_regularization(s, model, grads, mcmc_options_);
-  else if (step < o.refine_until())
-    model.record_accumulate_stats(s, grads, *out.rects, cam);
+  if (!mcmc && step < o.refine_until()) model.record_accumulate_stats(s, grads, *out.rects, cam);
   kernels::LearningRates lr =
       model.adam_options().rates(it, o.iterations, static_cast<float>(data_->scene_extent_m));
   for (float* r : {&lr.means, &lr.log_scales, &lr.quats, &lr.opacity_logits, &lr.sh_dc, &lr.sh_rest})
     *r *= o.lr_scale;
-  const kernels::TrainableGaussians::ShFromColour sh_from_colour{out.rects, cam};
-  model.record_adam_step(s, grads, lr, step, &sh_from_colour);
+  // One fused pass: the parameters' gradients (with MCMC's regularizers) and their Adam step.
+  const kernels::TrainableGaussians::FusedStep fused{
+      out.rects, cam,
+      mcmc ? kernels::McmcStrategy::regularization_weights(mcmc_options_, static_cast<uint32_t>(model.size()))
+           : kernels::RegularizationWeights{}};
+  model.record_adam_step(s, grads, lr, step, &fused);
   if (mcmc) mcmc->record_noise(s, model, mcmc_options_, lr.means, step);
   s.submit_and_wait();
   for (const auto& k : s.profile()) times[k.name] += k.ms;

@@ -199,6 +199,12 @@ McmcStrategy::Draws McmcStrategy::last_draws() const {
   return d;
 }
 
+RegularizationWeights McmcStrategy::regularization_weights(const McmcOptions& options, uint32_t gaussians) {
+  if (gaussians == 0) return {};
+  return {static_cast<float>(double{options.opacity_reg} / gaussians),
+          static_cast<float>(double{options.scale_reg} / (3.0 * gaussians))};
+}
+
 void McmcStrategy::record_regularization(engine::Sequence& sequence, const TrainableGaussians& model,
                                          const Rasterizer::DeviceGrads& grads,
                                          const McmcOptions& options) const {
@@ -208,10 +214,11 @@ void McmcStrategy::record_regularization(engine::Sequence& sequence, const Train
     throw std::invalid_argument("mcmc regularization: no opacity or log-scale gradient buffer");
   check_binding(*grads.opacity_logits, n, 4, "mcmc regularization: opacity gradients");
   check_binding(*grads.log_scales, 3ull * n, 4, "mcmc regularization: log-scale gradients");
+  const RegularizationWeights w = regularization_weights(options, n);
   McmcParams p{};
   p.count = n;
-  p.opacity_reg = static_cast<float>(double{options.opacity_reg} / n);
-  p.scale_reg = static_cast<float>(double{options.scale_reg} / (3.0 * n));
+  p.opacity_reg = w.opacity;
+  p.scale_reg = w.scale;
   const DeviceGaussians& g = model.gaussians();
   sequence.dispatch(*regularize_, elementwise_groups(*context_, n, "mcmc/mcmc_regularize"),
                     {{REG_BINDING_OPACITY_LOGITS, &g.opacity_logits.buffer(), Access::kRead},

@@ -65,7 +65,10 @@ class McmcStrategy {
   // Rasterizer::forward again after it.
   McmcReport relocate_and_grow(TrainableGaussians& model, const McmcOptions& options, uint32_t step,
                                const engine::Buffer* plane_distance = nullptr);
-  // Records the regularizers' gradients into `grads` (after the backward, before the Adam step).
+  // The regularizers' gradient weights for `gaussians` rows: opacity_reg / N and scale_reg / (3 N) (the
+  // losses are means over the rows), for the fused step (TrainableGaussians::FusedStep).
+  static RegularizationWeights regularization_weights(const McmcOptions& options, uint32_t gaussians);
+  // Records the regularizers' gradients into stored `grads` (after the backward, before the Adam step).
   void record_regularization(engine::Sequence& sequence, const TrainableGaussians& model,
                              const Rasterizer::DeviceGrads& grads, const McmcOptions& options) const;
   // Records the position noise (after the Adam step); `means_lr` is the step's learning rate of the means.

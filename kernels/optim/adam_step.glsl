@@ -1,5 +1,5 @@
 // One Adam step of one value (torch.optim.Adam's bias-corrected update), shared by adam.comp and
-// sh_adam.comp so that the two stay the same arithmetic. Returns false, changing nothing, when the gradient,
+// gaussian_adam.comp so that the two stay the same arithmetic. Returns false, changing nothing, when the gradient,
 // a moment or the new value is not finite (the caller counts the skip).
 bool adam_step_value(AdamParams a, float lr, float g, inout float param, inout float m, inout float v) {
   const float m1 = a.beta1 * m + (1.0 - a.beta1) * g;

@@ -37,29 +37,48 @@ struct AdamParams {
   uint reserved;
 };
 
-// ---- sh_adam.comp: Adam on the SH coefficients, their gradient computed in the kernel from the colour
-// gradient of the rasterizer's per-Gaussian rows (no stored SH gradient). One invocation per Gaussian. ----
-#define SH_ADAM_BINDING_SH 0          // [N][K][C] float, updated in place
-#define SH_ADAM_BINDING_EXP_AVG 1     // [N][K][C] float, updated in place
-#define SH_ADAM_BINDING_EXP_AVG_SQ 2  // [N][K][C] float, updated in place
-#define SH_ADAM_BINDING_COUNTERS 3    // [ADAM_COUNTER_SLOTS] uint
-#define SH_ADAM_BINDING_MEANS 4       // [N][3] float: the means the backward used (before their own step)
-#define SH_ADAM_BINDING_TILE_RECTS 5  // [N][2] packed tile rectangles: an empty one means culled, no gradient
-#define SH_ADAM_BINDING_GRAD2D 6      // [N][SPLAT_GRAD2D_FIXED + C] float: the colour gradient at the end
-#define SH_ADAM_BINDING_COUNT 7
+// ---- gaussian_adam.comp: the projection's backward, 3DGS-MCMC's regularizers and Adam for every parameter
+// group in one pass, one invocation per Gaussian: each gradient computed from the rasterizer's per-Gaussian
+// rows (splat/param_gradients.glsl) and applied at once, so that training stores no parameter gradient
+// (44 B + the SH's per Gaussian). Counter slot g counts group g's skipped elements (ParamGroup order:
+// means, log_scales, quats, opacity_logits, sh). ----
+#define GAUSSIAN_ADAM_BINDING_MEANS 0           // [N][3] float, updated in place
+#define GAUSSIAN_ADAM_BINDING_LOG_SCALES 1      // [N][3]
+#define GAUSSIAN_ADAM_BINDING_QUATS 2           // [N][4]
+#define GAUSSIAN_ADAM_BINDING_OPACITY_LOGITS 3  // [N]
+#define GAUSSIAN_ADAM_BINDING_SH 4              // [N][K][C]
+#define GAUSSIAN_ADAM_BINDING_EXP_AVG 5         // five bindings from here: the groups' first moments
+#define GAUSSIAN_ADAM_BINDING_EXP_AVG_SQ 10     // five bindings from here: the groups' second moments
+#define GAUSSIAN_ADAM_BINDING_COUNTERS 15       // [ADAM_COUNTER_SLOTS] uint
+#define GAUSSIAN_ADAM_BINDING_TILE_RECTS 16     // [N][2] packed: an empty rectangle means culled, no gradient
+#define GAUSSIAN_ADAM_BINDING_GRAD2D 17         // [N][SPLAT_GRAD2D_FIXED + C] float, the backward's rows
+#define GAUSSIAN_ADAM_BINDING_COUNT 18
+#define GAUSSIAN_ADAM_GROUPS 5
 
-struct ShAdamParams {
-  AdamParams adam;  // count: Gaussians; period K * C and lead C as for the SH buffer in adam.comp
-  float centre[3];  // camera centre in world coordinates
-  uint sh_degree;   // active degree (basis beyond it is 0)
-  uint sh_coeffs;   // K of the SH buffer
-  uint reserved;
+// Push constants: the view (as SplatView, without the tile grid) and the step. beta1, beta2 and eps are
+// specialization constants (2, 3, 4), so that all of it fits the 128 bytes every device offers.
+struct GaussianAdamParams {
+  float rot[9];          // R_cam_world, column-major
+  float trans[3];        // t_cam_world
+  float fx, fy, cx, cy;  // pixels
+  float near_m;
+  uint width, height;
+  uint count;                      // Gaussians
+  uint sh_degree;                  // active degree
+  uint sh_coeffs;                  // K of the SH buffer
+  float lr[GAUSSIAN_ADAM_GROUPS];  // means, log_scales, quats, opacity_logits, SH degree 0
+  float lr_sh_rest;                // the SH coefficients above degree 0
+  float bias_correction1;          // 1 - beta1^step (step counted from 1)
+  float sqrt_bias_correction2;     // sqrt(1 - beta2^step)
+  float opacity_reg;               // added to each opacity logit's gradient: opacity_reg * o (1 - o)
+  float scale_reg;                 // added to each log-scale's gradient: scale_reg * exp(log_scale)
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(AdamParams) <= 128);
-static_assert(sizeof(ShAdamParams) <= 128);
-static_assert(SH_ADAM_BINDING_COUNT == SH_ADAM_BINDING_GRAD2D + 1);
+static_assert(sizeof(GaussianAdamParams) <= 128);
+static_assert(GAUSSIAN_ADAM_BINDING_COUNT == GAUSSIAN_ADAM_BINDING_GRAD2D + 1);
+static_assert(GAUSSIAN_ADAM_GROUPS <= ADAM_COUNTER_SLOTS);
 static_assert(ADAM_BINDING_COUNT == ADAM_BINDING_COUNTERS + 1);
 }  // namespace litgs::kernels
 #endif

@@ -75,7 +75,7 @@ TrainableGaussians::TrainableGaussians(engine::Context& context, const TrainingS
       channels_(state.model.channels),
       sh_degree_(state.model.sh_degree),
       adam_(context),
-      sh_adam_(context, state.model.channels),
+      gaussian_adam_(context, state.model.channels, adam),
       scan_(context) {
   adam_options_.check();
   state.check();
@@ -154,29 +154,29 @@ void TrainableGaussians::upload_state(Slot& slot, const TrainingState& state) {
 }
 
 void TrainableGaussians::record_adam_step(engine::Sequence& sequence, const Rasterizer::DeviceGrads& grads,
-                                          const LearningRates& lr, uint32_t step,
-                                          const ShFromColour* sh_from_colour) {
+                                          const LearningRates& lr, uint32_t step, const FusedStep* fused) {
   const Slot& s = *current_;
   const uint64_t n = size();
+  if (!grads.means) {
+    if (!fused || !fused->tile_rects || !grads.grad2d)
+      throw std::invalid_argument(
+          "record_adam_step: no stored gradients, and no tile rectangles and camera to compute them from");
+    GaussianAdamKernel::Target t;
+    for (uint32_t g = 0; g < kParamGroupCount; ++g) {
+      t.params[g] = &param_buffer(*s.params, g);
+      t.exp_avg[g] = &s.exp_avg[g]->buffer();
+      t.exp_avg_sq[g] = &s.exp_avg_sq[g]->buffer();
+    }
+    t.counters = &adam_counters_->buffer();
+    t.tile_rects = fused->tile_rects;
+    t.grad2d = grads.grad2d;
+    gaussian_adam_.record(sequence, t, static_cast<uint32_t>(n), sh_values() / channels_, fused->camera,
+                          adam_options_, step, lr, fused->regularization);
+    return;
+  }
   const auto widths = group_widths(sh_values());
   const float rates[kParamGroupCount] = {lr.means, lr.log_scales, lr.quats, lr.opacity_logits, lr.sh_dc};
-  if (!grads.sh) {
-    if (!sh_from_colour || !sh_from_colour->tile_rects || !grads.grad2d)
-      throw std::invalid_argument(
-          "record_adam_step: no SH gradient buffer and no tile rectangles and camera to compute it from");
-    // First: the SH gradient's view direction comes from the means before their step.
-    ShAdamKernel::Target t{&s.params->sh.buffer(),
-                           &s.exp_avg[kSh]->buffer(),
-                           &s.exp_avg_sq[kSh]->buffer(),
-                           &adam_counters_->buffer(),
-                           &s.params->means.buffer(),
-                           sh_from_colour->tile_rects,
-                           grads.grad2d};
-    sh_adam_.record(sequence, t, static_cast<uint32_t>(n), sh_values() / channels_, sh_from_colour->camera,
-                    adam_options_, step, lr.sh_dc, lr.sh_rest, kSh);
-  }
   for (uint32_t g = 0; g < kParamGroupCount; ++g) {
-    if (g == kSh && !grads.sh) continue;
     const engine::Buffer* grad = grad_buffer(grads, g);
     if (!grad)
       throw std::invalid_argument(std::string("record_adam_step: no gradient buffer for ") +

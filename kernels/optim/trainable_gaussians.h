@@ -18,7 +18,7 @@
 #include "engine/sequence.h"
 #include "kernels/densify/densify.h"
 #include "kernels/optim/adam.h"
-#include "kernels/optim/sh_adam.h"
+#include "kernels/optim/gaussian_adam.h"
 #include "kernels/optim/training_state.h"
 #include "kernels/scan/scan.h"
 #include "kernels/splat/rasterizer.h"
@@ -43,17 +43,19 @@ class TrainableGaussians {
   size_t size() const;
   size_t capacity() const;  // rows the current buffers hold
 
-  // What the SH step needs when the rasterizer stored no SH gradient (RasterizerOptions::sh_gradient false):
-  // the forward's tile rectangles and camera, to compute it from the colour gradient
-  // (kernels/optim/sh_adam.h).
-  struct ShFromColour {
+  // What the fused step needs when the rasterizer stored no parameter gradients
+  // (RasterizerOptions::parameter_gradients false): the forward's tile rectangles and camera, and the
+  // regularizers' weights (kernels/optim/gaussian_adam.h).
+  struct FusedStep {
     const engine::Buffer* tile_rects = nullptr;
     SplatCamera camera;
+    RegularizationWeights regularization;
   };
-  // Records one Adam step (step counts from 1) of every group from the rasterizer's gradients. Without
-  // grads.sh, `sh_from_colour` is required (std::invalid_argument otherwise).
+  // Records one Adam step (step counts from 1) of every group from the rasterizer's gradients: from the
+  // stored gradients of every group (grads.means ... grads.sh), or, when the rasterizer stored none, in one
+  // fused pass from grads.grad2d, which needs `fused` (std::invalid_argument otherwise).
   void record_adam_step(engine::Sequence& sequence, const Rasterizer::DeviceGrads& grads,
-                        const LearningRates& lr, uint32_t step, const ShFromColour* sh_from_colour = nullptr);
+                        const LearningRates& lr, uint32_t step, const FusedStep* fused = nullptr);
   // Records the densification statistics of the last backward: for Gaussians whose tile rectangle (the
   // rasterizer's `rects`) is not empty, grad_accum += |(dL/du W/2, dL/dv H/2)|, denom += 1, and
   // max_radius = max(max_radius, opacity-aware screen radius in pixels). Record before the Adam step.
@@ -100,7 +102,7 @@ class TrainableGaussians {
   bool statistics_;  // the densification statistics are kept
   uint32_t channels_, sh_degree_;
   AdamKernel adam_;
-  ShAdamKernel sh_adam_;
+  GaussianAdamKernel gaussian_adam_;
   ExclusiveScan scan_;
   std::unique_ptr<engine::Kernel> stats_, candidates_, decide_, scatter_rows_, scatter_geometry_,
       reset_opacity_;

@@ -209,8 +209,7 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
                    rasterize_texel_bindings(BWD_BINDING_ISECT_IDS, BWD_BINDING_ISECT_GAUSSIAN,
                                             BWD_BINDING_CENTRES, BWD_BINDING_CONICS, BWD_BINDING_COLORS));
   reduce_ = make("splat/reduce_isect_grads", REDUCE_BINDING_COUNT, sizeof(SplatView));
-  project_backward_ = make("splat/project_backward", PBWD_BINDING_COUNT, sizeof(SplatView),
-                           {{2, options_.sh_gradient ? 1u : 0u}},
+  project_backward_ = make("splat/project_backward", PBWD_BINDING_COUNT, sizeof(SplatView), {},
                            {{PBWD_BINDING_MEANS, f1},
                             {PBWD_BINDING_LOG_SCALES, f1},
                             {PBWD_BINDING_QUATS, f4},
@@ -489,11 +488,6 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
   const uint32_t stride = SPLAT_GRAD2D_FIXED + channels_;
   upstream_buffers();
   grow(ctx, b.grad2d, size_t{n} * stride, "splat: grad2d");
-  grow(ctx, b.g_means, 3 * size_t{n}, "splat: grad means");
-  grow(ctx, b.g_log_scales, 3 * size_t{n}, "splat: grad log_scales");
-  grow(ctx, b.g_quats, 4 * size_t{n}, "splat: grad quats");
-  grow(ctx, b.g_logits, n, "splat: grad opacity_logits");
-  grow(ctx, b.g_sh, options_.sh_gradient ? size_t{n} * K * channels_ : 1, "splat: grad sh");
   if (options_.deterministic) grow(ctx, b.isect_grads, intersections_ * stride, "splat: intersection grads");
   backward_passes_ = passes_for(backward_entries_per_pass_);
   const size_t pixels = static_cast<size_t>(last_camera_.width) * last_camera_.height;
@@ -526,6 +520,13 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
                 {REDUCE_BINDING_ISECT_GRADS, &b.isect_grads->buffer(), Access::kRead},
                 {REDUCE_BINDING_GRAD2D, &b.grad2d->buffer(), Access::kWrite}},
                view);
+  if (!options_.parameter_gradients)
+    return {nullptr, nullptr, nullptr, nullptr, nullptr, &b.grad2d->buffer()};
+  grow(ctx, b.g_means, 3 * size_t{n}, "splat: grad means");
+  grow(ctx, b.g_log_scales, 3 * size_t{n}, "splat: grad log_scales");
+  grow(ctx, b.g_quats, 4 * size_t{n}, "splat: grad quats");
+  grow(ctx, b.g_logits, n, "splat: grad opacity_logits");
+  grow(ctx, b.g_sh, size_t{n} * K * channels_, "splat: grad sh");
   s.dispatch(*project_backward_, elementwise_groups(*context_, n, "splat/project_backward"),
              {{PBWD_BINDING_MEANS, &g.means.buffer(), Access::kRead},
               {PBWD_BINDING_LOG_SCALES, &g.log_scales.buffer(), Access::kRead},
@@ -540,15 +541,13 @@ Rasterizer::DeviceGrads Rasterizer::record_backward(engine::Sequence& s) {
               {PBWD_BINDING_GRAD_OPACITY_LOGITS, &b.g_logits->buffer(), Access::kWrite},
               {PBWD_BINDING_GRAD_SH, &b.g_sh->buffer(), Access::kWrite}},
              view);
-  return {&b.g_means->buffer(),
-          &b.g_log_scales->buffer(),
-          &b.g_quats->buffer(),
-          &b.g_logits->buffer(),
-          options_.sh_gradient ? &b.g_sh->buffer() : nullptr,
-          &b.grad2d->buffer()};
+  return {&b.g_means->buffer(),  &b.g_log_scales->buffer(), &b.g_quats->buffer(),
+          &b.g_logits->buffer(), &b.g_sh->buffer(),         &b.grad2d->buffer()};
 }
 
 GaussianGrads<float> Rasterizer::download_grads() const {
+  if (!options_.parameter_gradients)
+    throw std::logic_error("Rasterizer::download_grads: this rasterizer stores no parameter gradients");
   if (!last_gaussians_ || !buffers_->g_means)
     throw std::logic_error("Rasterizer::download_grads before backward");
   const Buffers& b = *buffers_;
@@ -559,7 +558,7 @@ GaussianGrads<float> Rasterizer::download_grads() const {
   out.log_scales = b.g_log_scales->download(0, 3 * n);
   out.quats = b.g_quats->download(0, 4 * n);
   out.opacity_logits = b.g_logits->download(0, n);
-  if (options_.sh_gradient) out.sh = b.g_sh->download(0, n * K * channels_);
+  out.sh = b.g_sh->download(0, n * K * channels_);
   const size_t stride = SPLAT_GRAD2D_FIXED + channels_;
   const std::vector<float> rows = b.grad2d->download(0, n * stride);
   out.means2d.resize(2 * n);

@@ -32,10 +32,10 @@ struct RasterizerOptions {
   // the device's subgroup size so that no pass exceeds a driver's loop limit (the default). Tests set it to
   // force many passes on short lists, or one oversized pass.
   uint32_t entries_per_pass = 0;
-  // false: the backward stores no SH gradient (DeviceGrads::sh is null, download_grads() leaves `sh` empty);
-  // the optimizer computes it from the colour gradient in grad2d (kernels/optim/sh_adam.h). Training uses it:
-  // 64 B per Gaussian at SH degree 3 and one channel.
-  bool sh_gradient = true;
+  // false: the backward stops at the per-Gaussian rows (grad2d) and stores no parameter gradient
+  // (DeviceGrads has only grad2d; download_grads() throws); the optimizer's fused step computes them
+  // (kernels/optim/gaussian_adam.h). Training uses it: 108 B per Gaussian at SH degree 3 and one channel.
+  bool parameter_gradients = true;
 };
 
 // Counters of a rasterizer's renders (Rasterizer::read_counters).
@@ -112,11 +112,12 @@ class Rasterizer {
   // creation; the caller overwrites or fills them before record_backward).
   DeviceUpstream upstream_buffers();
   struct DeviceGrads {
+    // Null without RasterizerOptions::parameter_gradients.
     const engine::Buffer* means;           // [N][3]
     const engine::Buffer* log_scales;      // [N][3]
     const engine::Buffer* quats;           // [N][4]
     const engine::Buffer* opacity_logits;  // [N]
-    const engine::Buffer* sh;              // [N][K][C]; null without RasterizerOptions::sh_gradient
+    const engine::Buffer* sh;              // [N][K][C]
     // [N][SPLAT_GRAD2D_FIXED + C] the projected quantities' gradients; dL/d(mean2d) in columns 0 and 1
     // (densification statistics read them there: no separate copy).
     const engine::Buffer* grad2d;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gpu_test.h"
+#include "kernels/mcmc/mcmc.h"
 #include "kernels/optim/trainable_gaussians.h"
 #include "splat_scenes.h"
 
@@ -230,11 +231,12 @@ TEST_F(TrainingSmokeTest, WithoutDensifyStatisticsTheModelHasNoStatisticArrays) 
   }
 }
 
-// Training stores no SH gradient: the SH step computes it from the colour gradient in the rasterizer's rows
-// (kernels/optim/sh_adam.comp). Three steps that way must match three steps from the stored gradient
-// (project_backward's, itself checked against the double reference): every parameter and moment of every
-// group, for one and three channels, with the active SH degree below the model's and some Gaussians culled.
-TEST_F(TrainingSmokeTest, TheShStepFromTheColourGradientEqualsTheStepFromTheStoredGradient) {
+// Training stores no parameter gradient: one fused pass (kernels/optim/gaussian_adam.comp) computes each
+// Gaussian's gradients from the rasterizer's rows, adds MCMC's regularizers and steps Adam. Three steps that
+// way must match three steps of the separate kernels (project_backward, itself checked against the double
+// reference; mcmc_regularize; adam): every parameter and moment of every group, for one and three channels,
+// with the active SH degree below the model's and some Gaussians culled.
+TEST_F(TrainingSmokeTest, TheFusedStepEqualsTheSeparateBackwardRegularizationAndAdamSteps) {
   for (uint32_t channels : {1u, 3u}) {
     SCOPED_TRACE(channels);
     const uint32_t W = 64, H = 48;
@@ -243,9 +245,13 @@ TEST_F(TrainingSmokeTest, TheShStepFromTheColourGradientEqualsTheStepFromTheStor
     GaussianModel start = testing::random_scene(300, channels, 3, 17);
     for (size_t i = 0; i < 20; ++i) start.means[3 * i + 2] = -1.0f;  // behind the camera: culled
     TrainableGaussians stored(context(), start), computed(context(), start);
-    RasterizerOptions without_sh;
-    without_sh.sh_gradient = false;
-    Rasterizer raster_stored(context(), channels), raster_computed(context(), channels, without_sh);
+    RasterizerOptions fused_options;
+    fused_options.parameter_gradients = false;
+    Rasterizer raster_stored(context(), channels), raster_computed(context(), channels, fused_options);
+    McmcStrategy mcmc(context());
+    McmcOptions mcmc_options;
+    mcmc_options.opacity_reg = 0.5f;  // large, so that the regularizers' share of the gradient is seen
+    mcmc_options.scale_reg = 0.5f;
     std::mt19937 rng(3);
     std::normal_distribution<float> normal(0.0f, 1e-3f);
     for (uint32_t step = 1; step <= 3; ++step) {
@@ -262,11 +268,15 @@ TEST_F(TrainingSmokeTest, TheShStepFromTheColourGradientEqualsTheStepFromTheStor
         const Rasterizer::DeviceGrads grads = raster->record_backward(s);
         const LearningRates lr = model->adam_options().rates(step - 1, 3, 5.0f);
         if (raster == &raster_computed) {
+          ASSERT_EQ(grads.means, nullptr);
           ASSERT_EQ(grads.sh, nullptr);
-          const TrainableGaussians::ShFromColour from{raster->device_outputs().rects, camera};
-          model->record_adam_step(s, grads, lr, step, &from);
+          const TrainableGaussians::FusedStep fused{
+              raster->device_outputs().rects, camera,
+              McmcStrategy::regularization_weights(mcmc_options, static_cast<uint32_t>(model->size()))};
+          model->record_adam_step(s, grads, lr, step, &fused);
         } else {
           ASSERT_NE(grads.sh, nullptr);
+          mcmc.record_regularization(s, *model, grads, mcmc_options);
           model->record_adam_step(s, grads, lr, step);
         }
         s.submit_and_wait();
@@ -282,6 +292,9 @@ TEST_F(TrainingSmokeTest, TheShStepFromTheColourGradientEqualsTheStepFromTheStor
     };
     expect_close(a.model.sh, b.model.sh, "sh");
     expect_close(a.model.means, b.model.means, "means");
+    expect_close(a.model.log_scales, b.model.log_scales, "log_scales");
+    expect_close(a.model.quats, b.model.quats, "quats");
+    expect_close(a.model.opacity_logits, b.model.opacity_logits, "opacity_logits");
     for (uint32_t g = 0; g < kParamGroupCount; ++g) {
       expect_close(a.exp_avg[g], b.exp_avg[g], "exp_avg");
       expect_close(a.exp_avg_sq[g], b.exp_avg_sq[g], "exp_avg_sq");
