@@ -108,7 +108,10 @@ void main() {
   }
   for (uint k = 0u; k < 4u; ++k) ADAM_ELEMENT(quats, m_quats, v_quats, 4 * i + k, g.quat[k], p.lr[2], 2u)
   ADAM_ELEMENT(opacity_logits, m_logits, v_logits, i, g.logit, p.lr[3], 3u)
-  for (uint k = 0u; k < K; ++k)
+  // SH bands above the active degree are not stepped: their gradient is 0, and has been since training
+  // began (the active degree only rises), so their moments are 0 and Adam's step would leave them exactly.
+  const uint active_coeffs = min(K, (p.sh_degree + 1u) * (p.sh_degree + 1u));
+  for (uint k = 0u; k < active_coeffs; ++k)
     for (uint c = 0u; c < CHANNELS; ++c) {
       const uint j = (i * K + k) * CHANNELS + c;
       ADAM_ELEMENT(sh, m_sh, v_sh, j, g.basis[k] * g.color[c], k == 0u ? p.lr[4] : p.lr_sh_rest, 4u)

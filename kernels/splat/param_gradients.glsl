@@ -44,14 +44,16 @@ ParamGradients param_gradients(uint i, ViewGeometry geometry, uint sh_degree, ui
   sh_basis(sh_degree, dir, grads.basis);
   float weights[SPLAT_MAX_SH_COEFFS];
   for (uint k = 0u; k < uint(SPLAT_MAX_SH_COEFFS); ++k) weights[k] = 0.0;
+  // The basis is 0 beyond the active degree: those coefficients add nothing (to finite sums).
+  const uint active_coeffs = min(K, (sh_degree + 1u) * (sh_degree + 1u));
   for (uint c = 0u; c < CHANNELS; ++c) {
     const float g_color = grad2d_value(base + SPLAT_GRAD2D_FIXED + c);
     float sum = 0.5;
-    for (uint k = 0u; k < K; ++k) sum += grads.basis[k] * param_sh((i * K + k) * CHANNELS + c);
+    for (uint k = 0u; k < active_coeffs; ++k) sum += grads.basis[k] * param_sh((i * K + k) * CHANNELS + c);
     const bool clamped = sum < 0.0;
     grads.color[c] = clamped ? 0.0 : g_color;
     if (!clamped)
-      for (uint k = 0u; k < K; ++k) weights[k] += g_color * param_sh((i * K + k) * CHANNELS + c);
+      for (uint k = 0u; k < active_coeffs; ++k) weights[k] += g_color * param_sh((i * K + k) * CHANNELS + c);
   }
   const vec3 ddir = sh_basis_dir_grad(sh_degree, dir, weights);
   const vec3 dray = (ddir - dir * dot(dir, ddir)) / length(ray);
