@@ -29,7 +29,8 @@ struct BenchRenderOptions {
   uint32_t channels = 1;
   bool backward = false;
   bool deterministic = false;
-  uint32_t runs = 5;  // timed runs after one warm-up
+  uint32_t pixels_per_invocation = 0;  // 0: the device's default (RasterizerOptions)
+  uint32_t runs = 5;                   // timed runs after one warm-up
   uint32_t seed = 1;
   bool json = false;
   void check() const {
@@ -37,6 +38,8 @@ struct BenchRenderOptions {
     if (channels < 1 || channels > 4) throw std::invalid_argument("--channels must be 1..4");
     if (width == 0 || height == 0) throw std::invalid_argument("--width and --height must be positive");
     if (runs < 1) throw std::invalid_argument("--runs must be at least 1");
+    if (pixels_per_invocation != 0 && pixels_per_invocation != 1 && pixels_per_invocation != 8)
+      throw std::invalid_argument("--pixels-per-invocation must be 0 (the device's default), 1 or 8");
   }
 };
 
@@ -68,6 +71,7 @@ void run_bench_render(const BenchRenderOptions& o) {
   kernels::DeviceGaussians gaussians(context, model);
   kernels::RasterizerOptions options;
   options.deterministic = o.deterministic;
+  options.pixels_per_invocation = o.pixels_per_invocation;
   kernels::Rasterizer rasterizer(context, o.channels, options);
 
   kernels::RenderGradInput grad;
@@ -113,6 +117,7 @@ void run_bench_render(const BenchRenderOptions& o) {
                         {"sh_degree", o.sh_degree},
                         {"channels", o.channels},
                         {"runs", o.runs},
+                        {"pixels_per_invocation", rasterizer.pixels_per_invocation()},
                         {"forward_ms", median(forward_ms)},
                         {"gpu_kernels_ms", all_kernels_ms},
                         {"intersections", rasterizer.intersections()},
@@ -144,6 +149,7 @@ void run_bench_render(const BenchRenderOptions& o) {
             << ", median of " << o.runs << " runs after a warm-up, on " << context.info().name << "\n"
             << "  intersections        " << rasterizer.intersections() << " (" << per_gaussian
             << " per Gaussian)\n"
+            << "  pixels / invocation  " << rasterizer.pixels_per_invocation() << "\n"
             << "  longest tile list    " << counters.longest_tile_list
             << " entries: " << counters.forward_passes << " forward pass(es) of "
             << rasterizer.forward_entries_per_pass() << ", " << counters.backward_passes
@@ -188,6 +194,9 @@ void add_bench_render_command(CLI::App& bench) {
   cmd->add_option("--channels", o->channels, "Channels (1 thermal, 3 RGB)")->capture_default_str();
   cmd->add_flag("--backward", o->backward, "Also time forward + backward");
   cmd->add_flag("--deterministic", o->deterministic, "Deterministic backward (no float atomics)");
+  cmd->add_option("--pixels-per-invocation", o->pixels_per_invocation,
+                  "Rasterize layout: 8 (2x4 blocks) or 1; 0: the device's default (8 on a CPU, 1 on a GPU)")
+      ->capture_default_str();
   cmd->add_option("--runs", o->runs, "Timed runs after one warm-up")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Scene seed")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON object");

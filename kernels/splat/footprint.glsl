@@ -23,25 +23,43 @@ bool footprint_reaches(vec4 mean_extent, vec2 lo, vec2 hi) {
 // no result and keeps exp() away from denormals, which are very slow on CPUs.
 const float SIGMA_CUTOFF = 30.0;
 
-// The origin of this invocation's 2x4 block of pixels: invocation i of the tile's 8x4 grid of blocks, in Z
-// (Morton) order, so that a subgroup of S invocations covers a compact region (S = 8: 8x8 pixels, 32: the
-// tile) and skips the footprints that miss it. Why eight pixels per invocation: every subgroup reads its
-// tile's whole list, so fewer subgroups per tile mean fewer reads, tests, butterfly sums and atomic adds per
-// pixel (docs/design.md, how the rasterizer works).
-#if SPLAT_TILE_SIZE != 16 || SPLAT_GROUP_X != 8 || SPLAT_GROUP_Y != 4
-#error "block_origin() numbers the 2x4 blocks of a 16x16 tile"
+#ifdef SPLAT_RASTERIZE_PASS
+// Pixels per invocation, 8 (a 2x4 block) or 1, and the workgroup size (8x4 or 16x16 invocations per 16x16
+// tile): specialization constants (splat_shared.h). On a CPU device every subgroup reads its tile's whole
+// list, so eight pixels per invocation mean fewer reads, tests, butterfly sums and atomic adds per pixel
+// (docs/design.md, how the rasterizer works); a GPU wants the 256 invocations.
+#if SPLAT_TILE_SIZE != 16
+#error "block_origin() numbers the pixels of a 16x16 tile"
 #endif
+layout(constant_id = SPLAT_SPEC_PIXEL_BLOCK) const uint PIXEL_BLOCK = 8u;
+layout(local_size_x = 8, local_size_y = 4) in;
+layout(local_size_x_id = SPLAT_SPEC_GROUP_X, local_size_y_id = SPLAT_SPEC_GROUP_Y) in;
+const uint GROUP_INVOCATIONS = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+
+// The origin of this invocation's block of pixels (PIXEL_BLOCK 8: 2x4 pixels, 1: one pixel), invocations in
+// Z (Morton) order, so that a subgroup covers a compact region (8 lanes: 8x8 pixels with 2x4 blocks, 4x2
+// with one pixel; 32 lanes: the tile, or 8x4) and skips the footprints that miss it.
 uvec2 block_origin() {
   const uint i = gl_LocalInvocationIndex;
+  const uvec2 tile_origin = gl_WorkGroupID.xy * uint(SPLAT_TILE_SIZE);
+  if (PIXEL_BLOCK == 1u) {
+    const uint x = (i & 1u) | ((i >> 1u) & 2u) | ((i >> 2u) & 4u) | ((i >> 3u) & 8u);
+    const uint y = ((i >> 1u) & 1u) | ((i >> 2u) & 2u) | ((i >> 3u) & 4u) | ((i >> 4u) & 8u);
+    return tile_origin + uvec2(x, y);
+  }
   const uint x = (i & 1u) | ((i >> 1u) & 2u) | ((i >> 2u) & 4u);
   const uint y = ((i >> 1u) & 1u) | ((i >> 2u) & 2u);
-  return gl_WorkGroupID.xy * uint(SPLAT_TILE_SIZE) + uvec2(2u * x, 4u * y);
+  return tile_origin + uvec2(2u * x, 4u * y);
 }
 
-#ifdef SPLAT_RASTERIZE_PASS
+// Pixel (dx, dy) of the invocation's block, or one outside every image when the block has one pixel.
+uvec2 block_pixel(uvec2 origin, uint dx, uint dy) {
+  return PIXEL_BLOCK == 8u || (dx == 0u && dy == 0u) ? origin + uvec2(dx, dy) : uvec2(0xffffffffu);
+}
+
 // The subgroup's lanes that exist: a device whose subgroups are wider than the workgroup (64-wide AMD waves)
 // runs it as one partial subgroup, whose chunks of list entries and butterfly sums must not reach past it.
-uint subgroup_lanes() { return min(gl_SubgroupSize, uint(SPLAT_GROUP_INVOCATIONS)); }
+uint subgroup_lanes() { return min(gl_SubgroupSize, GROUP_INVOCATIONS); }
 #endif
 
 // sigma along the edge x = dx (relative to the mean) of a box, at its smallest: dy = -(b / c) dx clamped

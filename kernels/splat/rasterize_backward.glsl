@@ -1,4 +1,4 @@
-// One workgroup per tile, one invocation per 2x4 pixels (as rasterize_forward.comp, for the same reason):
+// One workgroup per tile, one invocation per 2x4 pixels or per pixel (as rasterize_forward.comp):
 // walk the tile's list back to front from each pixel's last contributor, recovering transmittance by division (alpha <= 0.99 keeps it stable), and turn the
 // pixel's upstream gradients into per-Gaussian gradients of (mean2d, conic, opacity, depth, colour).
 //
@@ -18,8 +18,6 @@
 #include "splat/splat_shared.h"
 #include "splat/splat_math.h"
 #include "splat/splat_view.glsl"
-
-layout(local_size_x = SPLAT_GROUP_X, local_size_y = SPLAT_GROUP_Y) in;
 
 layout(std430, binding = BWD_BINDING_RANGES) readonly buffer Ranges { uvec2 ranges[]; };
 // The per-entry reads, as texels (splat_shared.h).
@@ -132,9 +130,9 @@ void subgroup_sum3(inout vec4 a, inout vec4 b, inout vec4 c) {
 }
 
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
-// Per chunk, each lane's entry sums of each subgroup: [subgroup * S + lane][3] (subgroups x S = 32).
-const uint WORKGROUP_INVOCATIONS = SPLAT_GROUP_INVOCATIONS;
-shared vec4 s_partial[WORKGROUP_INVOCATIONS * 3];
+// Per chunk, each lane's entry sums of each subgroup: [subgroup * S + lane][3] (subgroups x S = the
+// workgroup's invocations).
+shared vec4 s_partial[GROUP_INVOCATIONS * 3];
 shared uint s_walk;
 #else
 void add_to(uint index, float value) {
@@ -194,17 +192,20 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 subg
       const float dep = subgroupShuffle(depth, k);
       const uint entry = chunk_start + k;
       const EntryGrad r0 = entry_backward(p0, me, co, col, dep, entry);
-      const EntryGrad r1 = entry_backward(p1, me, co, col, dep, entry);
-      const EntryGrad r2 = entry_backward(p2, me, co, col, dep, entry);
-      const EntryGrad r3 = entry_backward(p3, me, co, col, dep, entry);
-      const EntryGrad r4 = entry_backward(p4, me, co, col, dep, entry);
-      const EntryGrad r5 = entry_backward(p5, me, co, col, dep, entry);
-      const EntryGrad r6 = entry_backward(p6, me, co, col, dep, entry);
-      const EntryGrad r7 = entry_backward(p7, me, co, col, dep, entry);
-      vec4 s0 = ((r0.g0 + r1.g0) + (r2.g0 + r3.g0)) + ((r4.g0 + r5.g0) + (r6.g0 + r7.g0));
-      vec4 s1 = ((r0.g1 + r1.g1) + (r2.g1 + r3.g1)) + ((r4.g1 + r5.g1) + (r6.g1 + r7.g1));
-      vec4 s2 = channels_add(channels_add(channels_add(r0.g2, r1.g2), channels_add(r2.g2, r3.g2)),
-                             channels_add(channels_add(r4.g2, r5.g2), channels_add(r6.g2, r7.g2)));
+      vec4 s0 = r0.g0, s1 = r0.g1, s2 = r0.g2;
+      if (PIXEL_BLOCK == 8u) {
+        const EntryGrad r1 = entry_backward(p1, me, co, col, dep, entry);
+        const EntryGrad r2 = entry_backward(p2, me, co, col, dep, entry);
+        const EntryGrad r3 = entry_backward(p3, me, co, col, dep, entry);
+        const EntryGrad r4 = entry_backward(p4, me, co, col, dep, entry);
+        const EntryGrad r5 = entry_backward(p5, me, co, col, dep, entry);
+        const EntryGrad r6 = entry_backward(p6, me, co, col, dep, entry);
+        const EntryGrad r7 = entry_backward(p7, me, co, col, dep, entry);
+        s0 = ((r0.g0 + r1.g0) + (r2.g0 + r3.g0)) + ((r4.g0 + r5.g0) + (r6.g0 + r7.g0));
+        s1 = ((r0.g1 + r1.g1) + (r2.g1 + r3.g1)) + ((r4.g1 + r5.g1) + (r6.g1 + r7.g1));
+        s2 = channels_add(channels_add(channels_add(r0.g2, r1.g2), channels_add(r2.g2, r3.g2)),
+                          channels_add(channels_add(r4.g2, r5.g2), channels_add(r6.g2, r7.g2)));
+      }
       subgroup_sum3(s0, s1, s2);
       if (gl_SubgroupInvocationID == k) {
         a0 = s0;
@@ -263,19 +264,20 @@ void main() {
   const uvec2 range = ranges[tile];
   const uint plane = view.width * view.height;
   PixelGrad p0 = start_pixel(base, plane);
-  PixelGrad p1 = start_pixel(base + uvec2(1u, 0u), plane);
-  PixelGrad p2 = start_pixel(base + uvec2(0u, 1u), plane);
-  PixelGrad p3 = start_pixel(base + uvec2(1u, 1u), plane);
-  PixelGrad p4 = start_pixel(base + uvec2(0u, 2u), plane);
-  PixelGrad p5 = start_pixel(base + uvec2(1u, 2u), plane);
-  PixelGrad p6 = start_pixel(base + uvec2(0u, 3u), plane);
-  PixelGrad p7 = start_pixel(base + uvec2(1u, 3u), plane);
+  PixelGrad p1 = start_pixel(block_pixel(base, 1u, 0u), plane);
+  PixelGrad p2 = start_pixel(block_pixel(base, 0u, 1u), plane);
+  PixelGrad p3 = start_pixel(block_pixel(base, 1u, 1u), plane);
+  PixelGrad p4 = start_pixel(block_pixel(base, 0u, 2u), plane);
+  PixelGrad p5 = start_pixel(block_pixel(base, 1u, 2u), plane);
+  PixelGrad p6 = start_pixel(block_pixel(base, 0u, 3u), plane);
+  PixelGrad p7 = start_pixel(block_pixel(base, 1u, 3u), plane);
   const uint my_last = max(max(max(p0.last, p1.last), max(p2.last, p3.last)),
                            max(max(p4.last, p5.last), max(p6.last, p7.last)));
 #if SPLAT_BWD_MODE != SPLAT_BWD_DETERMINISTIC
   if (subgroupAll(my_last <= segment.begin)) return;  // nothing of this subgroup's walks lies in this pass
 #endif
-  const vec2 subgroup_lo = subgroupMin(p0.centre), subgroup_hi = subgroupMax(p7.centre);
+  const vec2 subgroup_lo = subgroupMin(p0.centre);
+  const vec2 subgroup_hi = subgroupMax(PIXEL_BLOCK == 8u ? p7.centre : p0.centre);
   uint chunk_end;
 
 #if SPLAT_BWD_MODE == SPLAT_BWD_DETERMINISTIC
@@ -299,7 +301,7 @@ void main() {
     s_partial[slot + 1u] = a1;
     s_partial[slot + 2u] = a2;
     barrier();
-    for (uint t = gl_LocalInvocationIndex; t < 3u * S; t += WORKGROUP_INVOCATIONS) {
+    for (uint t = gl_LocalInvocationIndex; t < 3u * S; t += GROUP_INVOCATIONS) {
       const uint k = t / 3u, part = t % 3u;
       if (chunk_start + k >= chunk_end) continue;
       vec4 total = vec4(0.0);

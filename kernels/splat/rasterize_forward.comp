@@ -4,8 +4,9 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_KHR_shader_subgroup_shuffle : require
-// One workgroup per 16x16 tile, one invocation per 2x4 pixels: alpha-blend the tile's list front to back, one
-// list segment per pass (splat_shared.h: a long list takes several passes, carrying the blend state).
+// One workgroup per 16x16 tile, one invocation per 2x4 pixels (CPU devices) or per pixel (GPUs;
+// footprint.glsl): alpha-blend the tile's list front to back, one list segment per pass (splat_shared.h: a
+// long list takes several passes, carrying the blend state).
 #define SPLAT_RASTERIZE_PASS
 #include "limits.h"
 #include "splat/splat_shared.h"
@@ -13,8 +14,6 @@
 #include "splat/splat_view.glsl"
 #include "splat/footprint.glsl"
 #include "splat/channels.glsl"
-
-layout(local_size_x = SPLAT_GROUP_X, local_size_y = SPLAT_GROUP_Y) in;
 
 layout(std430, binding = FWD_BINDING_RANGES) readonly buffer Ranges { uvec2 ranges[]; };
 // The per-entry reads, as texels (splat_shared.h).
@@ -38,7 +37,8 @@ layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]
 // subgroups reads the tile's list, and each entry taken by shuffle serves eight pixels (lavapipe, 100k
 // Gaussians at 640x512: 82 ms with one pixel, 48 with four, 45 with eight; docs/experiments.md 2026-11-26).
 
-// One pixel's blend state. Eight per invocation, as separate variables (CPU drivers spill arrays).
+// One pixel's blend state. Up to eight per invocation, as separate variables (CPU drivers spill arrays);
+// with one pixel per invocation s1..s7 lie outside the image and are never blended.
 struct PixelState {
   uvec2 pixel;
   bool inside;
@@ -120,14 +120,15 @@ void main() {
   const bool final_pass = length <= segment.end;
   const uint plane = view.width * view.height;
   PixelState s0 = start_pixel(base, plane);
-  PixelState s1 = start_pixel(base + uvec2(1u, 0u), plane);
-  PixelState s2 = start_pixel(base + uvec2(0u, 1u), plane);
-  PixelState s3 = start_pixel(base + uvec2(1u, 1u), plane);
-  PixelState s4 = start_pixel(base + uvec2(0u, 2u), plane);
-  PixelState s5 = start_pixel(base + uvec2(1u, 2u), plane);
-  PixelState s6 = start_pixel(base + uvec2(0u, 3u), plane);
-  PixelState s7 = start_pixel(base + uvec2(1u, 3u), plane);
-  const vec2 subgroup_lo = subgroupMin(s0.centre), subgroup_hi = subgroupMax(s7.centre);
+  PixelState s1 = start_pixel(block_pixel(base, 1u, 0u), plane);
+  PixelState s2 = start_pixel(block_pixel(base, 0u, 1u), plane);
+  PixelState s3 = start_pixel(block_pixel(base, 1u, 1u), plane);
+  PixelState s4 = start_pixel(block_pixel(base, 0u, 2u), plane);
+  PixelState s5 = start_pixel(block_pixel(base, 1u, 2u), plane);
+  PixelState s6 = start_pixel(block_pixel(base, 0u, 3u), plane);
+  PixelState s7 = start_pixel(block_pixel(base, 1u, 3u), plane);
+  const vec2 subgroup_lo = subgroupMin(s0.centre);
+  const vec2 subgroup_hi = subgroupMax(PIXEL_BLOCK == 8u ? s7.centre : s0.centre);
   uint chunk = range.x + segment.begin;
   const uint lanes = subgroup_lanes();
   for (; chunk < end; chunk += lanes) {
@@ -156,13 +157,15 @@ void main() {
         const float dep = subgroupShuffle(depth, k);
         const uint position = chunk + k - range.x + 1u;
         blend(s0, me, co, col, dep, position);
-        blend(s1, me, co, col, dep, position);
-        blend(s2, me, co, col, dep, position);
-        blend(s3, me, co, col, dep, position);
-        blend(s4, me, co, col, dep, position);
-        blend(s5, me, co, col, dep, position);
-        blend(s6, me, co, col, dep, position);
-        blend(s7, me, co, col, dep, position);
+        if (PIXEL_BLOCK == 8u) {
+          blend(s1, me, co, col, dep, position);
+          blend(s2, me, co, col, dep, position);
+          blend(s3, me, co, col, dep, position);
+          blend(s4, me, co, col, dep, position);
+          blend(s5, me, co, col, dep, position);
+          blend(s6, me, co, col, dep, position);
+          blend(s7, me, co, col, dep, position);
+        }
       }
     }
   }

@@ -32,10 +32,9 @@ uint32_t forward_loops_per_chunk(uint32_t S, uint32_t C) {
   return 1 + (C + 1) + 5 + (S + 4);
 }
 
-uint32_t backward_loops_per_chunk(uint32_t S, uint32_t C, bool deterministic) {
+uint32_t backward_loops_per_chunk(uint32_t S, uint32_t C, bool deterministic, uint32_t invocations) {
   const uint32_t walk = 1 + (C + 1) + 5 + (S + 4) + S * (log2_ceil(S) + 1);
   if (!deterministic) return walk + 3 + 4 + 5 + (C + 1) + 2 * (SPLAT_GRAD2D_FIXED + C);
-  const uint32_t invocations = SPLAT_GROUP_INVOCATIONS;  // per tile, each 2x4 pixels
   const uint32_t subgroups = (invocations + S - 1) / S;
   const uint32_t sums_per_invocation = (3 * S + invocations - 1) / invocations;
   return walk + (sums_per_invocation + 1) * ((subgroups + 1) + 5);
@@ -44,11 +43,12 @@ uint32_t backward_loops_per_chunk(uint32_t S, uint32_t C, bool deterministic) {
 // Entries per pass: whole chunks within RASTERIZE_PASS_LOOP_BUDGET, for every subgroup size the device may
 // use.
 template <class LoopsPerChunk>
-uint32_t entries_within_budget(const engine::DeviceInfo& info, LoopsPerChunk loops_per_chunk) {
+uint32_t entries_within_budget(const engine::DeviceInfo& info, uint32_t invocations,
+                               LoopsPerChunk loops_per_chunk) {
   uint32_t entries = 0xFFFFFFFFu;
   for (uint32_t S : {info.min_subgroup_size, info.subgroup_size, info.max_subgroup_size}) {
     // A subgroup wider than the workgroup walks chunks of the lanes that exist (footprint.glsl).
-    S = std::clamp(S, 1u, uint32_t{SPLAT_GROUP_INVOCATIONS});
+    S = std::clamp(S, 1u, invocations);
     entries = std::min(entries, RASTERIZE_PASS_LOOP_BUDGET / loops_per_chunk(S) * S);
   }
   return std::max(entries, 1u);
@@ -198,14 +198,30 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   lengths_ = make("splat/tile_list_lengths", LENGTHS_BINDING_COUNT, sizeof(SplatView));
   emit_ = make("splat/emit_intersections", EMIT_BINDING_COUNT, sizeof(SplatView));
   ranges_ = make("splat/tile_ranges", RANGES_BINDING_COUNT, sizeof(SplatView));
-  forward_ = make("splat/rasterize_forward", FWD_BINDING_COUNT, sizeof(RasterizeParams), {},
+  const engine::DeviceInfo& info = context.info();
+  if (options_.pixels_per_invocation != 0 && options_.pixels_per_invocation != 1 &&
+      options_.pixels_per_invocation != 8)
+    throw std::invalid_argument(
+        "Rasterizer: pixels_per_invocation = " + std::to_string(options_.pixels_per_invocation) +
+        ", must be 0 (auto), 1 or 8");
+  pixels_per_invocation_ =
+      options_.pixels_per_invocation ? options_.pixels_per_invocation : (info.type == "cpu" ? 8u : 1u);
+  // The rasterize kernels' layout (footprint.glsl): 8x4 invocations of 2x4 pixels, or 16x16 of one.
+  const bool blocks = pixels_per_invocation_ == 8;
+  const uint32_t group_x = blocks ? 8 : SPLAT_TILE_SIZE, group_y = blocks ? 4 : SPLAT_TILE_SIZE;
+  const uint32_t invocations = group_x * group_y;
+  const std::vector<engine::SpecConstant> layout = {{SPLAT_SPEC_PIXEL_BLOCK, pixels_per_invocation_},
+                                                    {SPLAT_SPEC_GROUP_X, group_x},
+                                                    {SPLAT_SPEC_GROUP_Y, group_y}};
+  forward_ = make("splat/rasterize_forward", FWD_BINDING_COUNT, sizeof(RasterizeParams), layout,
                   rasterize_texel_bindings(FWD_BINDING_ISECT_IDS, FWD_BINDING_ISECT_GAUSSIAN,
                                            FWD_BINDING_CENTRES, FWD_BINDING_CONICS, FWD_BINDING_COLORS));
   const char* backward = options_.deterministic ? "splat/rasterize_backward_deterministic"
                          : uses_float_atomics() ? "splat/rasterize_backward_float_atomics"
                                                 : "splat/rasterize_backward_cas_atomics";
-  backward_ = make(backward, BWD_BINDING_COUNT, sizeof(RasterizeParams),
-                   {{2, options_.depth_gradient_to_opacity ? 1u : 0u}},
+  std::vector<engine::SpecConstant> backward_constants = layout;
+  backward_constants.push_back({2, options_.depth_gradient_to_opacity ? 1u : 0u});
+  backward_ = make(backward, BWD_BINDING_COUNT, sizeof(RasterizeParams), backward_constants,
                    rasterize_texel_bindings(BWD_BINDING_ISECT_IDS, BWD_BINDING_ISECT_GAUSSIAN,
                                             BWD_BINDING_CENTRES, BWD_BINDING_CONICS, BWD_BINDING_COLORS));
   reduce_ = make("splat/reduce_isect_grads", REDUCE_BINDING_COUNT, sizeof(SplatView));
@@ -221,15 +237,17 @@ Rasterizer::Rasterizer(engine::Context& context, uint32_t channels, RasterizerOp
   buffers_->counters->upload(std::vector<uint32_t>(SPLAT_COUNTER_COUNT, 0u));
   buffers_->readback = std::make_unique<DeviceArray<uint32_t>>(
       context, "splat: readback", SPLAT_COUNTER_COUNT, engine::MemoryKind::kHostVisible);
-  const engine::DeviceInfo& info = context.info();
-  forward_entries_per_pass_ =
+  forward_entries_per_pass_ = options_.entries_per_pass
+                                  ? options_.entries_per_pass
+                                  : entries_within_budget(info, invocations, [&](uint32_t S) {
+                                      return forward_loops_per_chunk(S, channels);
+                                    });
+  backward_entries_per_pass_ =
       options_.entries_per_pass
           ? options_.entries_per_pass
-          : entries_within_budget(info, [&](uint32_t S) { return forward_loops_per_chunk(S, channels); });
-  backward_entries_per_pass_ =
-      options_.entries_per_pass ? options_.entries_per_pass : entries_within_budget(info, [&](uint32_t S) {
-        return backward_loops_per_chunk(S, channels, options_.deterministic);
-      });
+          : entries_within_budget(info, invocations, [&](uint32_t S) {
+              return backward_loops_per_chunk(S, channels, options_.deterministic, invocations);
+            });
 }
 
 uint32_t Rasterizer::passes_for(uint32_t entries_per_pass) const {

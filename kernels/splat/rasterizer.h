@@ -36,6 +36,11 @@ struct RasterizerOptions {
   // (DeviceGrads has only grad2d; download_grads() throws); the optimizer's fused step computes them
   // (kernels/optim/gaussian_adam.h). Training uses it: 108 B per Gaussian at SH degree 3 and one channel.
   bool parameter_gradients = true;
+  // Pixels each rasterize invocation blends: 8 (a 2x4 block, 8x4 invocations per tile) or 1 (16x16
+  // invocations); 0: 8 on a CPU device, where every subgroup reads its tile's whole list and eight pixels
+  // share each read (lavapipe: about 2x faster), 1 on a GPU, whose many lanes want the 256 invocations (an
+  // H200: about 2x faster). Tests set it to run both layouts on one device.
+  uint32_t pixels_per_invocation = 0;
 };
 
 // Counters of a rasterizer's renders (Rasterizer::read_counters).
@@ -130,6 +135,8 @@ class Rasterizer {
   RasterizerCounters read_counters() const;
   // List entries per pass of the forward and of the backward on this device (see RasterizerOptions).
   uint32_t forward_entries_per_pass() const { return forward_entries_per_pass_; }
+  // Pixels per rasterize invocation on this device (RasterizerOptions::pixels_per_invocation resolved).
+  uint32_t pixels_per_invocation() const { return pixels_per_invocation_; }
   uint32_t backward_entries_per_pass() const { return backward_entries_per_pass_; }
 
   // Per-kernel GPU times of the last forward (and backward, if run after it).
@@ -159,6 +166,7 @@ class Rasterizer {
   uint64_t intersections_ = 0;
   uint32_t longest_tile_list_ = 0, forward_passes_ = 0, backward_passes_ = 0;
   uint32_t forward_entries_per_pass_ = 0, backward_entries_per_pass_ = 0;
+  uint32_t pixels_per_invocation_ = 8;
   uint32_t forward_walks_cut_before_ = 0;  // the running counter before the last forward's passes
   std::vector<engine::KernelTime> profile_;
 };

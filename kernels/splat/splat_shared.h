@@ -12,9 +12,13 @@ using uint = uint32_t;
 
 // ---- Numerics ----
 #define SPLAT_TILE_SIZE 16  // pixels per tile side; a forward/backward workgroup is one tile
-#define SPLAT_GROUP_X 8     // ... of 8x4 invocations, each blending a 2x4 block of pixels
-#define SPLAT_GROUP_Y 4     // (footprint.glsl block_origin)
-#define SPLAT_GROUP_INVOCATIONS (SPLAT_GROUP_X * SPLAT_GROUP_Y)
+// Pixels each rasterize invocation blends (RasterizerOptions::pixels_per_invocation; footprint.glsl
+// block_origin): 8, a 2x4 block (8x4 invocations per tile: CPU devices), or 1 (16x16 invocations: GPUs).
+// Specialization constants of the rasterize kernels, with the workgroup size:
+#define SPLAT_SPEC_PIXEL_BLOCK 3
+#define SPLAT_SPEC_GROUP_X 4
+#define SPLAT_SPEC_GROUP_Y 5
+#define SPLAT_BLOCK_PIXELS_MAX 8
 #define SPLAT_ALPHA_MAX 0.99           // per-Gaussian alpha clamp: keeps 1 - alpha >= 0.01 for backward
 #define SPLAT_ALPHA_MIN (1.0 / 255.0)  // contributions below this are skipped (and set the extent)
 #define SPLAT_T_MIN 1e-4               // a pixel stops once its transmittance would fall below this
