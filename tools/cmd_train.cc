@@ -40,7 +40,7 @@ struct TrainCliOptions {
   double init_flatness = 0.1;
   DataFlags data_flags;  // --intensity, --poses
   std::string trace;     // JSON lines appended at every progress report (the report's curves)
-  std::string max_gaussians = "2000000";  // a count, or auto (tools/train_budget.h)
+  std::string max_gaussians = "2000000";  // a count, auto or search (tools/train_budget.h)
   host::TrainingDataOptions data;
   host::TrainOptions train;
 };
@@ -115,57 +115,63 @@ void run_train(TrainCliOptions o) {
 
   host::InitOptions init;
   init.sh_degree = o.train.sh_degree;
-  kernels::GaussianModel model;
+  // The initial model for a budget: the LiDAR-map initialization is capped at it (the search initializes
+  // each budget it tries the same way).
+  const auto initialize = [&](uint32_t cap_gaussians, std::string& init_what) {
+    kernels::GaussianModel model;
+    if (o.train.resume) {
+      // The model comes from the checkpoint: --init and its options do not apply.
+      init_what = "the newest checkpoint in " + o.out;
+    } else if (init_kind == "random") {
+      model = host::init_random(data, o.random_count, o.train.seed, init);
+      init_what = std::to_string(o.random_count) + " random points";
+    } else if (init_from_map) {
+      // Planar map points become discs on their plane (the plane fit's normal), the rest spheres. Only the
+      // points a training view sees (a Gaussian none sees is never trained), and never more than the budget
+      // or --max-init-points: a seeded random subset.
+      const std::vector<uint8_t> seen = host::inside_any_view(map_points, host::training_cameras(data));
+      std::vector<size_t> keep;
+      for (size_t i = 0; i < map_points.size(); ++i)
+        if (seen[i]) keep.push_back(i);
+      if (keep.empty())  // no view sees the map (bad poses?): seed from all of it rather than nothing
+        for (size_t i = 0; i < map_points.size(); ++i) keep.push_back(i);
+      const size_t cap = std::min<size_t>(o.max_init_points, cap_gaussians);
+      if (keep.size() > cap) {
+        std::mt19937 rng(o.train.seed);
+        std::shuffle(keep.begin(), keep.end(), rng);
+        keep.resize(cap);
+      }
+      std::vector<Eigen::Vector3d> pts;
+      std::vector<Eigen::Vector3f> normals;
+      std::vector<uint8_t> planar;
+      for (size_t i : keep) {
+        pts.push_back(map_points[i]);
+        normals.push_back(planes->normals[i]);
+        planar.push_back(planes->planar[i]);
+      }
+      const auto covariances = host::surfel_covariances(
+          host::neighbour_scales(pts, init, data.scene_extent_m * 0.01), normals, planar, o.init_flatness);
+      model = host::init_from_points(pts, data, init, covariances);
+      init_what = std::to_string(pts.size()) + " LiDAR map points";
+    } else if (init_kind == "sfm") {
+      // The front end's triangulated points (`match`), already in the scene's recentred frame.
+      if (sfm_points.empty())
+        throw std::invalid_argument("--init sfm: " + sfm_dir.string() +
+                                    (io::has_sfm(sfm_dir)
+                                         ? " holds no triangulated point"
+                                         : " holds no front-end results (run `litgs-engine match` first)"));
+      model = host::init_from_points(sfm_points, data, init, {});
+      init_what = std::to_string(sfm_points.size()) + " front-end points (" + sfm_dir.string() + ")";
+    } else {
+      const host::InitPoints file =
+          host::load_points(o.init, o.init_in_scene_frame ? Eigen::Vector3d::Zero() : data.world_offset_m);
+      model = host::init_from_points(file.positions, data, init, file.covariances);
+      init_what = o.init + (file.covariances.empty() ? "" : " (with covariances)");
+    }
+    return model;
+  };
   std::string init_what;
-  if (o.train.resume) {
-    // The model comes from the checkpoint: --init and its options do not apply.
-    init_what = "the newest checkpoint in " + o.out;
-  } else if (init_kind == "random") {
-    model = host::init_random(data, o.random_count, o.train.seed, init);
-    init_what = std::to_string(o.random_count) + " random points";
-  } else if (init_from_map) {
-    // Planar map points become discs on their plane (the plane fit's normal), the rest spheres. Only the
-    // points a training view sees (a Gaussian none sees is never trained), and never more than the budget
-    // or --max-init-points: a seeded random subset.
-    const std::vector<uint8_t> seen = host::inside_any_view(map_points, host::training_cameras(data));
-    std::vector<size_t> keep;
-    for (size_t i = 0; i < map_points.size(); ++i)
-      if (seen[i]) keep.push_back(i);
-    if (keep.empty())  // no view sees the map (bad poses?): seed from all of it rather than nothing
-      for (size_t i = 0; i < map_points.size(); ++i) keep.push_back(i);
-    const size_t cap = std::min<size_t>(o.max_init_points, o.train.max_gaussians);
-    if (keep.size() > cap) {
-      std::mt19937 rng(o.train.seed);
-      std::shuffle(keep.begin(), keep.end(), rng);
-      keep.resize(cap);
-    }
-    std::vector<Eigen::Vector3d> pts;
-    std::vector<Eigen::Vector3f> normals;
-    std::vector<uint8_t> planar;
-    for (size_t i : keep) {
-      pts.push_back(map_points[i]);
-      normals.push_back(planes->normals[i]);
-      planar.push_back(planes->planar[i]);
-    }
-    const auto covariances = host::surfel_covariances(
-        host::neighbour_scales(pts, init, data.scene_extent_m * 0.01), normals, planar, o.init_flatness);
-    model = host::init_from_points(pts, data, init, covariances);
-    init_what = std::to_string(pts.size()) + " LiDAR map points";
-  } else if (init_kind == "sfm") {
-    // The front end's triangulated points (`match`), already in the scene's recentred frame.
-    if (sfm_points.empty())
-      throw std::invalid_argument("--init sfm: " + sfm_dir.string() +
-                                  (io::has_sfm(sfm_dir)
-                                       ? " holds no triangulated point"
-                                       : " holds no front-end results (run `litgs-engine match` first)"));
-    model = host::init_from_points(sfm_points, data, init, {});
-    init_what = std::to_string(sfm_points.size()) + " front-end points (" + sfm_dir.string() + ")";
-  } else {
-    const host::InitPoints file =
-        host::load_points(o.init, o.init_in_scene_frame ? Eigen::Vector3d::Zero() : data.world_offset_m);
-    model = host::init_from_points(file.positions, data, init, file.covariances);
-    init_what = o.init + (file.covariances.empty() ? "" : " (with covariances)");
-  }
+  kernels::GaussianModel model = initialize(o.train.max_gaussians, init_what);
 
   if (!budget_from_map) {
     budget.initial = &model;
@@ -175,6 +181,17 @@ void run_train(TrainCliOptions o) {
   o.train.check();
 
   engine::Context context;
+  if (o.max_gaussians == "search" && !o.train.resume) {
+    o.train.max_gaussians = search_max_gaussians(
+        context, data,
+        [&](uint32_t trial_budget) {
+          std::string what;
+          return initialize(trial_budget, what);
+        },
+        planes.get(), o.train, o.out);
+    o.train.check();
+    if (init_from_map) model = initialize(o.train.max_gaussians, init_what);
+  }
   const bool tty = ::isatty(STDOUT_FILENO);
   std::cout << "train: " << data.views.size() << " views (" << data.width << "x" << data.height << ", "
             << data.frozen_skipped << " frozen skipped), "
@@ -293,8 +310,10 @@ void add_train_command(CLI::App& app) {
       "Write point_cloud.ply in the scene's recentred frame (poses.txt's) instead of the original world "
       "frame (scene + world_offset_m)");
   cmd->add_option("--max-gaussians", o->max_gaussians,
-                  "Cap of the model size (the MCMC budget): a count, or auto (derived from the surface the "
-                  "training views see at their resolution: the LiDAR map, else the initialization's points)")
+                  "Cap of the model size (the MCMC budget): a count, auto (derived from the surface the "
+                  "training views see at their resolution: the LiDAR map, else the initialization's points), "
+                  "or search (trainings at doubling budgets on the training views less a validation eighth, "
+                  "while validation PSNR still gains 0.1 dB; then the final training at the budget found)")
       ->capture_default_str();
   cmd->add_option("--strategy", o->train.strategy,
                   "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")

@@ -6,7 +6,9 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "host/train/budget_search.h"
 #include "host/train/scene_budget.h"
+#include "host/train/trainer.h"
 #include "io/atomic_file.h"
 
 namespace litgs::tools {
@@ -17,7 +19,8 @@ uint32_t parse_count(const std::string& flag) {
                       std::all_of(flag.begin(), flag.end(), [](unsigned char c) { return std::isdigit(c); });
   const unsigned long long n = digits ? std::stoull(flag) : 0;
   if (n == 0 || n > UINT32_MAX)
-    throw std::invalid_argument("--max-gaussians must be a positive integer or auto, not '" + flag + "'");
+    throw std::invalid_argument("--max-gaussians must be a positive integer, auto or search, not '" + flag +
+                                "'");
   return static_cast<uint32_t>(n);
 }
 
@@ -37,8 +40,10 @@ uint32_t budget_of_earlier_run(const std::filesystem::path& file) {
 
 uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
                                const std::filesystem::path& out) {
-  if (flag != "auto") return parse_count(flag);
   const std::filesystem::path record = out / "budget.json";
+  if (flag == "search")
+    return in.resume ? budget_of_earlier_run(record) : host::BudgetSearchOptions{}.max_budget;
+  if (flag != "auto") return parse_count(flag);
   if (in.resume) return budget_of_earlier_run(record);
 
   std::vector<Eigen::Vector3d> points;
@@ -78,6 +83,61 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
             << " m^2 of surface = " << b.surface_pixels << " pixels at the finest view, "
             << options.pixels_per_gaussian << " pixels per Gaussian\n";
   return b.gaussians;
+}
+
+uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData& data,
+                              const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for,
+                              const host::PlanarMap* planes, const host::TrainOptions& options,
+                              const std::filesystem::path& out) {
+  const host::BudgetSearchOptions search;
+  const host::TrainingData split = host::validation_split(data, search.validation_every);
+  size_t validation_views = 0;
+  for (const host::TrainingView& v : split.views) validation_views += v.heldout;
+  std::cout << "train: budget search on " << split.views.size() - validation_views << " training views, "
+            << validation_views << " validating (the scene's held-out views are not used), "
+            << options.iterations << " iterations per budget\n";
+  const auto train_at = [&](uint32_t budget) {
+    host::TrainOptions t = options;
+    t.max_gaussians = budget;
+    t.resume = false;
+    t.checkpoint_every = 0;
+    t.eval_every = 0;  // the final evaluation only
+    const std::filesystem::path dir = out / "budget-search" / std::to_string(budget);
+    const host::TrainReport r = host::train(context, split, initial_for(budget), planes, t, dir, {}, nullptr,
+                                            [](const std::string&) {});
+    host::BudgetTrial trial;
+    trial.psnr_db = r.final_eval.psnr_db;
+    trial.ssim = r.final_eval.ssim;
+    trial.gaussians = static_cast<uint32_t>(r.gaussians);
+    trial.wall_s = r.wall_s;
+    std::cout << "train: budget " << budget << ": validation PSNR " << trial.psnr_db << " dB, SSIM "
+              << trial.ssim << " (" << trial.gaussians << " Gaussians, " << trial.wall_s << " s)\n";
+    return trial;
+  };
+  // A budget below the initialization's size (one not capped by the budget) cannot hold it: start there.
+  const uint32_t smallest = static_cast<uint32_t>(initial_for(search.start).size());
+  const host::BudgetSearchResult result = host::search_budget(train_at, smallest, search);
+  nlohmann::json trials = nlohmann::json::array();
+  for (const host::BudgetTrial& t : result.trials)
+    trials.push_back({{"budget", t.budget},
+                      {"validation_psnr_db", t.psnr_db},
+                      {"validation_ssim", t.ssim},
+                      {"gaussians", t.gaussians},
+                      {"wall_s", t.wall_s}});
+  io::write_file_atomic(out / "budget.json", [&](std::ostream& os) {
+    os << nlohmann::json{{"gaussians", result.chosen},
+                         {"source", "search"},
+                         {"min_gain_db", search.min_gain_db},
+                         {"factor", search.factor},
+                         {"validation_views", validation_views},
+                         {"training_views", split.views.size() - validation_views},
+                         {"trials", trials}}
+              .dump(2)
+       << "\n";
+  });
+  std::cout << "train: budget " << result.chosen << " Gaussians: the last that added at least "
+            << search.min_gain_db << " dB on the validation views (budget.json)\n";
+  return result.chosen;
 }
 
 }  // namespace litgs::tools

@@ -1,13 +1,18 @@
-// `train --max-gaussians N|auto`: the model's budget as given, or derived from the scene
-// (host/train/scene_budget.h) and recorded in OUT/budget.json (a resumed run reads it back from there).
+// `train --max-gaussians N|auto|search`: the model's budget as given, derived from the scene's surface
+// (auto, host/train/scene_budget.h), or searched by training at growing budgets while validation PSNR still
+// rises (search, host/train/budget_search.h); recorded in OUT/budget.json (a resumed run reads it back).
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "engine/context.h"
+#include "host/train/lidar_planes.h"
+#include "host/train/train_options.h"
 #include "host/train/training_data.h"
 #include "kernels/splat/splat_types.h"
 
@@ -22,8 +27,17 @@ struct BudgetInputs {
 };
 
 // `flag` is a positive integer or "auto"; std::invalid_argument naming the problem otherwise, or when auto
-// has no surface to measure (no LiDAR map and a random initialization).
+// has no surface to measure (no LiDAR map and a random initialization). "search" is resolved by
+// search_max_gaussians; here it gives the search's cap (or, resuming, the budget it recorded).
 uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
                                const std::filesystem::path& out);
+
+// `--max-gaussians search`: trainings with `options` at growing budgets on the validation split of the
+// training views, each from initial_for(budget) and in OUT/budget-search/<budget>/; writes OUT/budget.json
+// and returns the budget found. Prints one line per budget tried.
+uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData& data,
+                              const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for,
+                              const host::PlanarMap* planes, const host::TrainOptions& options,
+                              const std::filesystem::path& out);
 
 }  // namespace litgs::tools

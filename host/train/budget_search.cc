@@ -1,0 +1,54 @@
+#include "host/train/budget_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace litgs::host {
+
+void BudgetSearchOptions::check() const {
+  auto bad = [](const std::string& what) { throw std::invalid_argument("BudgetSearchOptions." + what); };
+  if (start == 0) bad("start must be positive");
+  if (!(factor > 1.0) || !std::isfinite(factor)) bad("factor must be above 1");
+  if (!(min_gain_db >= 0.0) || !std::isfinite(min_gain_db)) bad("min_gain_db must be 0 or more");
+  if (max_budget < start) bad("max_budget must be at least start");
+  if (validation_every < 2) bad("validation_every must be at least 2");
+}
+
+BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget)>& train_at,
+                                 uint32_t initial_gaussians, const BudgetSearchOptions& o) {
+  o.check();
+  BudgetSearchResult result;
+  uint32_t budget = std::min(std::max(o.start, initial_gaussians), o.max_budget);
+  double best = -INFINITY;
+  for (;;) {
+    BudgetTrial t = train_at(budget);
+    t.budget = budget;
+    result.trials.push_back(t);
+    // A NaN score never counts as a gain.
+    if (!(t.psnr_db >= best + o.min_gain_db)) break;
+    best = t.psnr_db;
+    result.chosen = budget;
+    if (budget >= o.max_budget) break;
+    budget = static_cast<uint32_t>(std::min<double>(std::ceil(budget * o.factor), o.max_budget));
+  }
+  if (result.chosen == 0) result.chosen = result.trials.front().budget;  // the first trial scored NaN
+  return result;
+}
+
+TrainingData validation_split(const TrainingData& data, uint32_t every) {
+  if (every < 2) throw std::invalid_argument("validation_split: every must be at least 2");
+  TrainingData out = data;
+  out.views.clear();
+  for (const TrainingView& v : data.views)
+    if (!v.heldout) out.views.push_back(v);
+  if (out.views.size() < 2)
+    throw std::invalid_argument("the budget search needs at least two training views to hold one out, has " +
+                                std::to_string(out.views.size()));
+  bool any = false;
+  for (size_t i = 0; i < out.views.size(); ++i) any |= out.views[i].heldout = i % every == every / 2;
+  if (!any) out.views[out.views.size() / 2].heldout = true;  // fewer views than every / 2 + 1
+  return out;
+}
+
+}  // namespace litgs::host

@@ -1,0 +1,52 @@
+// `train --max-gaussians search`: the Gaussian budget a scene needs, found by growing while held-out error
+// still falls. Trainings at budgets growing by `factor` run on the training views less a validation subset
+// (every `validation_every`-th training view; the scene's own held-out views are not used), each for the
+// full iterations; the search stops at the first budget whose validation PSNR does not beat the best so far
+// by `min_gain_db`, and keeps the last budget that did. A fixed budget the user must guess is replaced by
+// the smallest one that the views show still pays. The final training then runs at that budget on every
+// training view. Costs one training per budget tried.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "host/train/training_data.h"
+
+namespace litgs::host {
+
+struct BudgetSearchOptions {
+  uint32_t start = 5000;        // the first budget (raised to the initialization's size where larger)
+  double factor = 2.0;          // each budget is this times the last
+  double min_gain_db = 0.1;     // a larger budget is kept only if it adds at least this much
+  uint32_t max_budget = 4000000;  // the MCMC strategy's row limit
+  uint32_t validation_every = 8;  // every k-th training view validates (at least one)
+  void check() const;             // throws std::invalid_argument naming the bad field
+};
+
+struct BudgetTrial {
+  uint32_t budget = 0;
+  double psnr_db = 0;  // on the validation views
+  double ssim = 0;
+  uint32_t gaussians = 0;  // the model's size at the end
+  double wall_s = 0;
+};
+
+struct BudgetSearchResult {
+  uint32_t chosen = 0;
+  std::vector<BudgetTrial> trials;  // in the order run
+};
+
+// The search's rule over `train_at(budget)` (one training on the validation split). The first trial sets the
+// baseline; each next one is run while the last gained at least min_gain_db over the best before it.
+// std::invalid_argument for bad options; what train_at throws passes through.
+BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget)>& train_at,
+                                 uint32_t initial_gaussians, const BudgetSearchOptions& options = {});
+
+// The data the search trains on: the scene's held-out views dropped, and every validation_every-th of the
+// remaining views (counted from the middle of the first stride) held out instead. std::invalid_argument
+// when fewer than two training views remain to split.
+TrainingData validation_split(const TrainingData& data, uint32_t validation_every);
+
+}  // namespace litgs::host

@@ -1,0 +1,100 @@
+// The budget search's rule and its validation split (host/train/budget_search.h), on scripted scores.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "host/train/budget_search.h"
+
+namespace litgs::host {
+namespace {
+
+// A train_at that scores each budget from a table and records what ran.
+struct Scripted {
+  std::map<uint32_t, double> psnr;
+  std::vector<uint32_t> ran;
+  BudgetTrial operator()(uint32_t budget) {
+    ran.push_back(budget);
+    BudgetTrial t;
+    t.psnr_db = psnr.at(budget);
+    return t;
+  }
+};
+
+TEST(BudgetSearch, KeepsTheLastBudgetThatGainedAndStopsAtTheFirstThatDidNot) {
+  Scripted s{{{5000, 21.5}, {10000, 21.8}, {20000, 22.0}, {40000, 22.05}, {80000, 22.5}}, {}};
+  const BudgetSearchResult r = search_budget(std::ref(s), 3988);
+  EXPECT_EQ(r.chosen, 20000u);  // 40k gained 0.05 < 0.1 dB: stop there; 80k is never tried
+  EXPECT_EQ(s.ran, (std::vector<uint32_t>{5000, 10000, 20000, 40000}));
+  ASSERT_EQ(r.trials.size(), 4u);
+  EXPECT_EQ(r.trials[3].budget, 40000u);
+  EXPECT_DOUBLE_EQ(r.trials[3].psnr_db, 22.05);
+}
+
+TEST(BudgetSearch, AFallStopsTheSearchAtTheBudgetBeforeIt) {
+  Scripted s{{{5000, 21.5}, {10000, 21.7}, {20000, 22.0}, {40000, 22.2}, {80000, 22.4}, {160000, 21.7}}, {}};
+  EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 80000u);
+  EXPECT_EQ(s.ran.back(), 160000u);
+}
+
+TEST(BudgetSearch, StartsAtTheInitializationsSizeAndStopsAtTheCap) {
+  Scripted s{{{30000, 30.0}, {60000, 31.0}, {100000, 32.0}}, {}};
+  BudgetSearchOptions o;
+  o.max_budget = 100000;
+  EXPECT_EQ(search_budget(std::ref(s), 30000, o).chosen, 100000u);
+  EXPECT_EQ(s.ran, (std::vector<uint32_t>{30000, 60000, 100000}));  // the cap ends it while still gaining
+}
+
+TEST(BudgetSearch, ANonFiniteScoreIsNeverAGain) {
+  Scripted s{{{5000, 20.0}, {10000, NAN}}, {}};
+  EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 5000u);
+  Scripted first_nan{{{5000, NAN}}, {}};
+  const BudgetSearchResult r = search_budget(std::ref(first_nan), 0);
+  EXPECT_EQ(r.chosen, 5000u);
+  EXPECT_EQ(r.trials.size(), 1u);
+}
+
+TEST(BudgetSearch, BadOptionsAreRefusedByName) {
+  Scripted s{{{5000, 1.0}}, {}};
+  BudgetSearchOptions o;
+  o.factor = 1.0;
+  EXPECT_THROW(search_budget(std::ref(s), 0, o), std::invalid_argument);
+  o = {};
+  o.validation_every = 1;
+  EXPECT_THROW(search_budget(std::ref(s), 0, o), std::invalid_argument);
+  o = {};
+  o.min_gain_db = NAN;
+  EXPECT_THROW(search_budget(std::ref(s), 0, o), std::invalid_argument);
+  EXPECT_TRUE(s.ran.empty());
+}
+
+TEST(BudgetSearch, TheValidationSplitDropsTheTestViewsAndHoldsOutEveryKthTrainingView) {
+  TrainingData d;
+  for (int i = 0; i < 45; ++i) {
+    TrainingView v;
+    v.name = std::to_string(i);
+    v.heldout = i % 8 == 0;  // the scene's test views: 6
+    d.views.push_back(v);
+  }
+  const TrainingData s = validation_split(d, 8);
+  ASSERT_EQ(s.views.size(), 39u);
+  size_t validation = 0;
+  for (size_t i = 0; i < s.views.size(); ++i) {
+    EXPECT_NE(std::stoi(s.views[i].name) % 8, 0) << "a test view went into the search";
+    validation += s.views[i].heldout;
+  }
+  EXPECT_EQ(validation, 5u);  // views 4, 12, 20, 28, 36 of the 39
+  EXPECT_TRUE(s.views[4].heldout);
+  EXPECT_FALSE(s.views[0].heldout);
+
+  TrainingData few;
+  few.views.resize(3);
+  const TrainingData f = validation_split(few, 8);
+  EXPECT_EQ(f.views[1].heldout + f.views[0].heldout + f.views[2].heldout, 1);  // always one
+  few.views.resize(1);
+  EXPECT_THROW(validation_split(few, 8), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace litgs::host
