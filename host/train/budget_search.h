@@ -17,9 +17,9 @@
 namespace litgs::host {
 
 struct BudgetSearchOptions {
-  uint32_t start = 5000;        // the first budget (raised to the initialization's size where larger)
-  double factor = 2.0;          // each budget is this times the last
-  double min_gain_db = 0.1;     // a larger budget is kept only if it adds at least this much
+  uint32_t start = 5000;          // the first budget (raised to the initialization's size where larger)
+  double factor = 2.0;            // each budget is this times the last
+  double min_gain_db = 0.1;       // a larger budget is kept only if it adds at least this much
   uint32_t max_budget = 4000000;  // the MCMC strategy's row limit
   uint32_t validation_every = 8;  // every k-th training view validates (at least one)
   void check() const;             // throws std::invalid_argument naming the bad field
