@@ -118,12 +118,19 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
   const uint32_t smallest = static_cast<uint32_t>(initial_for(search.start).size());
   const host::BudgetSearchResult result = host::search_budget(train_at, smallest, search);
   nlohmann::json trials = nlohmann::json::array();
-  for (const host::BudgetTrial& t : result.trials)
+  for (const host::BudgetTrial& t : result.trials) {
+    if (!t.failure.empty()) {
+      trials.push_back({{"budget", t.budget}, {"failure", t.failure}});
+      std::cout << "train: budget " << t.budget << " does not fit the device (" << t.failure
+                << "): the search stops there\n";
+      continue;
+    }
     trials.push_back({{"budget", t.budget},
                       {"validation_psnr_db", t.psnr_db},
                       {"validation_ssim", t.ssim},
                       {"gaussians", t.gaussians},
                       {"wall_s", t.wall_s}});
+  }
   io::write_file_atomic(out / "budget.json", [&](std::ostream& os) {
     os << nlohmann::json{{"gaussians", result.chosen},
                          {"source", "search"},

@@ -22,7 +22,15 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
   uint32_t budget = std::min(std::max(o.start, initial_gaussians), o.max_budget);
   double best = -INFINITY;
   for (;;) {
-    BudgetTrial t = train_at(budget);
+    BudgetTrial t;
+    try {
+      t = train_at(budget);
+    } catch (const std::length_error& e) {
+      if (result.trials.empty()) throw;
+      t = BudgetTrial{};
+      t.psnr_db = NAN;
+      t.failure = e.what();
+    }
     t.budget = budget;
     result.trials.push_back(t);
     // A NaN score never counts as a gain.

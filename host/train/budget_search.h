@@ -31,6 +31,7 @@ struct BudgetTrial {
   double ssim = 0;
   uint32_t gaussians = 0;  // the model's size at the end
   double wall_s = 0;
+  std::string failure;  // why the budget could not be trained (the device's memory or buffer limits)
 };
 
 struct BudgetSearchResult {
@@ -39,8 +40,10 @@ struct BudgetSearchResult {
 };
 
 // The search's rule over `train_at(budget)` (one training on the validation split). The first trial sets the
-// baseline; each next one is run while the last gained at least min_gain_db over the best before it.
-// std::invalid_argument for bad options; what train_at throws passes through.
+// baseline; each next one is run while the last gained at least min_gain_db over the best before it. A
+// budget the device cannot hold (train_at throws std::length_error, as buffers over the device's memory or
+// limits do) ends the search at the budget before it, recorded as a failed trial; at the first budget it
+// passes through. std::invalid_argument for bad options; anything else train_at throws passes through.
 BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget)>& train_at,
                                  uint32_t initial_gaussians, const BudgetSearchOptions& options = {});
 

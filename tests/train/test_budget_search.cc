@@ -55,6 +55,32 @@ TEST(BudgetSearch, ANonFiniteScoreIsNeverAGain) {
   EXPECT_EQ(r.trials.size(), 1u);
 }
 
+TEST(BudgetSearch, ABudgetTheDeviceCannotHoldEndsTheSearchAtTheOneBefore) {
+  std::vector<uint32_t> ran;
+  const auto train_at = [&](uint32_t budget) {
+    ran.push_back(budget);
+    if (budget > 20000) throw std::length_error("out of memory allocating buffer 'gaussians: sh'");
+    BudgetTrial t;
+    t.psnr_db = budget / 1000.0;
+    return t;
+  };
+  const BudgetSearchResult r = search_budget(train_at, 0);
+  EXPECT_EQ(r.chosen, 20000u);
+  EXPECT_EQ(ran, (std::vector<uint32_t>{5000, 10000, 20000, 40000}));
+  ASSERT_EQ(r.trials.size(), 4u);
+  EXPECT_TRUE(std::isnan(r.trials.back().psnr_db));
+  EXPECT_NE(r.trials.back().failure.find("out of memory"), std::string::npos);
+  // At the first budget there is nothing to fall back on: the error is the caller's.
+  const auto never = [](uint32_t) -> BudgetTrial { throw std::length_error("too large"); };
+  EXPECT_THROW(search_budget(never, 0), std::length_error);
+  // Other errors are not a budget's size: they pass through.
+  const auto broken = [](uint32_t budget) -> BudgetTrial {
+    if (budget > 5000) throw std::runtime_error("disk full");
+    return BudgetTrial{0, 20.0};
+  };
+  EXPECT_THROW(search_budget(broken, 0), std::runtime_error);
+}
+
 TEST(BudgetSearch, BadOptionsAreRefusedByName) {
   Scripted s{{{5000, 1.0}}, {}};
   BudgetSearchOptions o;
