@@ -136,6 +136,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
                          {"source", "search"},
                          {"min_gain_db", search.min_gain_db},
                          {"factor", search.factor},
+                         {"patience", search.patience},
                          {"validation_views", validation_views},
                          {"training_views", split.views.size() - validation_views},
                          {"trials", trials}}

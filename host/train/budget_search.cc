@@ -21,6 +21,7 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
   BudgetSearchResult result;
   uint32_t budget = std::min(std::max(o.start, initial_gaussians), o.max_budget);
   double best = -INFINITY;
+  uint32_t misses = 0;  // budgets in a row that did not gain
   for (;;) {
     BudgetTrial t;
     try {
@@ -33,10 +34,14 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
     }
     t.budget = budget;
     result.trials.push_back(t);
-    // A NaN score never counts as a gain.
-    if (!(t.psnr_db >= best + o.min_gain_db)) break;
-    best = t.psnr_db;
-    result.chosen = budget;
+    // A NaN score never counts as a gain; a budget the device cannot hold ends the search.
+    if (t.psnr_db >= best + o.min_gain_db) {
+      best = t.psnr_db;
+      result.chosen = budget;
+      misses = 0;
+    } else if (!t.failure.empty() || ++misses > o.patience) {
+      break;
+    }
     if (budget >= o.max_budget) break;
     budget = static_cast<uint32_t>(std::min<double>(std::ceil(budget * o.factor), o.max_budget));
   }

@@ -1,10 +1,10 @@
 // `train --max-gaussians search`: the Gaussian budget a scene needs, found by growing while held-out error
 // still falls. Trainings at budgets growing by `factor` run on the training views less a validation subset
 // (every `validation_every`-th training view; the scene's own held-out views are not used), each for the
-// full iterations; the search stops at the first budget whose validation PSNR does not beat the best so far
-// by `min_gain_db`, and keeps the last budget that did. A fixed budget the user must guess is replaced by
-// the smallest one that the views show still pays. The final training then runs at that budget on every
-// training view. Costs one training per budget tried.
+// full iterations; the search stops once a budget's validation PSNR does not beat the best so far by
+// `min_gain_db` and `patience` more budgets do not either, and keeps the last budget that did. A fixed
+// budget the user must guess is replaced by the smallest one that the views show still pays. The final
+// training then runs at that budget on every training view. Costs one training per budget tried.
 #pragma once
 
 #include <cstdint>
@@ -17,9 +17,12 @@
 namespace litgs::host {
 
 struct BudgetSearchOptions {
-  uint32_t start = 5000;          // the first budget (raised to the initialization's size where larger)
-  double factor = 2.0;            // each budget is this times the last
-  double min_gain_db = 0.1;       // a larger budget is kept only if it adds at least this much
+  uint32_t start = 5000;     // the first budget (raised to the initialization's size where larger)
+  double factor = 2.0;       // each budget is this times the last
+  double min_gain_db = 0.1;  // a larger budget is kept only if it adds at least this much
+  // Budgets tried past one that did not gain before the search stops: 1 looks one doubling past a plateau
+  // (a budget that gains nothing can precede one that does: the facade at 20k).
+  uint32_t patience = 1;
   uint32_t max_budget = 4000000;  // the MCMC strategy's row limit
   uint32_t validation_every = 8;  // every k-th training view validates (at least one)
   void check() const;             // throws std::invalid_argument naming the bad field
@@ -40,7 +43,8 @@ struct BudgetSearchResult {
 };
 
 // The search's rule over `train_at(budget)` (one training on the validation split). The first trial sets the
-// baseline; each next one is run while the last gained at least min_gain_db over the best before it. A
+// baseline; the next ones run until patience + 1 budgets in a row fail to gain min_gain_db over the best
+// before them. A
 // budget the device cannot hold (train_at throws std::length_error, as buffers over the device's memory or
 // limits do) ends the search at the budget before it, recorded as a failed trial; at the first budget it
 // passes through. std::invalid_argument for bad options; anything else train_at throws passes through.

@@ -22,20 +22,46 @@ struct Scripted {
   }
 };
 
-TEST(BudgetSearch, KeepsTheLastBudgetThatGainedAndStopsAtTheFirstThatDidNot) {
-  Scripted s{{{5000, 21.5}, {10000, 21.8}, {20000, 22.0}, {40000, 22.05}, {80000, 22.5}}, {}};
+TEST(BudgetSearch, KeepsTheLastBudgetThatGainedAndStopsAfterTwoThatDidNot) {
+  Scripted s{{{5000, 21.5}, {10000, 21.8}, {20000, 22.0}, {40000, 22.05}, {80000, 22.08}, {160000, 23.0}},
+             {}};
   const BudgetSearchResult r = search_budget(std::ref(s), 3988);
-  EXPECT_EQ(r.chosen, 20000u);  // 40k gained 0.05 < 0.1 dB: stop there; 80k is never tried
-  EXPECT_EQ(s.ran, (std::vector<uint32_t>{5000, 10000, 20000, 40000}));
-  ASSERT_EQ(r.trials.size(), 4u);
+  EXPECT_EQ(r.chosen, 20000u);  // 40k and 80k gained under 0.1 dB: stop there; 160k is never tried
+  EXPECT_EQ(s.ran, (std::vector<uint32_t>{5000, 10000, 20000, 40000, 80000}));
+  ASSERT_EQ(r.trials.size(), 5u);
   EXPECT_EQ(r.trials[3].budget, 40000u);
   EXPECT_DOUBLE_EQ(r.trials[3].psnr_db, 22.05);
 }
 
-TEST(BudgetSearch, AFallStopsTheSearchAtTheBudgetBeforeIt) {
-  Scripted s{{{5000, 21.5}, {10000, 21.7}, {20000, 22.0}, {40000, 22.2}, {80000, 22.4}, {160000, 21.7}}, {}};
+TEST(BudgetSearch, LooksOneBudgetPastAPlateau) {
+  // The facade's shape: nothing gained at 20k, then much at 40k and 80k.
+  Scripted s{{{5000, 33.85},
+              {10000, 35.0},
+              {20000, 34.86},
+              {40000, 35.5},
+              {80000, 36.0},
+              {160000, 36.05},
+              {320000, 35.9}},
+             {}};
   EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 80000u);
-  EXPECT_EQ(s.ran.back(), 160000u);
+  EXPECT_EQ(s.ran.back(), 320000u);
+  BudgetSearchOptions impatient;
+  impatient.patience = 0;
+  Scripted t{s.psnr, {}};
+  EXPECT_EQ(search_budget(std::ref(t), 0, impatient).chosen, 10000u);
+}
+
+TEST(BudgetSearch, AFallStopsTheSearchAtTheBudgetBeforeIt) {
+  Scripted s{{{5000, 21.5},
+              {10000, 21.7},
+              {20000, 22.0},
+              {40000, 22.2},
+              {80000, 22.4},
+              {160000, 21.7},
+              {320000, 21.2}},
+             {}};
+  EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 80000u);
+  EXPECT_EQ(s.ran.back(), 320000u);
 }
 
 TEST(BudgetSearch, StartsAtTheInitializationsSizeAndStopsAtTheCap) {
@@ -47,12 +73,12 @@ TEST(BudgetSearch, StartsAtTheInitializationsSizeAndStopsAtTheCap) {
 }
 
 TEST(BudgetSearch, ANonFiniteScoreIsNeverAGain) {
-  Scripted s{{{5000, 20.0}, {10000, NAN}}, {}};
+  Scripted s{{{5000, 20.0}, {10000, NAN}, {20000, NAN}}, {}};
   EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 5000u);
-  Scripted first_nan{{{5000, NAN}}, {}};
+  Scripted first_nan{{{5000, NAN}, {10000, NAN}}, {}};
   const BudgetSearchResult r = search_budget(std::ref(first_nan), 0);
   EXPECT_EQ(r.chosen, 5000u);
-  EXPECT_EQ(r.trials.size(), 1u);
+  EXPECT_EQ(r.trials.size(), 2u);
 }
 
 TEST(BudgetSearch, ABudgetTheDeviceCannotHoldEndsTheSearchAtTheOneBefore) {
