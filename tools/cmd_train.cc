@@ -170,8 +170,11 @@ void run_train(TrainCliOptions o) {
     }
     return model;
   };
+  // A searched budget caps a LiDAR-map seeding only once it is known: that one is made after the search.
+  const bool search = o.max_gaussians == "search" && !o.train.resume;
   std::string init_what;
-  kernels::GaussianModel model = initialize(o.train.max_gaussians, init_what);
+  kernels::GaussianModel model;
+  if (!(search && init_from_map)) model = initialize(o.train.max_gaussians, init_what);
 
   if (!budget_from_map) {
     budget.initial = &model;
@@ -181,7 +184,7 @@ void run_train(TrainCliOptions o) {
   o.train.check();
 
   engine::Context context;
-  if (o.max_gaussians == "search" && !o.train.resume) {
+  if (search) {
     o.train.max_gaussians = search_max_gaussians(
         context, data,
         [&](uint32_t trial_budget) {
