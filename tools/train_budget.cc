@@ -1,5 +1,6 @@
 #include "tools/train_budget.h"
 
+#include <algorithm>
 #include <cctype>
 #include <fstream>
 #include <iostream>
@@ -90,28 +91,42 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
                               const host::PlanarMap* planes, const host::TrainOptions& options,
                               const std::filesystem::path& out) {
   const host::BudgetSearchOptions search;
-  const host::TrainingData split = host::validation_split(data, search.validation_every);
-  size_t validation_views = 0;
-  for (const host::TrainingView& v : split.views) validation_views += v.heldout;
-  std::cout << "train: budget search on " << split.views.size() - validation_views << " training views, "
-            << validation_views << " validating (the scene's held-out views are not used), "
-            << options.iterations << " iterations per budget\n";
+  std::vector<host::TrainingData> splits;
+  for (uint32_t fold = 0; fold < search.folds; ++fold)
+    splits.push_back(host::validation_split(data, search.validation_every, fold, search.folds));
+  std::vector<size_t> validation_views;  // per fold
+  for (const host::TrainingData& split : splits)
+    validation_views.push_back(std::count_if(split.views.begin(), split.views.end(),
+                                             [](const host::TrainingView& v) { return v.heldout; }));
+  const size_t views = splits.front().views.size();
+  std::cout << "train: budget search on " << views << " views, " << search.folds
+            << " trainings per budget, each validating on every " << search.validation_every
+            << "th view from its own offset (" << validation_views.front()
+            << " views; the scene's held-out views are not used), " << options.iterations
+            << " iterations each\n";
   const auto train_at = [&](uint32_t budget) {
-    host::TrainOptions t = options;
-    t.max_gaussians = budget;
-    t.resume = false;
-    t.checkpoint_every = 0;
-    t.eval_every = 0;  // the final evaluation only
-    const std::filesystem::path dir = out / "budget-search" / std::to_string(budget);
-    const host::TrainReport r = host::train(context, split, initial_for(budget), planes, t, dir, {}, nullptr,
-                                            [](const std::string&) {});
     host::BudgetTrial trial;
-    trial.psnr_db = r.final_eval.psnr_db;
-    trial.ssim = r.final_eval.ssim;
-    trial.gaussians = static_cast<uint32_t>(r.gaussians);
-    trial.wall_s = r.wall_s;
-    std::cout << "train: budget " << budget << ": validation PSNR " << trial.psnr_db << " dB, SSIM "
-              << trial.ssim << " (" << trial.gaussians << " Gaussians, " << trial.wall_s << " s)\n";
+    for (uint32_t fold = 0; fold < search.folds; ++fold) {
+      host::TrainOptions t = options;
+      t.max_gaussians = budget;
+      t.seed = options.seed + fold;
+      t.resume = false;
+      t.checkpoint_every = 0;
+      t.eval_every = 0;  // the final evaluation only
+      const std::filesystem::path dir =
+          out / "budget-search" / std::to_string(budget) / ("fold-" + std::to_string(fold));
+      const host::TrainReport r = host::train(context, splits[fold], initial_for(budget), planes, t, dir, {},
+                                              nullptr, [](const std::string&) {});
+      trial.fold_psnr_db.push_back(r.final_eval.psnr_db);
+      trial.psnr_db += r.final_eval.psnr_db / search.folds;
+      trial.ssim += r.final_eval.ssim / search.folds;
+      trial.gaussians = std::max(trial.gaussians, static_cast<uint32_t>(r.gaussians));
+      trial.wall_s += r.wall_s;
+    }
+    std::cout << "train: budget " << budget << ": validation PSNR " << trial.psnr_db << " dB (folds:";
+    for (double p : trial.fold_psnr_db) std::cout << " " << p;
+    std::cout << "), SSIM " << trial.ssim << " (" << trial.gaussians << " Gaussians, " << trial.wall_s
+              << " s)\n";
     return trial;
   };
   // A budget below the initialization's size (one not capped by the budget) cannot hold it: start there.
@@ -127,6 +142,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
     }
     trials.push_back({{"budget", t.budget},
                       {"validation_psnr_db", t.psnr_db},
+                      {"validation_psnr_db_per_fold", t.fold_psnr_db},
                       {"validation_ssim", t.ssim},
                       {"gaussians", t.gaussians},
                       {"wall_s", t.wall_s}});
@@ -137,8 +153,9 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
                          {"min_gain_db", search.min_gain_db},
                          {"factor", search.factor},
                          {"patience", search.patience},
-                         {"validation_views", validation_views},
-                         {"training_views", split.views.size() - validation_views},
+                         {"folds", search.folds},
+                         {"views", views},
+                         {"validation_views_per_fold", validation_views},
                          {"trials", trials}}
               .dump(2)
        << "\n";

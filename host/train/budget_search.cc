@@ -13,6 +13,7 @@ void BudgetSearchOptions::check() const {
   if (!(min_gain_db >= 0.0) || !std::isfinite(min_gain_db)) bad("min_gain_db must be 0 or more");
   if (max_budget < start) bad("max_budget must be at least start");
   if (validation_every < 2) bad("validation_every must be at least 2");
+  if (folds < 1 || folds > validation_every) bad("folds must be between 1 and validation_every");
 }
 
 BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget)>& train_at,
@@ -49,8 +50,11 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
   return result;
 }
 
-TrainingData validation_split(const TrainingData& data, uint32_t every) {
+TrainingData validation_split(const TrainingData& data, uint32_t every, uint32_t fold, uint32_t folds) {
   if (every < 2) throw std::invalid_argument("validation_split: every must be at least 2");
+  if (folds < 1 || folds > every || fold >= folds)
+    throw std::invalid_argument("validation_split: fold " + std::to_string(fold) + " of " +
+                                std::to_string(folds) + " folds with every " + std::to_string(every));
   TrainingData out = data;
   out.views.clear();
   for (const TrainingView& v : data.views)
@@ -58,9 +62,11 @@ TrainingData validation_split(const TrainingData& data, uint32_t every) {
   if (out.views.size() < 2)
     throw std::invalid_argument("the budget search needs at least two training views to hold one out, has " +
                                 std::to_string(out.views.size()));
+  const size_t offset = (every / 2 + fold * (every / folds)) % every;
   bool any = false;
-  for (size_t i = 0; i < out.views.size(); ++i) any |= out.views[i].heldout = i % every == every / 2;
-  if (!any) out.views[out.views.size() / 2].heldout = true;  // fewer views than every / 2 + 1
+  for (size_t i = 0; i < out.views.size(); ++i) any |= out.views[i].heldout = i % every == offset;
+  // Fewer views than the offset + 1: one view per fold, spread over the list.
+  if (!any) out.views[(out.views.size() / 2 + fold) % out.views.size()].heldout = true;
   return out;
 }
 

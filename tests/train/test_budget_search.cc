@@ -116,6 +116,9 @@ TEST(BudgetSearch, BadOptionsAreRefusedByName) {
   o.validation_every = 1;
   EXPECT_THROW(search_budget(std::ref(s), 0, o), std::invalid_argument);
   o = {};
+  o.folds = 0;
+  EXPECT_THROW(search_budget(std::ref(s), 0, o), std::invalid_argument);
+  o = {};
   o.min_gain_db = NAN;
   EXPECT_THROW(search_budget(std::ref(s), 0, o), std::invalid_argument);
   EXPECT_TRUE(s.ran.empty());
@@ -146,6 +149,36 @@ TEST(BudgetSearch, TheValidationSplitDropsTheTestViewsAndHoldsOutEveryKthTrainin
   EXPECT_EQ(f.views[1].heldout + f.views[0].heldout + f.views[2].heldout, 1);  // always one
   few.views.resize(1);
   EXPECT_THROW(validation_split(few, 8), std::invalid_argument);
+}
+
+TEST(BudgetSearch, TheTwoFoldsValidateOnDisjointViewsHalfAStrideApart) {
+  TrainingData d;
+  for (int i = 0; i < 40; ++i) {
+    TrainingView v;
+    v.name = std::to_string(i);
+    v.heldout = i % 8 == 0;  // the scene's test views: 5
+    d.views.push_back(v);
+  }
+  const TrainingData f0 = validation_split(d, 8, 0, 2), f1 = validation_split(d, 8, 1, 2);
+  ASSERT_EQ(f0.views.size(), 35u);
+  ASSERT_EQ(f1.views.size(), 35u);
+  std::vector<size_t> v0, v1;
+  for (size_t i = 0; i < 35; ++i) {
+    EXPECT_EQ(f0.views[i].name, f1.views[i].name);  // the same views, split differently
+    if (f0.views[i].heldout) v0.push_back(i);
+    if (f1.views[i].heldout) v1.push_back(i);
+    EXPECT_FALSE(f0.views[i].heldout && f1.views[i].heldout) << "view " << i << " validates in both folds";
+  }
+  EXPECT_EQ(v0, (std::vector<size_t>{4, 12, 20, 28}));  // fold 0 is the one-fold split
+  EXPECT_EQ(v1, (std::vector<size_t>{0, 8, 16, 24, 32}));
+  EXPECT_EQ(validation_split(d, 8).views[4].heldout, true);
+
+  TrainingData few;
+  few.views.resize(3);
+  const TrainingData a = validation_split(few, 8, 0, 2), b = validation_split(few, 8, 1, 2);
+  for (size_t i = 0; i < 3; ++i) EXPECT_FALSE(a.views[i].heldout && b.views[i].heldout);
+  EXPECT_THROW(validation_split(d, 8, 2, 2), std::invalid_argument);  // no fold 2 of 2
+  EXPECT_THROW(validation_split(d, 8, 0, 9), std::invalid_argument);  // more folds than offsets
 }
 
 }  // namespace
