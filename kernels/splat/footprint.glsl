@@ -60,6 +60,10 @@ uvec2 block_pixel(uvec2 origin, uint dx, uint dy) {
 // The subgroup's lanes that exist: a device whose subgroups are wider than the workgroup (64-wide AMD waves)
 // runs it as one partial subgroup, whose chunks of list entries and butterfly sums must not reach past it.
 uint subgroup_lanes() { return min(gl_SubgroupSize, GROUP_INVOCATIONS); }
+
+// The 32-bit words of a ballot that hold the subgroup's lanes: 1 with 2x4 pixels per invocation, known when
+// the pipeline is built (a CPU driver would otherwise run the word loop's body once more, masked).
+uint ballot_words() { return GROUP_INVOCATIONS <= 32u ? 1u : (subgroup_lanes() + 31u) / 32u; }
 #endif
 
 // sigma along the edge x = dx (relative to the mean) of a box, at its smallest: dy = -(b / c) dx clamped

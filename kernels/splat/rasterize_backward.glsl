@@ -181,11 +181,13 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 subg
   a0 = vec4(0.0);
   a1 = vec4(0.0);
   a2 = vec4(0.0);
-  uvec4 todo = subgroupBallot(relevant);
-  for (int word = 3; word >= 0; --word) {
-    while (todo[word] != 0u) {
-      const uint bit = uint(findMSB(todo[word]));
-      todo[word] &= ~(1u << bit);
+  // Run as rasterize_forward.comp's walk: the body max(1, entries) times per word on a CPU driver.
+  const uvec4 ballot = subgroupBallot(relevant);
+  for (int word = int(ballot_words()) - 1; word >= 0; --word) {
+    uint todo = ballot[word];
+    if (todo != 0u) do {
+      const uint bit = uint(findMSB(todo));
+      todo &= ~(1u << bit);
       const uint k = 32u * uint(word) + bit;
       const vec4 me = subgroupShuffle(mean_extent, k), co = subgroupShuffle(conic_opacity, k);
       const vec4 col = channels_shuffle(color, k);
@@ -212,7 +214,7 @@ void chunk_backward(uint list_start, uint chunk_start, uint chunk_end, vec2 subg
         a1 = s1;
         a2 = s2;
       }
-    }
+    } while (todo != 0u);
   }
 }
 
@@ -321,15 +323,17 @@ void main() {
     atomicAdd(counters[SPLAT_COUNTER_BACKWARD_WALKS_CUT], 1u);
 #else
   // Each subgroup walks back from its own longest walk; lane k adds its entry's sums once.
-  for (chunk_end = min(subgroupMax(my_last), segment.end); chunk_end > segment.begin;
-       chunk_end = chunk_start_below(chunk_end)) {
+  // do-while, not for: a CPU driver runs a loop's body once more, masked, when a for loop's test fails.
+  chunk_end = min(subgroupMax(my_last), segment.end);
+  if (chunk_end > segment.begin) do {
     uint g;
     bool relevant;
     vec4 a0, a1, a2;
     chunk_backward(range.x, chunk_start_below(chunk_end), chunk_end, subgroup_lo, subgroup_hi, p0, p1, p2, p3, p4, p5, p6, p7, g,
                    relevant, a0, a1, a2);
     if (relevant) add_entry_grads(g, a0, a1, a2);
-  }
+    chunk_end = chunk_start_below(chunk_end);
+  } while (chunk_end > segment.begin);
   if (chunk_end > segment.begin && subgroupElect()) atomicAdd(counters[SPLAT_COUNTER_BACKWARD_WALKS_CUT], 1u);
 #endif
 

@@ -93,6 +93,12 @@ void blend(inout PixelState s, vec4 me, vec4 co, vec4 color, float depth, uint p
   s.contributions += hit && !stop ? 1u : 0u;
 }
 
+// Whether every pixel of the subgroup has stopped.
+bool all_done(PixelState s0, PixelState s1, PixelState s2, PixelState s3, PixelState s4, PixelState s5,
+              PixelState s6, PixelState s7) {
+  return subgroupAll(s0.done && s1.done && s2.done && s3.done && s4.done && s5.done && s6.done && s7.done);
+}
+
 // Writes the outputs, or the state the next pass continues from.
 void finish_pixel(PixelState s, uint plane, bool final_pass) {
   if (!s.inside) return;
@@ -131,8 +137,8 @@ void main() {
   const vec2 subgroup_hi = subgroupMax(PIXEL_BLOCK == 8u ? s7.centre : s0.centre);
   uint chunk = range.x + segment.begin;
   const uint lanes = subgroup_lanes();
-  for (; chunk < end; chunk += lanes) {
-    if (subgroupAll(s0.done && s1.done && s2.done && s3.done && s4.done && s5.done && s6.done && s7.done)) break;
+  // do-while, not for: a CPU driver runs a loop's body once more, masked, when a for loop's test fails.
+  if (chunk < end && !all_done(s0, s1, s2, s3, s4, s5, s6, s7)) do {
     const uint entry = chunk + gl_SubgroupInvocationID;
     vec4 mean_extent = vec4(0.0), conic_opacity = vec4(0.0), color = vec4(0.0);
     float depth = 0.0;
@@ -146,11 +152,14 @@ void main() {
       relevant = footprint_reaches(mean_extent, subgroup_lo, subgroup_hi);
       if (relevant) color = load_entry_color(g);
     }
-    uvec4 todo = subgroupBallot(relevant);
-    for (uint word = 0u; word < 4u; ++word) {
-      while (todo[word] != 0u) {
-        const uint k = 32u * word + uint(findLSB(todo[word]));
-        todo[word] &= todo[word] - 1u;
+    // A CPU driver runs an `if` masked and a loop's body at least once, so a `while` over the ballot's bits
+    // would blend one empty entry more per word and chunk; this walk runs its body max(1, entries) times.
+    const uvec4 ballot = subgroupBallot(relevant);
+    for (uint word = 0u; word < ballot_words(); ++word) {
+      uint todo = ballot[word];
+      if (todo != 0u) do {
+        const uint k = 32u * word + uint(findLSB(todo));
+        todo &= todo - 1u;
         const vec4 me = subgroupShuffle(mean_extent, k);
         const vec4 co = subgroupShuffle(conic_opacity, k);
         const vec4 col = channels_shuffle(color, k);
@@ -166,12 +175,13 @@ void main() {
           blend(s6, me, co, col, dep, position);
           blend(s7, me, co, col, dep, position);
         }
-      }
+      } while (todo != 0u);
     }
-  }
+    chunk += lanes;
+  } while (chunk < end && !all_done(s0, s1, s2, s3, s4, s5, s6, s7));
   // A driver's loop limit (lavapipe: 65535 iterations per invocation) ends the walk early without an error:
   // count it, so that a pass sized wrongly for a device is seen (SPLAT_COUNTER_FORWARD_WALKS_CUT).
-  if (chunk < end && !subgroupAll(s0.done && s1.done && s2.done && s3.done && s4.done && s5.done && s6.done && s7.done) && subgroupElect())
+  if (chunk < end && !all_done(s0, s1, s2, s3, s4, s5, s6, s7) && subgroupElect())
     atomicAdd(counters[SPLAT_COUNTER_FORWARD_WALKS_CUT], 1u);
   const uint subgroup_contributions = subgroupAdd(s0.contributions + s1.contributions + s2.contributions + s3.contributions + s4.contributions + s5.contributions + s6.contributions + s7.contributions);
   if (subgroupElect() && subgroup_contributions > 0u)

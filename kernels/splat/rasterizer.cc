@@ -24,6 +24,8 @@ namespace {
 // the loop structure of the kernels (rasterize_forward.comp, rasterize_backward.glsl): the chunk loop, the
 // colour load, the four ballot words and their entries, and per entry the butterfly sum (log2 S steps), the
 // atomic adds (compare-and-swap loops) or the deterministic mode's sum over the workgroup's subgroups.
+// The forward's and the atomic backward's walks are do-while loops over one ballot word now (at most S
+// iterations per chunk, no extra one): these bounds, made for the earlier for and while loops, still hold.
 uint32_t log2_ceil(uint32_t v) {
   return static_cast<uint32_t>(std::bit_width(std::max(v, 1u) - 1));
 }
