@@ -111,9 +111,12 @@ void main() {
   // SH bands above the active degree are not stepped: their gradient is 0, and has been since training
   // began (the active degree only rises), so their moments are 0 and Adam's step would leave them exactly.
   const uint active_coeffs = min(K, (p.sh_degree + 1u) * (p.sh_degree + 1u));
-  for (uint k = 0u; k < active_coeffs; ++k)
+  // do-while (active_coeffs >= 1): a CPU driver runs a for loop's body once more, masked, at its end.
+  uint k = 0u;
+  do {
     for (uint c = 0u; c < CHANNELS; ++c) {
       const uint j = (i * K + k) * CHANNELS + c;
       ADAM_ELEMENT(sh, m_sh, v_sh, j, g.basis[k] * g.color[c], k == 0u ? p.lr[4] : p.lr_sh_rest, 4u)
     }
+  } while (++k < active_coeffs);
 }

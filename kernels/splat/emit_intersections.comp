@@ -22,12 +22,15 @@ void main() {
   if (s >= view.count) return;
   const uint g = order[s];
   const uvec4 r = unpack_tile_rect(rects[g]);
-  uint e = offsets[s];
-  for (uint ty = r.y; ty < r.w; ++ty)
-    for (uint tx = r.x; tx < r.z; ++tx) {
-      tile_keys[e] = ty * view.tiles_x + tx;
-      isect_ids[e] = e;
-      isect_gaussian[e] = g;
-      ++e;
-    }
+  const uint first = offsets[s];
+  const uint width = r.z - r.x, count = width * (r.w - r.y);
+  // One do-while over the rectangle's tiles, not two nested for loops: a CPU driver runs every loop's body
+  // once more, masked, when its test fails (nested: once per row and once more in all).
+  uint t = 0u;
+  if (count > 0u) do {
+    const uint e = first + t;
+    tile_keys[e] = (r.y + t / width) * view.tiles_x + r.x + t % width;
+    isect_ids[e] = e;
+    isect_gaussian[e] = g;
+  } while (++t < count);
 }
