@@ -104,6 +104,17 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
             << "th view from its own offset (" << validation_views.front()
             << " views; the scene's held-out views are not used), " << options.iterations
             << " iterations each\n";
+  // The seeding at the last budget asked for, so that the folds (and the first trial after the size check
+  // below) share one instead of each building it (a LiDAR-map seeding fits covariances to its points).
+  uint32_t cached_budget = 0;
+  kernels::GaussianModel cached;
+  const auto initial_at = [&](uint32_t budget) -> const kernels::GaussianModel& {
+    if (cached_budget != budget) {
+      cached = initial_for(budget);
+      cached_budget = budget;
+    }
+    return cached;
+  };
   const auto train_at = [&](uint32_t budget) {
     host::BudgetTrial trial;
     for (uint32_t fold = 0; fold < search.folds; ++fold) {
@@ -115,7 +126,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
       t.eval_every = 0;  // the final evaluation only
       const std::filesystem::path dir =
           out / "budget-search" / std::to_string(budget) / ("fold-" + std::to_string(fold));
-      const host::TrainReport r = host::train(context, splits[fold], initial_for(budget), planes, t, dir, {},
+      const host::TrainReport r = host::train(context, splits[fold], initial_at(budget), planes, t, dir, {},
                                               nullptr, [](const std::string&) {});
       trial.fold_psnr_db.push_back(r.final_eval.psnr_db);
       trial.psnr_db += r.final_eval.psnr_db / search.folds;
@@ -130,7 +141,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
     return trial;
   };
   // A budget below the initialization's size (one not capped by the budget) cannot hold it: start there.
-  const uint32_t smallest = static_cast<uint32_t>(initial_for(search.start).size());
+  const uint32_t smallest = static_cast<uint32_t>(initial_at(search.start).size());
   const host::BudgetSearchResult result = host::search_budget(train_at, smallest, search);
   nlohmann::json trials = nlohmann::json::array();
   for (const host::BudgetTrial& t : result.trials) {
