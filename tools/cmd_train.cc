@@ -316,9 +316,9 @@ void add_train_command(CLI::App& app) {
          "--max-gaussians", o->max_gaussians,
          "Cap of the model size (the MCMC budget): a count, auto (derived from the surface the "
          "training views see at their resolution: the LiDAR map, else the initialization's points), "
-         "or search (trainings at doubling budgets on the training views less a validation eighth, "
-         "while validation PSNR still gains 0.1 dB, looking one doubling past a plateau; then the final "
-         "training at the budget found)")
+         "or search (two trainings per doubling budget, each on the training views less its own "
+         "validation eighth, while their mean validation PSNR still gains 0.1 dB, looking one doubling "
+         "past a plateau; then the final training at the budget found)")
       ->capture_default_str();
   cmd->add_option("--strategy", o->train.strategy,
                   "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")

@@ -5,7 +5,7 @@
 //   lambda    lambda_geo 0, 0.2, 0.4, 0.6, 0.8: PSNR, SSIM, depth and centres to planes, EMD
 //   features  ORB, SIFT, AKAZE, each with and without CLAHE (Table III): inlier ratio, verified pairs,
 //             points; ATE, plane residual and PSNR where refine uses the front end's tracks
-//   strategy  ADC and MCMC at 1/4, 1/2 and 1 times train.max_gaussians (auto: 5k, 20k, 80k and auto):
+//   strategy  ADC and MCMC at 1/4, 1/2 and 1 times train.max_gaussians (auto or search: 5k, 20k, 80k and it):
 //             Gaussians, PSNR, SSIM, seconds
 #pragma once
 

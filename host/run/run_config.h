@@ -125,7 +125,8 @@ void for_each_field(Config& c, F&& f) {
     "mcmc (fixed budget; at 320x256 on DUNR better and faster than uncapped adc) | adc (capped by "
     "max_gaussians: at 160x128 on DUNR 0.2 dB above mcmc at each budget, and slower; README)");
   f("train", "max_gaussians", c.train.max_gaussians,
-    "MCMC budget (adc: cap): a count, or auto (derived from the surface the training views see)");
+    "MCMC budget (adc: cap): a count, auto (derived from the surface the training views see) or search "
+    "(grown while validation PSNR rises: two trainings per budget tried; README)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
   f("train", "init", c.train.init,
