@@ -124,8 +124,8 @@ std::vector<std::string> compared_budgets(const std::string& base) {
   const bool count = !base.empty() && base.find_first_not_of("0123456789") == std::string::npos &&
                      base.size() <= 9 && std::stoul(base) >= 4;
   if (!count)
-    throw std::invalid_argument("train.max_gaussians must be a count (at least 4), auto or search, not '" + base +
-                                "'");
+    throw std::invalid_argument("train.max_gaussians must be a count (at least 4), auto or search, not '" +
+                                base + "'");
   const unsigned long b = std::stoul(base);
   return {std::to_string(b / 4), std::to_string(b / 2), base};
 }
