@@ -64,13 +64,15 @@ EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32
     if (levels) {
       const kernels::LevelGeometry g{W, H, 1, static_cast<float>(cam.cx), static_cast<float>(cam.cy)};
       const std::vector<float> leveled = apply_level(img.image, g, levels->values(i), levels->vignetting());
-      e.psnr_db += kernels::psnr(leveled, target);
+      e.view_psnr_db.emplace_back(data_->views[i].name, kernels::psnr(leveled, target));
+      e.psnr_db += e.view_psnr_db.back().second;
       e.ssim += kernels::ssim_reference(leveled, target, 1, W, H);
       e.mae_counts += counts * mean_abs_diff(leveled, target);
       e.psnr_identity_db += kernels::psnr(img.image, target);
       e.mae_counts_identity += counts * mean_abs_diff(img.image, target);
     } else {
-      e.psnr_db += kernels::psnr(img.image, target);
+      e.view_psnr_db.emplace_back(data_->views[i].name, kernels::psnr(img.image, target));
+      e.psnr_db += e.view_psnr_db.back().second;
       e.ssim += kernels::ssim_reference(img.image, target, 1, W, H);
       e.mae_counts += counts * mean_abs_diff(img.image, target);
     }

@@ -24,6 +24,9 @@ nlohmann::json metrics_json(const TrainReport& report, const TrainingData& data,
                             {"evaluations", nlohmann::json::array()},
                             {"kernel_ms_per_iteration", nlohmann::json::object()}};
   for (const auto& [name, ms] : report.kernel_ms_per_iteration) metrics["kernel_ms_per_iteration"][name] = ms;
+  metrics["heldout_psnr_per_view"] = nlohmann::json::array();
+  for (const auto& [name, psnr] : report.final_eval.view_psnr_db)
+    metrics["heldout_psnr_per_view"].push_back({{"view", name}, {"psnr_db", psnr}});
   // Where peak_device_bytes went, by buffer name (engine::Buffer::peak_breakdown), most first.
   metrics["peak_device_breakdown"] = nlohmann::json::array();
   for (const auto& [name, bytes] : report.peak_device_breakdown)

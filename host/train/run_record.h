@@ -8,6 +8,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "kernels/optim/training_state.h"
@@ -26,6 +27,9 @@ struct EvalResult {
   // these score it at the identity level (the map as it is).
   bool leveled = false;
   double psnr_identity_db = 0, mae_counts_identity = -1;
+  // Each held-out view's PSNR (the terms of psnr_db's mean), with its frame name: one badly observed view
+  // can decide the mean. Written to metrics.json for the final evaluation only.
+  std::vector<std::pair<std::string, double>> view_psnr_db;
 };
 
 // Events of a run that change what is learnt without stopping it, summed over every iteration of the run (a

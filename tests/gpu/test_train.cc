@@ -188,6 +188,15 @@ TEST_F(TrainTest, TrainsAndWritesOutputs) {
   EXPECT_EQ(j["iterations"], 60);
   EXPECT_EQ(j["gaussians"], m.size());
   EXPECT_GT(j["peak_device_bytes"].get<uint64_t>(), 0u);
+  // Each held-out view's PSNR, named, and heldout_psnr is their mean.
+  const auto& views = j.at("heldout_psnr_per_view");
+  ASSERT_EQ(views.size(), j.at("heldout_views").get<size_t>());
+  double sum = 0;
+  for (const auto& v : views) {
+    EXPECT_FALSE(v.at("view").get<std::string>().empty());
+    sum += v.at("psnr_db").get<double>();
+  }
+  EXPECT_NEAR(sum / static_cast<double>(views.size()), j.at("heldout_psnr").get<double>(), 1e-9);
 }
 
 TEST_F(TrainTest, ResumeContinuesExactly) {
