@@ -43,6 +43,9 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
     } else if (!t.failure.empty() || ++misses > o.patience) {
       break;
     }
+    // A budget the training did not fill (MCMC's growth ends below it) ends the search: a larger one would
+    // train the same model again.
+    if (t.failure.empty() && t.gaussians > 0 && t.gaussians < budget) break;
     if (budget >= o.max_budget) break;
     budget = static_cast<uint32_t>(std::min<double>(std::ceil(budget * o.factor), o.max_budget));
   }

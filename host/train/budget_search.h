@@ -49,7 +49,8 @@ struct BudgetSearchResult {
 
 // The search's rule over `train_at(budget)` (one training on the validation split). The first trial sets the
 // baseline; the next ones run until patience + 1 budgets in a row fail to gain min_gain_db over the best
-// before them. A
+// before them, or until a trial ends with fewer Gaussians than its budget (a larger budget would train the
+// same model: MCMC's growth in the given iterations, not the budget, limited it). A
 // budget the device cannot hold (train_at throws std::length_error, as buffers over the device's memory or
 // limits do) ends the search at the budget before it, recorded as a failed trial; at the first budget it
 // passes through. std::invalid_argument for bad options; anything else train_at throws passes through.

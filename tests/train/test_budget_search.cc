@@ -1,6 +1,7 @@
 // The budget search's rule and its validation split (host/train/budget_search.h), on scripted scores.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -49,6 +50,25 @@ TEST(BudgetSearch, LooksOneBudgetPastAPlateau) {
   impatient.patience = 0;
   Scripted t{s.psnr, {}};
   EXPECT_EQ(search_budget(std::ref(t), 0, impatient).chosen, 10000u);
+}
+
+TEST(BudgetSearch, ABudgetTheTrainingDidNotFillEndsTheSearch) {
+  // DUNR's shape: growth from 3,988 points reaches 156,975 Gaussians in 2,000 iterations, so 160k is not
+  // filled and 320k would train the same model.
+  std::vector<uint32_t> ran;
+  const auto train_at = [&](uint32_t budget) {
+    ran.push_back(budget);
+    BudgetTrial t;
+    t.gaussians = std::min<uint32_t>(budget, 156975);
+    t.psnr_db = budget <= 80000 ? 20.0 + budget / 20000.0 : 20.0;  // gains up to 80k, then falls
+    return t;
+  };
+  EXPECT_EQ(search_budget(train_at, 3988).chosen, 80000u);
+  EXPECT_EQ(ran, (std::vector<uint32_t>{5000, 10000, 20000, 40000, 80000, 160000}));  // not 320k
+  // A filled budget (or one a scripted trial leaves at 0 Gaussians) does not end it.
+  Scripted s{{{5000, 21.0}, {10000, 21.5}, {20000, 21.5}, {40000, 21.5}}, {}};
+  EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 10000u);
+  EXPECT_EQ(s.ran.size(), 4u);
 }
 
 TEST(BudgetSearch, AFallStopsTheSearchAtTheBudgetBeforeIt) {
