@@ -144,14 +144,20 @@ TEST(BudgetSearch, BadOptionsAreRefusedByName) {
   EXPECT_TRUE(s.ran.empty());
 }
 
-TEST(BudgetSearch, TheValidationSplitDropsTheTestViewsAndHoldsOutEveryKthTrainingView) {
+// `frames` views named by their index, every 8th held out as the scene's test views.
+TrainingData views_with_every_8th_held_out(int frames) {
   TrainingData d;
-  for (int i = 0; i < 45; ++i) {
+  for (int i = 0; i < frames; ++i) {
     TrainingView v;
     v.name = std::to_string(i);
-    v.heldout = i % 8 == 0;  // the scene's test views: 6
+    v.heldout = i % 8 == 0;
     d.views.push_back(v);
   }
+  return d;
+}
+
+TEST(BudgetSearch, TheValidationSplitDropsTheTestViewsAndHoldsOutEveryKthTrainingView) {
+  const TrainingData d = views_with_every_8th_held_out(45);  // 6 test views
   const TrainingData s = validation_split(d, 8);
   ASSERT_EQ(s.views.size(), 39u);
   size_t validation = 0;
@@ -172,13 +178,7 @@ TEST(BudgetSearch, TheValidationSplitDropsTheTestViewsAndHoldsOutEveryKthTrainin
 }
 
 TEST(BudgetSearch, TheTwoFoldsValidateOnDisjointViewsHalfAStrideApart) {
-  TrainingData d;
-  for (int i = 0; i < 40; ++i) {
-    TrainingView v;
-    v.name = std::to_string(i);
-    v.heldout = i % 8 == 0;  // the scene's test views: 5
-    d.views.push_back(v);
-  }
+  const TrainingData d = views_with_every_8th_held_out(40);  // 5 test views
   const TrainingData f0 = validation_split(d, 8, 0, 2), f1 = validation_split(d, 8, 1, 2);
   ASSERT_EQ(f0.views.size(), 35u);
   ASSERT_EQ(f1.views.size(), 35u);
