@@ -1,10 +1,11 @@
 // `train --max-gaussians search`: the Gaussian budget a scene needs, found by growing while held-out error
-// still falls. Trainings at budgets growing by `factor` run on the training views less a validation subset
-// (every `validation_every`-th training view; the scene's own held-out views are not used), each for the
-// full iterations; the search stops once a budget's validation PSNR does not beat the best so far by
-// `min_gain_db` and `patience` more budgets do not either, and keeps the last budget that did. A fixed
-// budget the user must guess is replaced by the smallest one that the views show still pays. The final
-// training then runs at that budget on every training view. Costs one training per budget tried.
+// still falls. Each budget, growing by `factor`, is trained `folds` times for the full iterations, each on
+// the training views less its own validation subset (every `validation_every`-th training view from the
+// fold's offset; the scene's own held-out views are not used), and scored by the folds' mean validation PSNR;
+// the search stops once a budget does not beat the best so far by `min_gain_db` and `patience` more budgets
+// do not either, and keeps the last budget that did. A fixed budget the user must guess is replaced by the
+// smallest one that the views show still pays. The final training then runs at that budget on every
+// training view. Costs `folds` trainings per budget tried.
 #pragma once
 
 #include <cstdint>
@@ -47,10 +48,10 @@ struct BudgetSearchResult {
   std::vector<BudgetTrial> trials;  // in the order run
 };
 
-// The search's rule over `train_at(budget)` (one training on the validation split). The first trial sets the
-// baseline; the next ones run until patience + 1 budgets in a row fail to gain min_gain_db over the best
-// before them, or until a trial ends with fewer Gaussians than its budget (a larger budget would train the
-// same model: MCMC's growth in the given iterations, not the budget, limited it). A
+// The search's rule over `train_at(budget)` (the budget's trainings on the validation splits, scored). The
+// first trial sets the baseline; the next ones run until patience + 1 budgets in a row fail to gain
+// min_gain_db over the best before them, or until a trial ends with fewer Gaussians than its budget (a larger
+// budget would train the same model: MCMC's growth in the given iterations, not the budget, limited it). A
 // budget the device cannot hold (train_at throws std::length_error, as buffers over the device's memory or
 // limits do) ends the search at the budget before it, recorded as a failed trial; at the first budget it
 // passes through. std::invalid_argument for bad options; anything else train_at throws passes through.

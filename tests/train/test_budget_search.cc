@@ -11,7 +11,8 @@
 namespace litgs::host {
 namespace {
 
-// A train_at that scores each budget from a table and records what ran.
+// A train_at that scores each budget from a table, fills it (as MCMC does when its growth reaches the
+// budget) and records what ran.
 struct Scripted {
   std::map<uint32_t, double> psnr;
   std::vector<uint32_t> ran;
@@ -19,6 +20,7 @@ struct Scripted {
     ran.push_back(budget);
     BudgetTrial t;
     t.psnr_db = psnr.at(budget);
+    t.gaussians = budget;
     return t;
   }
 };
@@ -65,7 +67,7 @@ TEST(BudgetSearch, ABudgetTheTrainingDidNotFillEndsTheSearch) {
   };
   EXPECT_EQ(search_budget(train_at, 3988).chosen, 80000u);
   EXPECT_EQ(ran, (std::vector<uint32_t>{5000, 10000, 20000, 40000, 80000, 160000}));  // not 320k
-  // A filled budget (or one a scripted trial leaves at 0 Gaussians) does not end it.
+  // Filled budgets do not end it: the plateau rule does.
   Scripted s{{{5000, 21.0}, {10000, 21.5}, {20000, 21.5}, {40000, 21.5}}, {}};
   EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 10000u);
   EXPECT_EQ(s.ran.size(), 4u);
