@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -129,6 +130,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
       const host::TrainReport r = host::train(context, splits[fold], initial_at(budget), planes, t, dir, {},
                                               nullptr, [](const std::string&) {});
       trial.fold_psnr_db.push_back(r.final_eval.psnr_db);
+      for (const auto& view : r.final_eval.view_psnr_db) trial.view_psnr_db.push_back(view.second);
       trial.psnr_db += r.final_eval.psnr_db / search.folds;
       trial.ssim += r.final_eval.ssim / search.folds;
       trial.gaussians = std::max(trial.gaussians, static_cast<uint32_t>(r.gaussians));
@@ -151,16 +153,24 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
                 << "): the search stops there\n";
       continue;
     }
-    trials.push_back({{"budget", t.budget},
-                      {"validation_psnr_db", t.psnr_db},
-                      {"validation_psnr_db_per_fold", t.fold_psnr_db},
-                      {"validation_ssim", t.ssim},
-                      {"gaussians", t.gaussians},
-                      {"wall_s", t.wall_s}});
+    nlohmann::json trial = {{"budget", t.budget},
+                            {"validation_psnr_db", t.psnr_db},
+                            {"validation_psnr_db_per_fold", t.fold_psnr_db},
+                            {"validation_psnr_db_per_view", t.view_psnr_db},
+                            {"validation_ssim", t.ssim},
+                            {"gaussians", t.gaussians},
+                            {"wall_s", t.wall_s}};
+    if (std::isfinite(t.shortfall_db)) {
+      trial["shortfall_db"] = t.shortfall_db;  // against the reference, per view
+      trial["shortfall_se_db"] = t.shortfall_se_db;
+    }
+    trials.push_back(trial);
   }
   io::write_file_atomic(out / "budget.json", [&](std::ostream& os) {
     os << nlohmann::json{{"gaussians", result.chosen},
                          {"source", "search"},
+                         {"reference", result.reference},
+                         {"parsimony_se", search.parsimony_se},
                          {"min_gain_db", search.min_gain_db},
                          {"factor", search.factor},
                          {"patience", search.patience},
@@ -171,8 +181,10 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
               .dump(2)
        << "\n";
   });
-  std::cout << "train: budget " << result.chosen << " Gaussians: the last that added at least "
-            << search.min_gain_db << " dB on the validation views (budget.json)\n";
+  std::cout << "train: budget " << result.reference << " Gaussians was the last that added at least "
+            << search.min_gain_db << " dB on the validation views; chosen: " << result.chosen
+            << ", the smallest within " << search.parsimony_se
+            << " standard error(s) of it per view (budget.json)\n";
   return result.chosen;
 }
 

@@ -14,6 +14,7 @@ void BudgetSearchOptions::check() const {
   if (max_budget < start) bad("max_budget must be at least start");
   if (validation_every < 2) bad("validation_every must be at least 2");
   if (folds < 1 || folds > validation_every) bad("folds must be between 1 and validation_every");
+  if (!(parsimony_se >= 0.0) || !std::isfinite(parsimony_se)) bad("parsimony_se must be 0 or more");
 }
 
 BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget)>& train_at,
@@ -22,7 +23,8 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
   BudgetSearchResult result;
   uint32_t budget = std::min(std::max(o.start, initial_gaussians), o.max_budget);
   double best = -INFINITY;
-  uint32_t misses = 0;  // budgets in a row that did not gain
+  size_t reference = 0;  // the trial of the last budget that gained
+  uint32_t misses = 0;   // budgets in a row that did not gain
   for (;;) {
     BudgetTrial t;
     try {
@@ -38,7 +40,7 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
     // A NaN score never counts as a gain; a budget the device cannot hold ends the search.
     if (t.psnr_db >= best + o.min_gain_db) {
       best = t.psnr_db;
-      result.chosen = budget;
+      reference = result.trials.size() - 1;
       misses = 0;
     } else if (!t.failure.empty() || ++misses > o.patience) {
       break;
@@ -49,8 +51,31 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
     if (budget >= o.max_budget) break;
     budget = static_cast<uint32_t>(std::min<double>(std::ceil(budget * o.factor), o.max_budget));
   }
-  if (result.chosen == 0) result.chosen = result.trials.front().budget;  // the first trial scored NaN
+  // reference stays 0 where the first trial scored NaN.
+  result.reference = result.chosen = result.trials[reference].budget;
+  if (o.parsimony_se > 0)
+    result.chosen =
+        result.trials[choose_within_standard_errors(result.trials, reference, o.parsimony_se)].budget;
   return result;
+}
+
+size_t choose_within_standard_errors(std::vector<BudgetTrial>& trials, size_t reference, double se_multiple) {
+  const std::vector<double>& ref = trials.at(reference).view_psnr_db;
+  size_t chosen = reference;
+  for (size_t i = 0; i < trials.size(); ++i) {
+    BudgetTrial& t = trials[i];
+    if (!t.failure.empty() || t.view_psnr_db.size() != ref.size() || ref.size() < 2) continue;
+    const double n = static_cast<double>(ref.size());
+    double mean = 0, squares = 0;
+    for (size_t v = 0; v < ref.size(); ++v) mean += (ref[v] - t.view_psnr_db[v]) / n;
+    for (size_t v = 0; v < ref.size(); ++v) squares += std::pow(ref[v] - t.view_psnr_db[v] - mean, 2);
+    t.shortfall_db = mean;
+    t.shortfall_se_db = std::sqrt(squares / (n - 1) / n);
+    // Written so that a NaN view never qualifies a budget.
+    const bool within = mean <= se_multiple * t.shortfall_se_db;
+    if (i < chosen && within) chosen = i;
+  }
+  return chosen;
 }
 
 TrainingData validation_split(const TrainingData& data, uint32_t every, uint32_t fold, uint32_t folds) {

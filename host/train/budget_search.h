@@ -3,11 +3,15 @@
 // the training views less its own validation subset (every `validation_every`-th training view from the
 // fold's offset; the scene's own held-out views are not used), and scored by the folds' mean validation PSNR;
 // the search stops once a budget does not beat the best so far by `min_gain_db` and `patience` more budgets
-// do not either, and keeps the last budget that did. A fixed budget the user must guess is replaced by the
-// smallest one that the views show still pays. The final training then runs at that budget on every
-// training view. Costs `folds` trainings per budget tried.
+// do not either. Of the budgets tried up to the last one that gained, it keeps the smallest whose shortfall
+// against that one is within one standard error (the one-standard-error rule of cross-validation, Breiman et
+// al. 1984; Hastie, Tibshirani and Friedman, ESL 7.10), measured on paired per-view differences: a gain the
+// validation views cannot tell from noise does not buy Gaussians. A fixed budget the user must guess is
+// replaced by the smallest one that the views show still pays. The final training then runs at that budget
+// on every training view. Costs `folds` trainings per budget tried.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -30,6 +34,9 @@ struct BudgetSearchOptions {
   // its own seed; their mean validation PSNR scores the budget. One fold of 4-5 views misranked budgets by
   // up to 1 dB against the test views (docs/experiments.md); more folds cost one training each.
   uint32_t folds = 2;
+  // Standard errors of shortfall a smaller budget may have against the last one that gained and still be
+  // chosen; 0 keeps the last budget that gained.
+  double parsimony_se = 1.0;
   void check() const;  // throws std::invalid_argument naming the bad field
 };
 
@@ -37,6 +44,12 @@ struct BudgetTrial {
   uint32_t budget = 0;
   double psnr_db = 0;                // on the validation views (the folds' mean)
   std::vector<double> fold_psnr_db;  // each fold's
+  // Each validation view's, the folds' views in order: the same views in every trial, so trials pair up.
+  std::vector<double> view_psnr_db;
+  // Against the reference (the last budget that gained): the mean per-view PSNR it lacks and that mean's
+  // standard error; NaN where not measured (fewer than two paired views).
+  double shortfall_db = NAN;
+  double shortfall_se_db = NAN;
   double ssim = 0;
   uint32_t gaussians = 0;  // the model's size at the end
   double wall_s = 0;
@@ -45,6 +58,7 @@ struct BudgetTrial {
 
 struct BudgetSearchResult {
   uint32_t chosen = 0;
+  uint32_t reference = 0;           // the last budget that gained min_gain_db; chosen is at most this
   std::vector<BudgetTrial> trials;  // in the order run
 };
 
@@ -54,9 +68,17 @@ struct BudgetSearchResult {
 // budget would train the same model: MCMC's growth in the given iterations, not the budget, limited it). A
 // budget the device cannot hold (train_at throws std::length_error, as buffers over the device's memory or
 // limits do) ends the search at the budget before it, recorded as a failed trial; at the first budget it
-// passes through. std::invalid_argument for bad options; anything else train_at throws passes through.
+// passes through. Then chosen is the smallest budget up to the reference within parsimony_se standard errors
+// of it (choose_within_standard_errors). std::invalid_argument for bad options; anything else train_at throws
+// passes through.
 BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget)>& train_at,
                                  uint32_t initial_gaussians, const BudgetSearchOptions& options = {});
+
+// Fills each trial's shortfall against trials[reference] from their paired view_psnr_db and returns the index
+// of the smallest budget (of those tried, up to the reference's) whose mean shortfall is at most
+// `se_multiple` times its standard error. A trial whose views do not pair with the reference's (missing, a
+// different count, a failed trial) or fewer than two views is never chosen over the reference.
+size_t choose_within_standard_errors(std::vector<BudgetTrial>& trials, size_t reference, double se_multiple);
 
 // The data the search trains on: the scene's held-out views dropped, and every validation_every-th of the
 // remaining views held out instead, counted from the middle of the first stride for fold 0 and shifted by

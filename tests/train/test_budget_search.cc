@@ -16,14 +16,28 @@ namespace {
 struct Scripted {
   std::map<uint32_t, double> psnr;
   std::vector<uint32_t> ran;
+  std::map<uint32_t, std::vector<double>> views;  // per-view PSNRs where given (psnr is then their mean)
   BudgetTrial operator()(uint32_t budget) {
     ran.push_back(budget);
     BudgetTrial t;
-    t.psnr_db = psnr.at(budget);
+    if (views.count(budget) > 0) {
+      t.view_psnr_db = views.at(budget);
+      for (double v : t.view_psnr_db) t.psnr_db += v / static_cast<double>(t.view_psnr_db.size());
+    } else {
+      t.psnr_db = psnr.at(budget);
+    }
     t.gaussians = budget;
     return t;
   }
 };
+
+// Four validation views; each budget's PSNR per view is the 80k one's less `shortfall` plus `wobble` per
+// view.
+std::vector<double> views_below_80k(double shortfall, std::vector<double> wobble) {
+  const std::vector<double> at_80k = {23.0, 22.0, 24.0, 21.0};
+  for (size_t v = 0; v < wobble.size(); ++v) wobble[v] = at_80k[v] - shortfall + wobble[v];
+  return wobble;
+}
 
 TEST(BudgetSearch, KeepsTheLastBudgetThatGainedAndStopsAfterTwoThatDidNot) {
   Scripted s{{{5000, 21.5}, {10000, 21.8}, {20000, 22.0}, {40000, 22.05}, {80000, 22.08}, {160000, 23.0}},
@@ -129,6 +143,65 @@ TEST(BudgetSearch, ABudgetTheDeviceCannotHoldEndsTheSearchAtTheOneBefore) {
   EXPECT_THROW(search_budget(broken, 0), std::runtime_error);
 }
 
+TEST(BudgetSearch, KeepsTheSmallestBudgetWithinOneStandardErrorOfTheLastThatGained) {
+  // 80k gains 0.15 dB over 40k on average, but the views disagree (shortfalls -0.25..0.65): within noise.
+  // 20k lacks 1 dB on every view: a real loss. 160k gains nothing and 320k falls: 80k is the reference.
+  Scripted s;
+  s.views = {{5000, views_below_80k(2.0, {0, 0.1, -0.1, 0})},
+             {10000, views_below_80k(1.5, {0, 0.1, -0.1, 0})},
+             {20000, views_below_80k(1.0, {0.05, -0.05, 0.1, -0.1})},
+             {40000, views_below_80k(0.15, {0.4, -0.5, 0.3, -0.2})},
+             {80000, views_below_80k(0, {0, 0, 0, 0})},
+             {160000, views_below_80k(0, {0.02, -0.02, 0.01, 0})},
+             {320000, views_below_80k(0.5, {0, 0, 0, 0})}};
+  const BudgetSearchResult r = search_budget(std::ref(s), 0);
+  EXPECT_EQ(r.reference, 80000u);
+  EXPECT_EQ(r.chosen, 40000u);
+  ASSERT_EQ(r.trials.size(), 7u);
+  // 40k's per-view shortfalls: -0.25, 0.65, -0.15, 0.35; mean 0.15, sample sd sqrt(0.54 / 3), SE sd / 2.
+  EXPECT_NEAR(r.trials[3].shortfall_db, 0.15, 1e-12);
+  EXPECT_NEAR(r.trials[3].shortfall_se_db, std::sqrt(0.54 / 3.0) / 2.0, 1e-12);
+  EXPECT_NEAR(r.trials[2].shortfall_db, 1.0, 1e-12);
+  EXPECT_DOUBLE_EQ(r.trials[4].shortfall_db, 0.0);    // the reference against itself
+  EXPECT_NEAR(r.trials[6].shortfall_db, 0.5, 1e-12);  // larger budgets are measured too, never chosen
+
+  // With 0 standard errors the last budget that gained is kept.
+  BudgetSearchOptions strict;
+  strict.parsimony_se = 0;
+  Scripted t = s;
+  EXPECT_EQ(search_budget(std::ref(t), 0, strict).chosen, 80000u);
+}
+
+TEST(BudgetSearch, AGainEveryViewAgreesOnIsKept) {
+  // 40k lacks 0.15 dB on every view (+-0.01): small, but not noise.
+  Scripted s;
+  s.views = {
+      {5000, views_below_80k(2.0, {0, 0, 0, 0})},  {10000, views_below_80k(1.0, {0, 0, 0, 0})},
+      {20000, views_below_80k(0.5, {0, 0, 0, 0})}, {40000, views_below_80k(0.15, {0.01, -0.01, 0.01, -0.01})},
+      {80000, views_below_80k(0, {0, 0, 0, 0})},   {160000, views_below_80k(0.1, {0, 0, 0, 0})},
+      {320000, views_below_80k(0.3, {0, 0, 0, 0})}};
+  EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 80000u);
+}
+
+TEST(BudgetSearch, TrialsWithoutPairedViewsAreNeverChosenOverTheReference) {
+  std::vector<BudgetTrial> trials(3);
+  trials[0].view_psnr_db = {20.0, 21.0};              // two views
+  trials[1].view_psnr_db = {20.0, 21.0, 22.0};        // three: no pairs with the reference
+  trials[2].view_psnr_db = {20.0, 21.0, 22.0, 23.0};  // the reference
+  EXPECT_EQ(choose_within_standard_errors(trials, 2, 1.0), 2u);
+  EXPECT_TRUE(std::isnan(trials[0].shortfall_db));
+  trials[1].view_psnr_db = {NAN, 21.0, 22.0, 23.0};  // a non-finite view
+  EXPECT_EQ(choose_within_standard_errors(trials, 2, 1.0), 2u);
+  trials[1].view_psnr_db = {20.0, 21.0, 22.0, 23.0};  // identical scores: within any error
+  EXPECT_EQ(choose_within_standard_errors(trials, 2, 1.0), 1u);
+  trials[1].failure = "out of memory";
+  EXPECT_EQ(choose_within_standard_errors(trials, 2, 1.0), 2u);
+  std::vector<BudgetTrial> one_view(2);
+  one_view[0].view_psnr_db = {19.0};
+  one_view[1].view_psnr_db = {20.0};
+  EXPECT_EQ(choose_within_standard_errors(one_view, 1, 1.0), 1u);  // no standard error from one view
+}
+
 TEST(BudgetSearch, BadOptionsAreRefusedByName) {
   Scripted s{{{5000, 1.0}}, {}};
   BudgetSearchOptions o;
@@ -142,6 +215,9 @@ TEST(BudgetSearch, BadOptionsAreRefusedByName) {
   EXPECT_THROW(search_budget(std::ref(s), 0, o), std::invalid_argument);
   o = {};
   o.min_gain_db = NAN;
+  EXPECT_THROW(search_budget(std::ref(s), 0, o), std::invalid_argument);
+  o = {};
+  o.parsimony_se = -1;
   EXPECT_THROW(search_budget(std::ref(s), 0, o), std::invalid_argument);
   EXPECT_TRUE(s.ran.empty());
 }
