@@ -3,6 +3,7 @@
 // (Workswell WIRIS) read fine: we take the layout from BitsPerSample / SamplesPerPixel / SampleFormat.
 #include <tiffio.h>
 
+#include <algorithm>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
@@ -74,20 +75,27 @@ ImageInfo layout(const std::filesystem::path& path, TIFF* tif) {
 
 // Refuses a file whose strips cannot hold the image it declares, before the image is allocated (a 214-byte
 // file declaring 9477x65277 pixels once asked for 3.7 GB): uncompressed strips hold their bytes, compressed
-// ones expand at most 4096-fold (LZW's longest code string; deflate's limit is about 1032).
+// ones expand at most 4096-fold (LZW's longest code string; deflate's limit is about 1032). The strips hold
+// no more than the file does, whatever StripByteCounts claims (a 200-byte file claiming a 1.1 MB strip once
+// passed the check and asked for 1.26 GB).
 void check_stored_bytes(const std::filesystem::path& path, TIFF* tif, uint64_t decoded_bytes) {
   const uint64_t* counts = nullptr;
   if (!TIFFGetField(tif, TIFFTAG_STRIPBYTECOUNTS, &counts) || counts == nullptr)
     fail(path, 0, "no StripByteCounts tag");
   uint64_t stored = 0;
   for (uint32_t s = 0; s < TIFFNumberOfStrips(tif); ++s) stored += counts[s];
+  std::error_code error;
+  const uintmax_t file_bytes = std::filesystem::file_size(path, error);
+  const bool beyond_the_file = !error && stored > file_bytes;
+  if (beyond_the_file) stored = file_bytes;
   uint16_t compression = COMPRESSION_NONE;
   TIFFGetFieldDefaulted(tif, TIFFTAG_COMPRESSION, &compression);
   const uint64_t expansion = compression == COMPRESSION_NONE ? 1 : 4096;
   if (decoded_bytes / expansion > stored)
     fail(path, 0,
-         "declares " + std::to_string(decoded_bytes) + " bytes of pixels but its strips hold " +
-             std::to_string(stored) + " bytes" + (expansion > 1 ? " (compressed at most 4096-fold)" : ""));
+         "TIFF declares " + std::to_string(decoded_bytes) + " bytes of pixels but its strips hold " +
+             std::to_string(stored) + " bytes" + (beyond_the_file ? ", the whole file (truncated?)" : "") +
+             (expansion > 1 ? " (compressed at most 4096-fold)" : ""));
 }
 
 }  // namespace

@@ -33,5 +33,16 @@ TEST(FuzzRegression, TiffDeclaringGigabytesInATinyFile) {
   }
 }
 
+TEST(FuzzRegression, TiffWhoseStripByteCountsClaimMoreThanTheFileHolds) {
+  // libFuzzer out-of-memory (malloc of 1.26 GB): 200 bytes, deflated, whose StripByteCounts claims a 1.1 MB
+  // strip, which at 4096-fold expansion passed the size check.
+  try {
+    read_tiff(kRegressions / "tiff-strip-counts-beyond-the-file.tiff");
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("strips hold 200 bytes"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace litgs::io
