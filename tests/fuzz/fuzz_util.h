@@ -18,10 +18,15 @@
 
 namespace litgs::fuzz {
 
-// This process's scratch directory, created on first use and removed when the process exits normally.
+// This process's scratch directory, created on first use and removed when the process exits normally:
+// $LITGS_FUZZ_SCRATCH where set (ci/fuzz sets one per target, so that the paths the readers see, and with
+// them the fuzzer's run, do not change with the process id), else one named by the process id.
 inline const std::filesystem::path& temp_dir() {
   static const std::filesystem::path dir = [] {
-    auto d = std::filesystem::temp_directory_path() / ("litgs-fuzz-" + std::to_string(::getpid()));
+    const char* fixed = std::getenv("LITGS_FUZZ_SCRATCH");
+    auto d = fixed != nullptr && *fixed != '\0'
+                 ? std::filesystem::path(fixed)
+                 : std::filesystem::temp_directory_path() / ("litgs-fuzz-" + std::to_string(::getpid()));
     std::filesystem::remove_all(d);
     std::filesystem::create_directories(d);
     std::atexit([] {
