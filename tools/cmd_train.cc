@@ -41,6 +41,7 @@ struct TrainCliOptions {
   DataFlags data_flags;  // --intensity, --poses
   std::string trace;     // JSON lines appended at every progress report (the report's curves)
   std::string max_gaussians = "2000000";  // a count, auto or search (tools/train_budget.h)
+  host::BudgetSearchOptions budget_search;
   host::TrainingDataOptions data;
   host::TrainOptions train;
 };
@@ -73,6 +74,9 @@ std::string format_eta(double s) {
 }
 
 void run_train(TrainCliOptions o) {
+  if (o.budget_search.parsimony_se > 0 && o.max_gaussians != "search")
+    throw std::invalid_argument("--budget-parsimony applies to --max-gaussians search only, not '" +
+                                o.max_gaussians + "'");
   apply_data_flags(o.data_flags, o.data);
   o.train.check();
   const host::TrainingData data = host::load_training_data(o.scene, o.data);
@@ -191,7 +195,7 @@ void run_train(TrainCliOptions o) {
           std::string what;
           return initialize(trial_budget, what);
         },
-        planes.get(), o.train, o.out);
+        planes.get(), o.train, o.budget_search, o.out);
     o.train.check();
     if (init_from_map) model = initialize(o.train.max_gaussians, init_what);
   }
@@ -319,6 +323,12 @@ void add_train_command(CLI::App& app) {
          "or search (two trainings per doubling budget, each on the training views less its own "
          "validation eighth, while their mean validation PSNR still gains 0.1 dB, looking one doubling "
          "past a plateau; then the final training at the budget found)")
+      ->capture_default_str();
+  cmd->add_option("--budget-parsimony", o->budget_search.parsimony_se,
+                  "With --max-gaussians search: keep the smallest budget whose validation PSNR, paired per "
+                  "view, lacks at most this many standard errors against the last budget that gained (1: the "
+                  "one-standard-error rule; 0: that budget)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--strategy", o->train.strategy,
                   "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")

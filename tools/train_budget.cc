@@ -90,8 +90,8 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
 uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData& data,
                               const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for,
                               const host::PlanarMap* planes, const host::TrainOptions& options,
-                              const std::filesystem::path& out) {
-  const host::BudgetSearchOptions search;
+                              const host::BudgetSearchOptions& search, const std::filesystem::path& out) {
+  search.check();
   std::vector<host::TrainingData> splits;
   for (uint32_t fold = 0; fold < search.folds; ++fold)
     splits.push_back(host::validation_split(data, search.validation_every, fold, search.folds));
@@ -181,10 +181,12 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
               .dump(2)
        << "\n";
   });
-  std::cout << "train: budget " << result.reference << " Gaussians was the last that added at least "
-            << search.min_gain_db << " dB on the validation views; chosen: " << result.chosen
-            << ", the smallest within " << search.parsimony_se
-            << " standard error(s) of it per view (budget.json)\n";
+  std::cout << "train: budget " << result.reference << " Gaussians: the last that added at least "
+            << search.min_gain_db << " dB on the validation views";
+  if (search.parsimony_se > 0)
+    std::cout << "; kept " << result.chosen << ", the smallest within " << search.parsimony_se
+              << " standard error(s) of it per view";
+  std::cout << " (budget.json)\n";
   return result.chosen;
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engine/context.h"
+#include "host/train/budget_search.h"
 #include "host/train/lidar_planes.h"
 #include "host/train/train_options.h"
 #include "host/train/training_data.h"
@@ -34,10 +35,10 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
 
 // `--max-gaussians search`: trainings with `options` at growing budgets on the validation split of the
 // training views, each from initial_for(budget) and in OUT/budget-search/<budget>/; writes OUT/budget.json
-// and returns the budget found. Prints one line per budget tried.
+// and returns the budget found by `search`'s rule. Prints one line per budget tried.
 uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData& data,
                               const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for,
                               const host::PlanarMap* planes, const host::TrainOptions& options,
-                              const std::filesystem::path& out);
+                              const host::BudgetSearchOptions& search, const std::filesystem::path& out);
 
 }  // namespace litgs::tools

@@ -52,10 +52,9 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
     budget = static_cast<uint32_t>(std::min<double>(std::ceil(budget * o.factor), o.max_budget));
   }
   // reference stays 0 where the first trial scored NaN.
-  result.reference = result.chosen = result.trials[reference].budget;
-  if (o.parsimony_se > 0)
-    result.chosen =
-        result.trials[choose_within_standard_errors(result.trials, reference, o.parsimony_se)].budget;
+  result.reference = result.trials[reference].budget;
+  result.chosen =
+      result.trials[choose_within_standard_errors(result.trials, reference, o.parsimony_se)].budget;
   return result;
 }
 
@@ -73,7 +72,7 @@ size_t choose_within_standard_errors(std::vector<BudgetTrial>& trials, size_t re
     t.shortfall_se_db = std::sqrt(squares / (n - 1) / n);
     // Written so that a NaN view never qualifies a budget.
     const bool within = mean <= se_multiple * t.shortfall_se_db;
-    if (i < chosen && within) chosen = i;
+    if (i < chosen && within && se_multiple > 0) chosen = i;
   }
   return chosen;
 }

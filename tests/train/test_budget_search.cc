@@ -143,7 +143,7 @@ TEST(BudgetSearch, ABudgetTheDeviceCannotHoldEndsTheSearchAtTheOneBefore) {
   EXPECT_THROW(search_budget(broken, 0), std::runtime_error);
 }
 
-TEST(BudgetSearch, KeepsTheSmallestBudgetWithinOneStandardErrorOfTheLastThatGained) {
+TEST(BudgetSearch, WithParsimonyKeepsTheSmallestBudgetWithinOneStandardErrorOfTheLastThatGained) {
   // 80k gains 0.15 dB over 40k on average, but the views disagree (shortfalls -0.25..0.65): within noise.
   // 20k lacks 1 dB on every view: a real loss. 160k gains nothing and 320k falls: 80k is the reference.
   Scripted s;
@@ -154,7 +154,10 @@ TEST(BudgetSearch, KeepsTheSmallestBudgetWithinOneStandardErrorOfTheLastThatGain
              {80000, views_below_80k(0, {0, 0, 0, 0})},
              {160000, views_below_80k(0, {0.02, -0.02, 0.01, 0})},
              {320000, views_below_80k(0.5, {0, 0, 0, 0})}};
-  const BudgetSearchResult r = search_budget(std::ref(s), 0);
+  BudgetSearchOptions one_se;
+  one_se.parsimony_se = 1;
+  Scripted by_default = s;
+  const BudgetSearchResult r = search_budget(std::ref(s), 0, one_se);
   EXPECT_EQ(r.reference, 80000u);
   EXPECT_EQ(r.chosen, 40000u);
   ASSERT_EQ(r.trials.size(), 7u);
@@ -165,11 +168,12 @@ TEST(BudgetSearch, KeepsTheSmallestBudgetWithinOneStandardErrorOfTheLastThatGain
   EXPECT_DOUBLE_EQ(r.trials[4].shortfall_db, 0.0);    // the reference against itself
   EXPECT_NEAR(r.trials[6].shortfall_db, 0.5, 1e-12);  // larger budgets are measured too, never chosen
 
-  // With 0 standard errors the last budget that gained is kept.
-  BudgetSearchOptions strict;
-  strict.parsimony_se = 0;
-  Scripted t = s;
-  EXPECT_EQ(search_budget(std::ref(t), 0, strict).chosen, 80000u);
+  // By default (0 standard errors) the last budget that gained is kept, and the shortfalls are still
+  // recorded.
+  const BudgetSearchResult d = search_budget(std::ref(by_default), 0);
+  EXPECT_EQ(d.chosen, 80000u);
+  EXPECT_EQ(d.reference, 80000u);
+  EXPECT_NEAR(d.trials[3].shortfall_db, 0.15, 1e-12);
 }
 
 TEST(BudgetSearch, AGainEveryViewAgreesOnIsKept) {
@@ -180,7 +184,9 @@ TEST(BudgetSearch, AGainEveryViewAgreesOnIsKept) {
       {20000, views_below_80k(0.5, {0, 0, 0, 0})}, {40000, views_below_80k(0.15, {0.01, -0.01, 0.01, -0.01})},
       {80000, views_below_80k(0, {0, 0, 0, 0})},   {160000, views_below_80k(0.1, {0, 0, 0, 0})},
       {320000, views_below_80k(0.3, {0, 0, 0, 0})}};
-  EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 80000u);
+  BudgetSearchOptions one_se;
+  one_se.parsimony_se = 1;
+  EXPECT_EQ(search_budget(std::ref(s), 0, one_se).chosen, 80000u);
 }
 
 TEST(BudgetSearch, TrialsWithoutPairedViewsAreNeverChosenOverTheReference) {
