@@ -3,7 +3,6 @@
 // (Workswell WIRIS) read fine: we take the layout from BitsPerSample / SamplesPerPixel / SampleFormat.
 #include <tiffio.h>
 
-#include <algorithm>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
