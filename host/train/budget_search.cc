@@ -60,11 +60,12 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
 
 size_t choose_within_standard_errors(std::vector<BudgetTrial>& trials, size_t reference, double se_multiple) {
   const std::vector<double>& ref = trials.at(reference).view_psnr_db;
+  if (ref.size() < 2) return reference;  // no standard error from fewer views
+  const double n = static_cast<double>(ref.size());
   size_t chosen = reference;
   for (size_t i = 0; i < trials.size(); ++i) {
     BudgetTrial& t = trials[i];
-    if (!t.failure.empty() || t.view_psnr_db.size() != ref.size() || ref.size() < 2) continue;
-    const double n = static_cast<double>(ref.size());
+    if (!t.failure.empty() || t.view_psnr_db.size() != ref.size()) continue;
     double mean = 0, squares = 0;
     for (size_t v = 0; v < ref.size(); ++v) mean += (ref[v] - t.view_psnr_db[v]) / n;
     for (size_t v = 0; v < ref.size(); ++v) squares += std::pow(ref[v] - t.view_psnr_db[v] - mean, 2);
