@@ -8,7 +8,8 @@
 // (paired), is recorded with its standard error; with parsimony_se > 0 the smallest budget within that many
 // standard errors is kept instead (at 1, the one-standard-error rule of cross-validation: Breiman et al.
 // 1984; Hastie, Tibshirani and Friedman, ESL 7.10). The final training then runs at the budget kept on
-// every training view. Costs `folds` trainings per budget tried.
+// every training view. Costs `folds` trainings per budget tried; the trials are deterministic, so a search
+// repeated with the same options and seed on the same device keeps the same budget.
 #pragma once
 
 #include <cmath>
@@ -39,6 +40,11 @@ struct BudgetSearchOptions {
   // facade's search chose 160k, 0.31 dB below its 320k on the test views over four seeds, and DUNR's and the
   // street's choices did not change (docs/experiments.md).
   double parsimony_se = 0.0;
+  // Trials train with bit-identical gradients, so that one command keeps one budget: with float atomics the
+  // same trial moved by 0.2-0.35 dB between runs and DUNR's search kept 40k in one run and 80k in another.
+  // Costs about 10% per trial (DUNR at 40k: 36.8 -> 39.6-41.2 ms per iteration on lavapipe, 1.30 -> 1.43 on
+  // an H200; docs/experiments.md). The final training follows `train --deterministic` as any other.
+  bool deterministic_trials = true;
   void check() const;  // throws std::invalid_argument naming the bad field
 };
 
