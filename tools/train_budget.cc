@@ -100,11 +100,12 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
     validation_views.push_back(std::count_if(split.views.begin(), split.views.end(),
                                              [](const host::TrainingView& v) { return v.heldout; }));
   const size_t views = splits.front().views.size();
+  const bool deterministic = options.deterministic || search.deterministic_trials;
   std::cout << "train: budget search on " << views << " views, " << search.folds
             << " trainings per budget, each validating on every " << search.validation_every
             << "th view from its own offset (" << validation_views.front()
             << " views; the scene's held-out views are not used), " << options.iterations
-            << " iterations each" << (search.deterministic_trials ? ", deterministic" : "") << "\n";
+            << " iterations each" << (deterministic ? ", deterministic" : "") << "\n";
   // The seeding at the last budget asked for, so that the folds (and the first trial after the size check
   // below) share one instead of each building it (a LiDAR-map seeding fits covariances to its points).
   uint32_t cached_budget = 0;
@@ -122,7 +123,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
       host::TrainOptions t = options;
       t.max_gaussians = budget;
       t.seed = options.seed + fold;
-      t.deterministic = options.deterministic || search.deterministic_trials;
+      t.deterministic = deterministic;
       t.resume = false;
       t.checkpoint_every = 0;
       t.eval_every = 0;  // the final evaluation only
@@ -176,7 +177,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
                          {"factor", search.factor},
                          {"patience", search.patience},
                          {"folds", search.folds},
-                         {"deterministic_trials", search.deterministic_trials},
+                         {"deterministic_trials", deterministic},
                          {"views", views},
                          {"validation_views_per_fold", validation_views},
                          {"trials", trials}}

@@ -42,8 +42,8 @@ struct BudgetSearchOptions {
   double parsimony_se = 0.0;
   // Trials train with bit-identical gradients, so that one command keeps one budget: with float atomics the
   // same trial moved by 0.2-0.35 dB between runs and DUNR's search kept 40k in one run and 80k in another.
-  // Costs about 10% per trial (DUNR at 40k: 36.8 -> 39.6-41.2 ms per iteration on lavapipe, 1.30 -> 1.43 on
-  // an H200; docs/experiments.md). The final training follows `train --deterministic` as any other.
+  // Costs about 10% per trial (DUNR at 40k on lavapipe: 36.8 -> 39.6-41.2 ms per iteration;
+  // docs/experiments.md). The final training follows `train --deterministic` as any other.
   bool deterministic_trials = true;
   void check() const;  // throws std::invalid_argument naming the bad field
 };
