@@ -77,6 +77,16 @@ void run_train(TrainCliOptions o) {
   if (o.budget_search.parsimony_se > 0 && o.max_gaussians != "search")
     throw std::invalid_argument("--budget-parsimony applies to --max-gaussians search only, not '" +
                                 o.max_gaussians + "'");
+  const bool asked_to_resume = o.train.resume;
+  const bool reuse_finished_trials = restart_cut_short_search(o.max_gaussians, o.train.resume, o.out);
+  if (reuse_finished_trials)
+    std::cout
+        << "train: --resume: the budget search had not finished; it continues, reusing the trainings it "
+           "finished\n";
+  else if (asked_to_resume && !o.train.resume)
+    std::cout << "train: --resume: no checkpoint of the final training yet; it starts again at the searched "
+                 "budget, "
+              << o.max_gaussians << " Gaussians (budget.json)\n";
   apply_data_flags(o.data_flags, o.data);
   o.train.check();
   const host::TrainingData data = host::load_training_data(o.scene, o.data);
@@ -195,7 +205,7 @@ void run_train(TrainCliOptions o) {
           std::string what;
           return initialize(trial_budget, what);
         },
-        planes.get(), o.train, o.budget_search, o.out);
+        planes.get(), o.train, o.budget_search, o.out, reuse_finished_trials);
     o.train.check();
     if (init_from_map) model = initialize(o.train.max_gaussians, init_what);
   }

@@ -6,12 +6,16 @@
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 
 #include "host/train/budget_search.h"
+#include "host/train/checkpoint.h"
+#include "host/train/run_options.h"
 #include "host/train/scene_budget.h"
 #include "host/train/trainer.h"
 #include "io/atomic_file.h"
+#include "tools/budget_trial_record.h"
 
 namespace litgs::tools {
 namespace {
@@ -39,6 +43,15 @@ uint32_t budget_of_earlier_run(const std::filesystem::path& file) {
 }
 
 }  // namespace
+
+bool restart_cut_short_search(std::string& flag, bool& resume, const std::filesystem::path& out) {
+  if (!resume || flag != "search" || !host::newest_checkpoint(out).empty()) return false;
+  resume = false;
+  const std::filesystem::path record = out / "budget.json";
+  if (!std::filesystem::exists(record)) return true;
+  flag = std::to_string(budget_of_earlier_run(record));
+  return false;
+}
 
 uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
                                const std::filesystem::path& out) {
@@ -90,7 +103,8 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
 uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData& data,
                               const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for,
                               const host::PlanarMap* planes, const host::TrainOptions& options,
-                              const host::BudgetSearchOptions& search, const std::filesystem::path& out) {
+                              const host::BudgetSearchOptions& search, const std::filesystem::path& out,
+                              bool reuse_finished_trials) {
   search.check();
   std::vector<host::TrainingData> splits;
   for (uint32_t fold = 0; fold < search.folds; ++fold)
@@ -119,6 +133,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
   };
   const auto train_at = [&](uint32_t budget) {
     host::BudgetTrial trial;
+    uint32_t reused = 0;  // folds whose finished training an earlier, interrupted search left
     for (uint32_t fold = 0; fold < search.folds; ++fold) {
       host::TrainOptions t = options;
       t.max_gaussians = budget;
@@ -129,19 +144,32 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
       t.eval_every = 0;  // the final evaluation only
       const std::filesystem::path dir =
           out / "budget-search" / std::to_string(budget) / ("fold-" + std::to_string(fold));
-      const host::TrainReport r = host::train(context, splits[fold], initial_at(budget), planes, t, dir, {},
-                                              nullptr, [](const std::string&) {});
-      trial.fold_psnr_db.push_back(r.final_eval.psnr_db);
-      for (const auto& view : r.final_eval.view_psnr_db) trial.view_psnr_db.push_back(view.second);
-      trial.psnr_db += r.final_eval.psnr_db / search.folds;
-      trial.ssim += r.final_eval.ssim / search.folds;
-      trial.gaussians = std::max(trial.gaussians, static_cast<uint32_t>(r.gaussians));
-      trial.wall_s += r.wall_s;
+      const nlohmann::json key = {{"options", host::run_options_json(t, splits[fold])},
+                                  {"start", host::start_fingerprint(initial_at(budget), planes)}};
+      std::optional<FinishedTrial> finished;
+      if (reuse_finished_trials) finished = read_finished_trial(dir, key);
+      if (finished) {
+        ++reused;
+      } else {
+        const host::TrainReport r = host::train(context, splits[fold], initial_at(budget), planes, t, dir, {},
+                                                nullptr, [](const std::string&) {});
+        finished = FinishedTrial{
+            r.final_eval.psnr_db, r.final_eval.ssim, {}, static_cast<uint32_t>(r.gaussians), r.wall_s};
+        for (const auto& view : r.final_eval.view_psnr_db) finished->view_psnr_db.push_back(view.second);
+        write_finished_trial(dir, key, *finished);
+      }
+      trial.fold_psnr_db.push_back(finished->psnr_db);
+      trial.view_psnr_db.insert(trial.view_psnr_db.end(), finished->view_psnr_db.begin(),
+                                finished->view_psnr_db.end());
+      trial.psnr_db += finished->psnr_db / search.folds;
+      trial.ssim += finished->ssim / search.folds;
+      trial.gaussians = std::max(trial.gaussians, finished->gaussians);
+      trial.wall_s += finished->wall_s;
     }
     std::cout << "train: budget " << budget << ": validation PSNR " << trial.psnr_db << " dB (folds:";
     for (double p : trial.fold_psnr_db) std::cout << " " << p;
-    std::cout << "), SSIM " << trial.ssim << " (" << trial.gaussians << " Gaussians, " << trial.wall_s
-              << " s)\n";
+    std::cout << "), SSIM " << trial.ssim << " (" << trial.gaussians << " Gaussians, " << trial.wall_s << " s"
+              << (reused > 0 ? ", " + std::to_string(reused) + " of the trainings reused" : "") << ")\n";
     return trial;
   };
   // A budget below the initialization's size (one not capped by the budget) cannot hold it: start there.

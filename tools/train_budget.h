@@ -34,11 +34,21 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
                                const std::filesystem::path& out);
 
 // `--max-gaussians search`: trainings with `options` at growing budgets on the validation split of the
-// training views, each from initial_for(budget) and in OUT/budget-search/<budget>/; writes OUT/budget.json
-// and returns the budget found by `search`'s rule. Prints one line per budget tried.
+// training views, each from initial_for(budget) and in OUT/budget-search/<budget>/fold-<f>/ (with its
+// trial.json once finished: tools/budget_trial_record.h); writes OUT/budget.json and returns the budget found
+// by `search`'s rule. With reuse_finished_trials, a training whose trial.json matches is not run again.
+// Prints one line per budget tried.
 uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData& data,
                               const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for,
                               const host::PlanarMap* planes, const host::TrainOptions& options,
-                              const host::BudgetSearchOptions& search, const std::filesystem::path& out);
+                              const host::BudgetSearchOptions& search, const std::filesystem::path& out,
+                              bool reuse_finished_trials);
+
+// `train --resume --max-gaussians search` where OUT holds no checkpoint of the final training: the run was
+// cut short in the search, or after it before the final training's first checkpoint, and there is nothing
+// to resume from. Then the run starts again (`resume` becomes false): at the budget OUT/budget.json recorded
+// if the search had finished (`flag` becomes that count), else searching again, reusing the trainings the
+// search had finished (returns true). In any other case changes nothing and returns false.
+bool restart_cut_short_search(std::string& flag, bool& resume, const std::filesystem::path& out);
 
 }  // namespace litgs::tools

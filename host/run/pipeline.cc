@@ -1,5 +1,6 @@
 #include "host/run/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -168,10 +169,15 @@ class Runner {
     }
     // Continue an interrupted resumable stage only if it started with these inputs and options.
     const json started = read_json(dir / "started.json");
-    // Only from a checkpoint: one killed (or out of disk space) before its first has nothing to continue.
-    const fs::path checkpoints = ctx_.out_dir / plan.resume_from;
+    // Only from a checkpoint (or a finished trial of the budget search): one killed, or out of disk space,
+    // before its first has nothing to continue.
+    const bool something_to_continue =
+        std::any_of(plan.resume_from.begin(), plan.resume_from.end(), [&](const fs::path& rel) {
+          const fs::path folder = ctx_.out_dir / rel;
+          return fs::is_directory(folder) && !fs::is_empty(folder);
+        });
     const bool resume = plan.resumable && !forced && started.is_object() && started.value("key", "") == key &&
-                        fs::is_directory(checkpoints) && !fs::is_empty(checkpoints);
+                        something_to_continue;
     if (!resume) fs::remove_all(dir);
     fs::remove(manifest_path);
     fs::create_directories(dir);

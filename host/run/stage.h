@@ -52,10 +52,12 @@ struct StagePlan {
       outputs;             // files or folders, relative to DIR (stage_rel), complete when it ends
   bool resumable = false;  // the command continues from its own checkpoints (train): not wiped on rerun
   std::vector<std::string> resume_args;  // added to the command when it continues
-  std::filesystem::path resume_from;     // relative to DIR: a folder that must hold a checkpoint to continue
-  std::string skip_reason;               // non-empty: nothing to do, reported as "skipped: REASON"
-  std::vector<std::string> notes;        // printed with the stage's progress line and kept in run.json
-  std::optional<SceneCopy> scene_copy;   // made in DIR/<stage>/scene before the command runs
+  // Relative to DIR: folders of which one must hold what the command continues from (a checkpoint, a
+  // finished trial of the budget search).
+  std::vector<std::filesystem::path> resume_from;
+  std::string skip_reason;              // non-empty: nothing to do, reported as "skipped: REASON"
+  std::vector<std::string> notes;       // printed with the stage's progress line and kept in run.json
+  std::optional<SceneCopy> scene_copy;  // made in DIR/<stage>/scene before the command runs
 };
 
 struct Stage {

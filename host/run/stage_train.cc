@@ -44,7 +44,7 @@ StagePlan plan(const StageContext& c) {
   p.outputs = {rel / "point_cloud.ply", rel / "metrics.json", rel / "trace.jsonl"};
   p.resumable = true;
   p.resume_args = {"--resume"};
-  p.resume_from = rel / "checkpoints";
+  p.resume_from = {rel / "checkpoints", rel / "budget-search"};  // `train --resume` takes either up
   return p;
 }
 

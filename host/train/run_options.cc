@@ -1,5 +1,6 @@
 #include "host/train/run_options.h"
 
+#include <Eigen/Core>
 #include <charconv>
 #include <cstdio>
 #include <cstring>
@@ -7,6 +8,8 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+
+#include "host/train/lidar_planes.h"
 
 namespace litgs::host {
 namespace {
@@ -255,6 +258,25 @@ std::vector<std::string> check_resume_options(const std::filesystem::path& check
     throw std::invalid_argument(m.str());
   }
   return notes;
+}
+
+std::string start_fingerprint(const kernels::GaussianModel& initial, const PlanarMap* planes) {
+  Fnv1a f;
+  f.value(initial.channels);
+  f.value(initial.sh_degree);
+  for (const std::vector<float>* a :
+       {&initial.means, &initial.log_scales, &initial.quats, &initial.opacity_logits, &initial.sh}) {
+    f.value(a->size());
+    f.bytes(a->data(), a->size() * sizeof(float));
+  }
+  if (planes) {
+    f.value(planes->points.size());
+    f.bytes(planes->points.data(), planes->points.size() * sizeof(Eigen::Vector3f));
+    f.bytes(planes->normals.data(), planes->normals.size() * sizeof(Eigen::Vector3f));
+    f.bytes(planes->centres.data(), planes->centres.size() * sizeof(Eigen::Vector3f));
+    f.bytes(planes->planar.data(), planes->planar.size());
+  }
+  return f.hex();
 }
 
 }  // namespace litgs::host

@@ -23,10 +23,17 @@
 
 namespace litgs::host {
 
+struct PlanarMap;
+
 // {"train": {...TrainOptions but resume}, "data_options": {...TrainingDataOptions}, "data": {identity}}.
 // Float options are stored as their shortest decimal form, so that messages read "0.0002", not
 // "0.000199999994947575".
 nlohmann::json run_options_json(const TrainOptions& options, const TrainingData& data);
+
+// A fingerprint (FNV-1a, 16 hex digits) of what a training starts from besides its options and data: the
+// initial model and the LiDAR planes of its geometric term (none: nullptr). The budget search keeps it with
+// each finished trial, so that a resumed search reuses a trial only if it would train the same.
+std::string start_fingerprint(const kernels::GaussianModel& initial, const PlanarMap* planes);
 
 // Compares the options stored in `checkpoint` (written after `checkpoint_iteration` iterations) with this
 // run's. Returns one note per allowed difference (and per option the checkpoint did not record, assumed

@@ -302,6 +302,50 @@ TEST(RunBadInput, InterruptedStageIsNotTakenAsDone) {
   EXPECT_TRUE(read_json_file(eval_json).is_object());
 }
 
+// A run killed in the budget search (`train.max_gaussians: search`) has no checkpoint yet, but finished
+// trials: the rerun continues the stage and reuses them instead of starting the search again.
+TEST(RunBadInput, InterruptedBudgetSearchContinues) {
+  const fs::path dir = kRoot / "interrupted-search";
+  fs::remove_all(dir);
+  std::string yaml = small_run_yaml("", 200);
+  yaml.replace(yaml.find("max_gaussians: 3000"), 19, "max_gaussians: search");
+  const fs::path config = write_text(kRoot / "interrupted-search.yaml", yaml);
+  const std::string command = std::string(LITGS_ENGINE_BINARY) + " " + run_args("synth:facade", dir, config) +
+                              " > " + (kRoot / "interrupted-search.log").string() + " 2>&1 & echo $! > " +
+                              (kRoot / "interrupted-search.pid").string();
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  pid_t pid = 0;
+  std::ifstream(kRoot / "interrupted-search.pid") >> pid;
+  ASSERT_GT(pid, 0);
+  const auto a_trial_finished = [&] {
+    std::error_code ec;  // the folders appear while this looks
+    for (fs::recursive_directory_iterator it(dir / "train" / "budget-search", ec), end; !ec && it != end;
+         it.increment(ec))
+      if (it->path().filename() == "trial.json") return true;
+    return false;
+  };
+  const auto start = std::chrono::steady_clock::now();
+  while (!a_trial_finished()) {
+    ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(300)) << "no finished trial";
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(::kill(pid, SIGKILL), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  ASSERT_FALSE(fs::exists(dir / "train" / "budget.json")) << "killed too late: the search had finished";
+
+  const CommandResult r = run_engine(run_args("synth:facade", dir, config));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("train: Gaussian map on the Vulkan device (resuming from its checkpoint)"),
+            std::string::npos)
+      << r.output;
+  std::ifstream log(dir / "train" / "log.txt");
+  const std::string train_log{std::istreambuf_iterator<char>(log), {}};
+  EXPECT_NE(train_log.find("the budget search had not finished; it continues"), std::string::npos)
+      << train_log;
+  EXPECT_NE(train_log.find("of the trainings reused"), std::string::npos) << train_log;
+  EXPECT_TRUE(read_json_file(dir / "train" / "budget.json").is_object());
+}
+
 // `litgs-engine ARGS` with every file it (and its stages) write limited to `max_file_bytes`: writes past
 // that fail with EFBIG (SIGXFSZ ignored, as the limit and the disposition pass to the stages' children), as
 // on a full disk, without needing one.
