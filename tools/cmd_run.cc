@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <climits>
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 
@@ -36,6 +37,9 @@ void run_run(const RunCliOptions& o) {
 }  // namespace
 
 std::filesystem::path this_executable() {
+  // Started through a wrapper (ci/gpu-bundle-run starts the engine with a bundled loader, so /proc/self/exe
+  // names the loader), the wrapper says which program to run.
+  if (const char* engine = std::getenv("LITGS_ENGINE"); engine && *engine) return engine;
   char buf[PATH_MAX];
   const ssize_t n = ::readlink("/proc/self/exe", buf, sizeof buf - 1);
   if (n <= 0) throw std::runtime_error("cannot find this program's path (/proc/self/exe)");

@@ -143,8 +143,8 @@ AblationStudy strategy_study(const RunConfig& base) {
                 column("SSIM", "eval", "ssim", 4), column("training (s)", "train", "wall_s", 1),
                 column("ms/iteration", "train", "ms_per_iteration", 1)};
   s.note =
-      "budget: MCMC's fixed number of Gaussians; ADC's cap; auto: derived from the scene (`train "
-      "--max-gaussians auto`).";
+      "budget: MCMC's fixed number of Gaussians; ADC's cap; auto: derived from the scene's surface (`train "
+      "--max-gaussians auto`); search: searched on validation views (`train --max-gaussians search`).";
   return s;
 }
 

@@ -257,17 +257,23 @@ TEST(RunBadInput, ChangedInputRerunsTheStagesWithoutMixing) {
       << "resumed the old input's run";
 }
 
+// Starts `litgs-engine ARGS` without waiting (its output in kRoot/NAME.log); its pid, 0 if it did not start.
+pid_t start_in_background(const std::string& args, const std::string& name) {
+  const std::string command = std::string(LITGS_ENGINE_BINARY) + " " + args + " > " +
+                              (kRoot / (name + ".log")).string() + " 2>&1 & echo $! > " +
+                              (kRoot / (name + ".pid")).string();
+  if (std::system(command.c_str()) != 0) return 0;
+  pid_t pid = 0;
+  std::ifstream(kRoot / (name + ".pid")) >> pid;
+  return pid;
+}
+
 TEST(RunBadInput, InterruptedStageIsNotTakenAsDone) {
   const fs::path dir = kRoot / "interrupted";
   fs::remove_all(dir);
   // Long enough to be killed after its first checkpoint (iteration 20).
   const fs::path config = write_text(kRoot / "interrupted.yaml", small_run_yaml("", 400));
-  const std::string command = std::string(LITGS_ENGINE_BINARY) + " " + run_args("synth:facade", dir, config) +
-                              " > " + (kRoot / "interrupted.log").string() + " 2>&1 & echo $! > " +
-                              (kRoot / "interrupted.pid").string();
-  ASSERT_EQ(std::system(command.c_str()), 0);
-  pid_t pid = 0;
-  std::ifstream(kRoot / "interrupted.pid") >> pid;
+  const pid_t pid = start_in_background(run_args("synth:facade", dir, config), "interrupted");
   ASSERT_GT(pid, 0);
   const auto start = std::chrono::steady_clock::now();
   while (!fs::exists(dir / "train" / "checkpoints" / "iter_20.ckpt")) {
@@ -310,12 +316,7 @@ TEST(RunBadInput, InterruptedBudgetSearchContinues) {
   std::string yaml = small_run_yaml("", 200);
   yaml.replace(yaml.find("max_gaussians: 3000"), 19, "max_gaussians: search");
   const fs::path config = write_text(kRoot / "interrupted-search.yaml", yaml);
-  const std::string command = std::string(LITGS_ENGINE_BINARY) + " " + run_args("synth:facade", dir, config) +
-                              " > " + (kRoot / "interrupted-search.log").string() + " 2>&1 & echo $! > " +
-                              (kRoot / "interrupted-search.pid").string();
-  ASSERT_EQ(std::system(command.c_str()), 0);
-  pid_t pid = 0;
-  std::ifstream(kRoot / "interrupted-search.pid") >> pid;
+  const pid_t pid = start_in_background(run_args("synth:facade", dir, config), "interrupted-search");
   ASSERT_GT(pid, 0);
   const auto a_trial_finished = [&] {
     std::error_code ec;  // the folders appear while this looks
