@@ -74,6 +74,9 @@ std::string format_eta(double s) {
 }
 
 void run_train(TrainCliOptions o) {
+  if (o.budget_search.folds != host::BudgetSearchOptions{}.folds && o.max_gaussians != "search")
+    throw std::invalid_argument("--budget-folds applies to --max-gaussians search only, not '" +
+                                o.max_gaussians + "'");
   if (o.budget_search.parsimony_se > 0 && o.max_gaussians != "search")
     throw std::invalid_argument("--budget-parsimony applies to --max-gaussians search only, not '" +
                                 o.max_gaussians + "'");
@@ -339,6 +342,11 @@ void add_train_command(CLI::App& app) {
                   "view, lacks at most this many standard errors against the last budget that gained (1: the "
                   "one-standard-error rule; 0: that budget)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--budget-folds", o->budget_search.folds,
+                  "With --max-gaussians search: trainings per budget, each validating on its own eighth of the "
+                  "training views (8: every training view validates once; each fold costs one training)")
+      ->check(CLI::Range(1, 8))
       ->capture_default_str();
   cmd->add_option("--strategy", o->train.strategy,
                   "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")

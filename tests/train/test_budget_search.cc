@@ -285,5 +285,16 @@ TEST(BudgetSearch, TheTwoFoldsValidateOnDisjointViewsHalfAStrideApart) {
   EXPECT_THROW(validation_split(d, 8, 0, 9), std::invalid_argument);  // more folds than offsets
 }
 
+TEST(BudgetSearch, EightFoldsValidateEveryTrainingViewExactlyOnce) {
+  const TrainingData d = views_with_every_8th_held_out(40);  // 35 training views
+  std::vector<int> validated(35, 0);
+  for (uint32_t fold = 0; fold < 8; ++fold) {
+    const TrainingData f = validation_split(d, 8, fold, 8);
+    ASSERT_EQ(f.views.size(), 35u);
+    for (size_t i = 0; i < 35; ++i) validated[i] += f.views[i].heldout;
+  }
+  EXPECT_EQ(validated, std::vector<int>(35, 1));
+}
+
 }  // namespace
 }  // namespace litgs::host
