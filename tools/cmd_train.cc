@@ -343,9 +343,10 @@ void add_train_command(CLI::App& app) {
                   "one-standard-error rule; 0: that budget)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_option("--budget-folds", o->budget_search.folds,
-                  "With --max-gaussians search: trainings per budget, each validating on its own eighth of the "
-                  "training views (8: every training view validates once; each fold costs one training)")
+  cmd->add_option(
+         "--budget-folds", o->budget_search.folds,
+         "With --max-gaussians search: trainings per budget, each validating on its own eighth of the "
+         "training views (8: every training view validates once; each fold costs one training)")
       ->check(CLI::Range(1, 8))
       ->capture_default_str();
   cmd->add_option("--strategy", o->train.strategy,
