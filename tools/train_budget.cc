@@ -134,6 +134,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
   const auto train_at = [&](uint32_t budget) {
     host::BudgetTrial trial;
     uint32_t reused = 0;  // folds whose finished training an earlier, interrupted search left
+    const std::string start = host::start_fingerprint(initial_at(budget), planes);  // every fold's
     for (uint32_t fold = 0; fold < search.folds; ++fold) {
       host::TrainOptions t = options;
       t.max_gaussians = budget;
@@ -144,8 +145,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
       t.eval_every = 0;  // the final evaluation only
       const std::filesystem::path dir =
           out / "budget-search" / std::to_string(budget) / ("fold-" + std::to_string(fold));
-      const nlohmann::json key = {{"options", host::run_options_json(t, splits[fold])},
-                                  {"start", host::start_fingerprint(initial_at(budget), planes)}};
+      const nlohmann::json key = {{"options", host::run_options_json(t, splits[fold])}, {"start", start}};
       std::optional<FinishedTrial> finished;
       if (reuse_finished_trials) finished = read_finished_trial(dir, key);
       if (finished) {

@@ -126,7 +126,8 @@ void for_each_field(Config& c, F&& f) {
     "max_gaussians: at 160x128 on DUNR 0.2 dB above mcmc at each budget, and slower; README)");
   f("train", "max_gaussians", c.train.max_gaussians,
     "MCMC budget (adc: cap): a count (40000: through run on DUNR and two synthetic presets as good as 20k "
-    "or up to 0.9 dB better, about 20% slower), search (grown while the validation PSNR of trainings on the "
+    "or up to 0.9 dB better, 1.2x (H100) to 1.4x (lavapipe) the time), search (grown while the validation "
+    "PSNR of trainings on the "
     "training views less a validation eighth still rises, two per budget tried: 3-14x the time, and a "
     "cut-short search continues on rerun; not the default: on run's facade it kept 5k, 3.4 dB below the "
     "best fixed budget) or auto (from the surface the training views see; README)");
