@@ -133,6 +133,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
   };
   const auto train_at = [&](uint32_t budget) {
     host::BudgetTrial trial;
+    trial.initial_gaussians = static_cast<uint32_t>(initial_at(budget).size());
     uint32_t reused = 0;  // folds whose finished training an earlier, interrupted search left
     const std::string start = host::start_fingerprint(initial_at(budget), planes);  // every fold's
     for (uint32_t fold = 0; fold < search.folds; ++fold) {
@@ -169,7 +170,10 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
     std::cout << "train: budget " << budget << ": validation PSNR " << trial.psnr_db << " dB (folds:";
     for (double p : trial.fold_psnr_db) std::cout << " " << p;
     std::cout << "), SSIM " << trial.ssim << " (" << trial.gaussians << " Gaussians, " << trial.wall_s << " s"
-              << (reused > 0 ? ", " + std::to_string(reused) + " of the trainings reused" : "") << ")\n";
+              << (reused > 0 ? ", " + std::to_string(reused) + " of the trainings reused" : "")
+              << (trial.initial_gaussians >= budget ? ", filled by its initialization: no plateau counted"
+                                                    : "")
+              << ")\n";
     return trial;
   };
   // A budget below the initialization's size (one not capped by the budget) cannot hold it: start there.
@@ -189,6 +193,7 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
                             {"validation_psnr_db_per_view", t.view_psnr_db},
                             {"validation_ssim", t.ssim},
                             {"gaussians", t.gaussians},
+                            {"initial_gaussians", t.initial_gaussians},
                             {"wall_s", t.wall_s}};
     if (std::isfinite(t.shortfall_db)) {
       trial["shortfall_db"] = t.shortfall_db;  // against the reference, per view

@@ -171,13 +171,14 @@ class Runner {
     const json started = read_json(dir / "started.json");
     // Only from a checkpoint (or a finished trial of the budget search): one killed, or out of disk space,
     // before its first has nothing to continue.
-    const bool something_to_continue =
-        std::any_of(plan.resume_from.begin(), plan.resume_from.end(), [&](const fs::path& rel) {
-          const fs::path folder = ctx_.out_dir / rel;
-          return fs::is_directory(folder) && !fs::is_empty(folder);
-        });
+    std::string continue_from;  // the folders holding work to continue, named in the stage's line
+    for (const fs::path& rel : plan.resume_from) {
+      const fs::path folder = ctx_.out_dir / rel;
+      if (fs::is_directory(folder) && !fs::is_empty(folder))
+        continue_from += (continue_from.empty() ? "" : " and ") + rel.generic_string();
+    }
     const bool resume = plan.resumable && !forced && started.is_object() && started.value("key", "") == key &&
-                        something_to_continue;
+                        !continue_from.empty();
     if (!resume) fs::remove_all(dir);
     fs::remove(manifest_path);
     fs::create_directories(dir);
@@ -185,7 +186,7 @@ class Runner {
     if (plan.scene_copy && !resume) make_scene_copy(*plan.scene_copy, dir / "scene");
     std::vector<std::string> command = plan.command;
     if (resume) command.insert(command.end(), plan.resume_args.begin(), plan.resume_args.end());
-    out_ << tag << ": " << stage.what << (resume ? " (resuming from its checkpoint)" : "")
+    out_ << tag << ": " << stage.what << (resume ? " (resuming from " + continue_from + ")" : "")
          << (forced ? " (forced by --from)" : "") << "\n";
     for (const std::string& note : plan.notes) out_ << tag << ": note: " << note << "\n";
     out_ << std::flush;

@@ -42,8 +42,10 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
       best = t.psnr_db;
       reference = result.trials.size() - 1;
       misses = 0;
-    } else if (!t.failure.empty() || ++misses > o.patience) {
+    } else if (!t.failure.empty()) {
       break;
+    } else if (t.initial_gaussians < budget && ++misses > o.patience) {
+      break;  // a budget its initialization filled does not count as a miss
     }
     // A budget the training did not fill (MCMC's growth ends below it) ends the search: a larger one would
     // train the same model again.

@@ -60,6 +60,9 @@ struct BudgetTrial {
   double shortfall_se_db = NAN;
   double ssim = 0;
   uint32_t gaussians = 0;  // the model's size at the end
+  // The initialization's size (the budget caps it). One that fills the budget leaves MCMC no room to grow:
+  // the model is a subsample of the seeding points, not what the images ask for.
+  uint32_t initial_gaussians = 0;
   double wall_s = 0;
   std::string failure;  // why the budget could not be trained (the device's memory or buffer limits)
 };
@@ -72,7 +75,10 @@ struct BudgetSearchResult {
 
 // The search's rule over `train_at(budget)` (the budget's trainings on the validation splits, scored). The
 // first trial sets the baseline; the next ones run until patience + 1 budgets in a row fail to gain
-// min_gain_db over the best before them, or until a trial ends with fewer Gaussians than its budget (a larger
+// min_gain_db over the best before them (a budget its initialization filled is not counted: its score
+// measures how densely the seeding points were subsampled, not whether the images ask for more Gaussians;
+// the facade through `run`, seeded from 20k+ LiDAR points, stopped on a plateau of such budgets at 5k), or
+// until a trial ends with fewer Gaussians than its budget (a larger
 // budget would train the same model: MCMC's growth in the given iterations, not the budget, limited it). A
 // budget the device cannot hold (train_at throws std::length_error, as buffers over the device's memory or
 // limits do) ends the search at the budget before it, recorded as a failed trial; at the first budget it

@@ -288,7 +288,7 @@ TEST(RunBadInput, InterruptedStageIsNotTakenAsDone) {
   CommandResult r = run_engine(run_args("synth:facade", dir, config));
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(stage_status(dir, "import"), "up to date");
-  EXPECT_NE(r.output.find("train: Gaussian map on the Vulkan device (resuming from its checkpoint)"),
+  EXPECT_NE(r.output.find("train: Gaussian map on the Vulkan device (resuming from train/checkpoints)"),
             std::string::npos)
       << r.output;
   const nlohmann::json metrics = read_json_file(dir / "train" / "metrics.json");
@@ -336,7 +336,7 @@ TEST(RunBadInput, InterruptedBudgetSearchContinues) {
 
   const CommandResult r = run_engine(run_args("synth:facade", dir, config));
   ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("train: Gaussian map on the Vulkan device (resuming from its checkpoint)"),
+  EXPECT_NE(r.output.find("train: Gaussian map on the Vulkan device (resuming from train/budget-search)"),
             std::string::npos)
       << r.output;
   std::ifstream log(dir / "train" / "log.txt");

@@ -87,6 +87,28 @@ TEST(BudgetSearch, ABudgetTheTrainingDidNotFillEndsTheSearch) {
   EXPECT_EQ(s.ran.size(), 4u);
 }
 
+TEST(BudgetSearch, BudgetsTheInitializationFilledDoNotCountAsAPlateau) {
+  // The facade through `run`: seeded from 21k LiDAR map points, 5k, 10k and 20k start full and score flat;
+  // the budgets past the seeding then gain.
+  const std::map<uint32_t, double> psnr = {{5000, 33.06}, {10000, 32.92},  {20000, 33.02}, {40000, 33.6},
+                                           {80000, 34.2}, {160000, 34.25}, {320000, 34.0}};
+  std::vector<uint32_t> ran;
+  const auto train_at = [&](uint32_t budget) {
+    ran.push_back(budget);
+    BudgetTrial t;
+    t.psnr_db = psnr.at(budget);
+    t.gaussians = budget;
+    t.initial_gaussians = std::min<uint32_t>(budget, 21297);
+    return t;
+  };
+  EXPECT_EQ(search_budget(train_at, 5000).chosen, 80000u);
+  EXPECT_EQ(ran, (std::vector<uint32_t>{5000, 10000, 20000, 40000, 80000, 160000, 320000}));
+  // The same scores from a seeding that never fills a budget: the plateau at 10k and 20k ends the search.
+  Scripted s{psnr, {}};
+  EXPECT_EQ(search_budget(std::ref(s), 5000).chosen, 5000u);
+  EXPECT_EQ(s.ran.back(), 20000u);
+}
+
 TEST(BudgetSearch, AFallStopsTheSearchAtTheBudgetBeforeIt) {
   Scripted s{{{5000, 21.5},
               {10000, 21.7},
