@@ -28,7 +28,7 @@ rm "$last/trial.json"
 trials=$(find "$dir/cut/budget-search" -name trial.json | wc -l)
 train --out "$dir/cut" --resume > "$dir/cut.log" 2>&1 || fail "resume in the search: $(tail -2 "$dir/cut.log")"
 grep -q 'the budget search had not finished; it continues' "$dir/cut.log" || fail "no continuation notice"
-reused=$(sed -n 's/.*, \([0-9]*\) of the trainings reused).*/\1/p' "$dir/cut.log" | awk '{s += $1} END {print s + 0}')
+reused=$(sed -n 's/.*, \([0-9]*\) of the trainings reused[,)].*/\1/p' "$dir/cut.log" | awk '{s += $1} END {print s + 0}')
 [ "$reused" -eq "$trials" ] || fail "reused $reused trainings, $trials had finished"
 grep -v wall_s "$dir/cut/budget.json" | diff "$dir/whole.json" - || fail "budget.json differs from the whole run's"
 [ -f "$dir/cut/point_cloud.ply" ] || fail "no model after the continued search"
