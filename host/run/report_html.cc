@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "host/run/report_budget.h"
 #include "io/error.h"
 
 // Chart.js (MIT, Debian libjs-chart.js), embedded at build time by cmake/EmbedFile.cmake.
@@ -29,23 +30,6 @@ json read_json(const fs::path& path) {
   } catch (const json::exception& e) {
     throw io::IoError(path, 0, std::string("not valid JSON: ") + e.what());
   }
-}
-
-std::string escape_html(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
-  }
-  return out;
 }
 
 // JSON inside <script>: "</" would end the element.
@@ -176,6 +160,7 @@ figcaption{font-size:11px;color:#555}
 table{border-collapse:collapse;margin:4px 0}
 td,th{border:1px solid #ccc;padding:2px 8px;text-align:left}
 td.note{color:#666;font-size:12px}
+tr.kept td{font-weight:bold;background:#eef6ee}
 )";
 
 // Builds the charts from the data block; sets body[data-charts] to the number drawn (the browser test reads
@@ -226,6 +211,23 @@ const char* kChartsScript = R"(
 )";
 
 }  // namespace
+
+std::string escape_html(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '&')
+      out += "&amp;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
+  }
+  return out;
+}
 
 std::string base64(const std::string& bytes) {
   static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -310,6 +312,9 @@ std::string report_html(const fs::path& run_dir, unsigned max_views) {
   h += "</div>\n";
   h += "<h2>Held-out views</h2>\n" + views_html(eval, run_dir / "eval", max_views);
   h += "<h2>Summary</h2>\n" + summary_table(metrics, eval);
+  const fs::path budget_file = run_dir / "train" / "budget.json";
+  h += "<h2>Budget</h2>\n" + budget_section_html(fs::exists(budget_file) ? read_json(budget_file) : json(),
+                                                 metrics.value("gaussians", uint64_t{0}));
   h += "<h2>Stages</h2>\n" + stages_table(run);
   h += "<h2>Held-out views, per view</h2>\n" + per_view_table(eval);
   h += "<script type=\"application/json\" id=data>" + script_json(data) + "</script>\n<script>";

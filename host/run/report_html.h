@@ -2,7 +2,8 @@
 // as PNG data URIs; nothing is fetched at view time). Sections: the charts (held-out PSNR and training loss
 // against iterations and seconds, Gaussians over training, the trajectories' top view with truth, prior and
 // refined poses where the scene has ground truth), the held-out views (render beside the real
-// frame, error map, false colour, rendered depth), the summary of stages and metrics, the per-view table.
+// frame, error map, false colour, rendered depth), the summary of metrics, how the budget was chosen
+// (report_budget.h), the stages, the per-view table.
 #pragma once
 
 #include <filesystem>
@@ -10,8 +11,9 @@
 
 namespace litgs::host::run {
 
-// Reads DIR/run.json (optional), DIR/train/metrics.json, DIR/train/trace.jsonl, DIR/eval/eval.json and the
-// pictures it lists. io::IoError naming a missing or malformed file.
+// Reads DIR/run.json (optional), DIR/train/budget.json (optional), DIR/train/metrics.json,
+// DIR/train/trace.jsonl, DIR/eval/eval.json and the pictures it lists. io::IoError naming a missing or
+// malformed file.
 std::string report_html(const std::filesystem::path& run_dir, unsigned max_views);
 
 // The training's progress records as one curve: a resumed run appends records from its checkpoint's iteration
@@ -19,6 +21,9 @@ std::string report_html(const std::filesystem::path& run_dir, unsigned max_views
 // session's seconds continue from the last kept record. Returns [{iteration, seconds, loss, gaussians,
 // psnr_db}] in iteration order.
 std::string trace_curve_json(const std::string& trace_jsonl_text);
+
+// Text for HTML content and attribute values: < > & " escaped.
+std::string escape_html(const std::string& s);
 
 // RFC 4648 base64.
 std::string base64(const std::string& bytes);

@@ -8,6 +8,7 @@
 
 #include "host/run/content_hash.h"
 #include "host/run/input_kind.h"
+#include "host/run/report_budget.h"
 #include "host/run/report_html.h"
 #include "host/run/run_config.h"
 #include "io/error.h"
@@ -135,6 +136,51 @@ TEST(Report, TraceCurveOfAResumedRun) {
   EXPECT_EQ(c[2]["iteration"], 101);
   EXPECT_DOUBLE_EQ(c[2]["seconds"].get<double>(), 22.0);
   EXPECT_DOUBLE_EQ(c[3]["seconds"].get<double>(), 42.0);
+}
+
+// One table row per budget tried, from its <tr to its </tr>.
+std::string table_row(const std::string& html, const std::string& first_cell) {
+  const size_t cell = html.find("><td>" + first_cell + "</td>");
+  if (cell == std::string::npos) return "";
+  const size_t start = html.rfind("<tr", cell);
+  return html.substr(start, html.find("</tr>", cell) - start);
+}
+
+TEST(Report, BudgetSectionOfASearchMarksTheKeptBudgetAndWhy) {
+  const nlohmann::json budget = nlohmann::json::parse(R"({
+    "gaussians": 20000, "source": "search", "reference": 20000, "parsimony_se": 0.0, "min_gain_db": 0.1,
+    "folds": 2, "trials": [
+      {"budget": 10000, "validation_psnr_db": 33.24, "validation_psnr_db_per_fold": [34.16, 32.32],
+       "gaussians": 10000, "initial_gaussians": 10000, "wall_s": 60.5},
+      {"budget": 20000, "validation_psnr_db": 34.04, "validation_psnr_db_per_fold": [34.99, 33.09],
+       "gaussians": 20000, "initial_gaussians": 15000, "wall_s": 144.0},
+      {"budget": 40000, "failure": "out of memory allocating buffer 'gaussians: sh'"},
+      {"budget": 80000, "validation_psnr_db": 33.5, "gaussians": 46491, "initial_gaussians": 15000}]})");
+  const std::string html = budget_section_html(budget, 20000);
+  EXPECT_NE(html.find("kept <b>20000</b>"), std::string::npos) << html;
+  const std::string filled = table_row(html, "10000"), kept = table_row(html, "20000"),
+                    failed = table_row(html, "40000");
+  EXPECT_NE(filled.find("<td>33.24</td><td>34.16 / 32.32</td>"), std::string::npos) << filled;
+  EXPECT_NE(filled.find("filled by its initialization"), std::string::npos) << filled;
+  EXPECT_EQ(filled.find("kept"), std::string::npos) << filled;
+  EXPECT_NE(kept.find("class=kept"), std::string::npos) << kept;
+  EXPECT_EQ(kept.find("filled"), std::string::npos) << kept;
+  EXPECT_NE(failed.find("does not fit the device"), std::string::npos) << failed;
+  EXPECT_NE(table_row(html, "80000").find("training did not fill it"), std::string::npos) << html;
+  EXPECT_EQ(kept.find("did not fill"), std::string::npos) << kept;
+}
+
+TEST(Report, BudgetSectionOfAFixedOrDerivedBudget) {
+  EXPECT_NE(budget_section_html(nullptr, 40000).find("fixed budget"), std::string::npos);
+  const nlohmann::json derived = {
+      {"gaussians", 179219},       {"source", "<LiDAR map>"}, {"points", 3988},
+      {"points_seen", 3988},       {"surface_m2", 173.04},    {"surface_pixels", 716874},
+      {"pixels_per_gaussian", 4.0}};
+  const std::string html = budget_section_html(derived, 179219);
+  EXPECT_NE(html.find("<b>179219</b> Gaussians from 3988 of 3988 points seen (&lt;LiDAR map&gt;)"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("173.0 m<sup>2</sup>"), std::string::npos) << html;
 }
 
 TEST(Report, Base64TestVectors) {  // RFC 4648, section 10

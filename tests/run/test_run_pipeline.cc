@@ -344,7 +344,14 @@ TEST(RunBadInput, InterruptedBudgetSearchContinues) {
   EXPECT_NE(train_log.find("the budget search had not finished; it continues"), std::string::npos)
       << train_log;
   EXPECT_NE(train_log.find("of the trainings reused"), std::string::npos) << train_log;
-  EXPECT_TRUE(read_json_file(dir / "train" / "budget.json").is_object());
+  const nlohmann::json budget = read_json_file(dir / "train" / "budget.json");
+  ASSERT_TRUE(budget.is_object());
+  // The report shows how the budget was chosen: the kept budget's row is marked.
+  std::ifstream report(dir / "report.html");
+  const std::string html{std::istreambuf_iterator<char>(report), {}};
+  EXPECT_NE(
+      html.find("<tr class=kept><td>" + std::to_string(budget.at("gaussians").get<uint64_t>()) + "</td>"),
+      std::string::npos);
 }
 
 // `litgs-engine ARGS` with every file it (and its stages) write limited to `max_file_bytes`: writes past
