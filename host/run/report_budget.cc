@@ -1,6 +1,7 @@
 #include "host/run/report_budget.h"
 
 #include <sstream>
+#include <stdexcept>
 
 #include "host/run/report_html.h"
 
@@ -73,11 +74,16 @@ std::string derived_html(const json& b) {
 }  // namespace
 
 std::string budget_section_html(const json& budget, uint64_t gaussians_trained) {
-  if (!budget.is_object())
+  if (budget.is_null())
     return "<p>A fixed budget (<code>train.max_gaussians</code>); the model has " +
            std::to_string(gaussians_trained) + " Gaussians.</p>\n";
-  if (budget.value("source", "") == "search") return search_html(budget);
-  return derived_html(budget);
+  try {
+    if (!budget.is_object()) throw std::invalid_argument("not a JSON object");
+    if (budget.value("source", "") == "search") return search_html(budget);
+    return derived_html(budget);
+  } catch (const std::exception& e) {  // a damaged record costs its section, not the report
+    return "<p>train/budget.json is not a budget record (" + escape_html(e.what()) + ").</p>\n";
+  }
 }
 
 }  // namespace litgs::host::run

@@ -9,7 +9,8 @@
 
 namespace litgs::host::run {
 
-// `budget` is budget.json's content, or null when the file does not exist. HTML, escaped.
+// `budget` is budget.json's content, or null when the file does not exist; a record of the wrong shape gives
+// a paragraph that says so. HTML, escaped.
 std::string budget_section_html(const nlohmann::json& budget, uint64_t gaussians_trained);
 
 }  // namespace litgs::host::run

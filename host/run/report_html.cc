@@ -313,8 +313,10 @@ std::string report_html(const fs::path& run_dir, unsigned max_views) {
   h += "<h2>Held-out views</h2>\n" + views_html(eval, run_dir / "eval", max_views);
   h += "<h2>Summary</h2>\n" + summary_table(metrics, eval);
   const fs::path budget_file = run_dir / "train" / "budget.json";
-  h += "<h2>Budget</h2>\n" + budget_section_html(fs::exists(budget_file) ? read_json(budget_file) : json(),
-                                                 metrics.value("gaussians", uint64_t{0}));
+  json budget;  // null: no record, a fixed budget
+  if (fs::exists(budget_file))
+    budget = json::parse(read_text(budget_file), nullptr, false);  // discarded if bad
+  h += "<h2>Budget</h2>\n" + budget_section_html(budget, metrics.value("gaussians", uint64_t{0}));
   h += "<h2>Stages</h2>\n" + stages_table(run);
   h += "<h2>Held-out views, per view</h2>\n" + per_view_table(eval);
   h += "<script type=\"application/json\" id=data>" + script_json(data) + "</script>\n<script>";

@@ -183,6 +183,17 @@ TEST(Report, BudgetSectionOfAFixedOrDerivedBudget) {
   EXPECT_NE(html.find("173.0 m<sup>2</sup>"), std::string::npos) << html;
 }
 
+TEST(Report, ADamagedBudgetRecordSaysSoInItsSection) {
+  // Unparsable JSON reaches the section as a discarded value; wrong types as they are.
+  const std::string unparsable =
+      budget_section_html(nlohmann::json::parse("{\"gaussians\": ", nullptr, false), 1);
+  EXPECT_NE(unparsable.find("is not a budget record"), std::string::npos) << unparsable;
+  const std::string wrong_type = budget_section_html(
+      {{"source", "search"}, {"gaussians", "<many>"}, {"trials", nlohmann::json::array()}}, 1);
+  EXPECT_NE(wrong_type.find("is not a budget record"), std::string::npos) << wrong_type;
+  EXPECT_EQ(wrong_type.find("<many>"), std::string::npos) << wrong_type;  // escaped if echoed
+}
+
 TEST(Report, Base64TestVectors) {  // RFC 4648, section 10
   EXPECT_EQ(base64(""), "");
   EXPECT_EQ(base64("f"), "Zg==");
