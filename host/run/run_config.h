@@ -130,7 +130,8 @@ void for_each_field(Config& c, F&& f) {
     "PSNR of trainings on the "
     "training views less a validation eighth still rises, two per budget tried: 3-14x the time on an H100, "
     "about 30x on lavapipe, and a cut-short search continues on rerun; not the default: it misses the best "
-    "fixed budget on run's facade, 160k against 320k, -0.25 dB, on lavapipe, and street, -0.41 dB) or auto "
+    "fixed budget on run's facade, 160k against 320k, -0.25 dB, and street, 80k, -0.73 dB, on lavapipe) or "
+    "auto "
     "(from the surface the training views see; README)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
