@@ -1,6 +1,5 @@
 #include "host/run/pipeline.h"
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>

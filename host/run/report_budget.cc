@@ -1,6 +1,5 @@
 #include "host/run/report_budget.h"
 
-#include <sstream>
 #include <stdexcept>
 
 #include "host/run/report_html.h"
@@ -9,15 +8,6 @@ namespace litgs::host::run {
 namespace {
 
 using nlohmann::json;
-
-std::string fixed(const json& v, int digits) {
-  if (!v.is_number()) return "&ndash;";
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v.get<double>();
-  return s.str();
-}
 
 // A field or null: a const json's operator[] on a missing key is undefined.
 json field(const json& j, const char* key) {
@@ -33,9 +23,9 @@ std::string search_html(const json& b) {
   std::string h = "<p>Searched (<code>max_gaussians: search</code>): " + std::to_string(b.value("folds", 0)) +
                   " trainings per budget on the training views less a validation subset each; kept <b>" +
                   std::to_string(kept) + "</b>, the last budget that added at least " +
-                  fixed(field(b, "min_gain_db"), 2) + " dB of validation PSNR";
+                  number(field(b, "min_gain_db"), 2) + " dB of validation PSNR";
   if (b.value("parsimony_se", 0.0) > 0)
-    h += " (with parsimony " + fixed(field(b, "parsimony_se"), 1) + " SE: the smallest within that of " +
+    h += " (with parsimony " + number(field(b, "parsimony_se"), 1) + " SE: the smallest within that of " +
          std::to_string(b.value("reference", 0)) + ")";
   h += ".</p>\n<table class=budget><tr><th>budget</th><th>validation PSNR dB</th><th>per fold</th>"
        "<th>Gaussians</th><th>seconds</th><th></th></tr>\n";
@@ -47,14 +37,14 @@ std::string search_html(const json& b) {
     } else {
       std::string folds;
       for (const json& f : t.value("validation_psnr_db_per_fold", json::array()))
-        folds += (folds.empty() ? "" : " / ") + fixed(f, 2);
+        folds += (folds.empty() ? "" : " / ") + number(f, 2);
       std::string note = budget == kept ? "kept" : "";
       const auto add = [&](const char* why) { note += std::string(note.empty() ? "" : "; ") + why; };
       if (t.value("initial_gaussians", uint64_t{0}) >= budget) add("filled by its initialization");
       if (t.value("gaussians", budget) < budget)
         add("training did not fill it: a larger budget would not differ");
-      h += cell(fixed(field(t, "validation_psnr_db"), 2)) + cell(folds) +
-           cell(std::to_string(t.value("gaussians", 0))) + cell(fixed(field(t, "wall_s"), 1)) + cell(note);
+      h += cell(number(field(t, "validation_psnr_db"), 2)) + cell(folds) +
+           cell(std::to_string(t.value("gaussians", 0))) + cell(number(field(t, "wall_s"), 1)) + cell(note);
     }
     h += "</tr>\n";
   }
@@ -66,9 +56,9 @@ std::string derived_html(const json& b) {
          std::to_string(b.value("gaussians", 0)) + "</b> Gaussians from " +
          std::to_string(b.value("points_seen", 0)) + " of " + std::to_string(b.value("points", 0)) +
          " points seen (" + escape_html(b.value("source", std::string("points"))) + "), " +
-         fixed(field(b, "surface_m2"), 1) + " m<sup>2</sup> of surface, " +
-         fixed(field(b, "surface_pixels"), 0) + " pixels at the finest view, " +
-         fixed(field(b, "pixels_per_gaussian"), 1) + " pixels per Gaussian.</p>\n";
+         number(field(b, "surface_m2"), 1) + " m<sup>2</sup> of surface, " +
+         number(field(b, "surface_pixels"), 0) + " pixels at the finest view, " +
+         number(field(b, "pixels_per_gaussian"), 1) + " pixels per Gaussian.</p>\n";
 }
 
 }  // namespace

@@ -39,15 +39,6 @@ std::string script_json(const json& j) {
   return s;
 }
 
-std::string number(const json& v, int digits, const std::string& unit = "") {
-  if (!v.is_number()) return "&ndash;";
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v.get<double>() << unit;
-  return s.str();
-}
-
 std::string row(const std::string& name, const std::string& value, const std::string& note = "") {
   return "<tr><th>" + name + "</th><td>" + value + "</td><td class=note>" + note + "</td></tr>\n";
 }
@@ -227,6 +218,15 @@ std::string escape_html(const std::string& s) {
       out += c;
   }
   return out;
+}
+
+std::string number(const json& v, int digits, const std::string& unit) {
+  if (!v.is_number()) return "&ndash;";
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(digits);
+  s << v.get<double>() << unit;
+  return s.str();
 }
 
 std::string base64(const std::string& bytes) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 
 namespace litgs::host::run {
@@ -21,6 +22,9 @@ std::string report_html(const std::filesystem::path& run_dir, unsigned max_views
 // session's seconds continue from the last kept record. Returns [{iteration, seconds, loss, gaussians,
 // psnr_db}] in iteration order.
 std::string trace_curve_json(const std::string& trace_jsonl_text);
+
+// A JSON number with `digits` decimals and `unit` appended; an en dash (&ndash;) where it is not a number.
+std::string number(const nlohmann::json& v, int digits, const std::string& unit = "");
 
 // Text for HTML content and attribute values: < > & " escaped.
 std::string escape_html(const std::string& s);
