@@ -42,13 +42,21 @@ void print_text(const host::ModelEvaluation& e, const nlohmann::json& trajectory
                     : "8-bit value / 255")
             << "); PSNR in dB (peak 1), SSIM 11-tap Gaussian window (sigma 1.5)"
             << (counts ? ", MAE in raw counts" : "") << ", depth residual in m\n";
-  std::printf("%-28s %9s %7s %10s %12s %10s\n", "view", "PSNR dB", "SSIM", "MAE count", "depth rms m",
-              "render ms");
+  std::printf("%-28s %9s %7s %10s %12s %10s %10s %9s\n", "view", "PSNR dB", "SSIM", "MAE count",
+              "depth rms m", "render ms", "covis dB", "covis %");
+  auto percent = [](double fraction) { return fraction >= 0 ? fixed(100 * fraction, 1) : fixed(-1, 1); };
   for (const host::ViewMetrics& m : e.views)
-    std::printf("%-28s %9.3f %7.4f %10s %12s %10.2f\n", m.name.c_str(), m.psnr_db, m.ssim,
-                fixed(m.mae_counts, 1).c_str(), fixed(m.depth_plane_rmse_m, 4).c_str(), m.render_ms);
-  std::printf("%-28s %9.3f %7.4f %10s %12s %10.2f (median)\n", "mean", e.psnr_db, e.ssim,
-              fixed(e.mae_counts, 1).c_str(), fixed(e.depth_plane_rmse_m, 4).c_str(), e.render_ms_median);
+    std::printf("%-28s %9.3f %7.4f %10s %12s %10.2f %10s %9s\n", m.name.c_str(), m.psnr_db, m.ssim,
+                fixed(m.mae_counts, 1).c_str(), fixed(m.depth_plane_rmse_m, 4).c_str(), m.render_ms,
+                fixed(m.covisible_psnr_db, 3).c_str(), percent(m.covisible_fraction).c_str());
+  std::printf("%-28s %9.3f %7.4f %10s %12s %10.2f %10s %9s (render: median)\n", "mean", e.psnr_db, e.ssim,
+              fixed(e.mae_counts, 1).c_str(), fixed(e.depth_plane_rmse_m, 4).c_str(), e.render_ms_median,
+              fixed(e.covisible_psnr_db, 3).c_str(), percent(e.covisible_fraction).c_str());
+  if (e.covisibility_unavailable.empty())
+    std::cout << "eval: covis: PSNR over the held-out pixels whose true surface point a training view also "
+                 "sees (gt/depth), and their share\n";
+  else
+    std::cout << "eval: covisible PSNR not measured: " << e.covisibility_unavailable << "\n";
   if (e.emd)
     std::cout << "eval: EMD " << fixed(e.emd->mean_m, 4) << " m (sampling floor " << fixed(e.emd->floor_m, 4)
               << " m, std " << fixed(e.emd->std_m, 4) << " over " << e.emd->rounds << " draws of "

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "engine/context.h"
+#include "host/eval/covisibility.h"
 #include "host/train/evaluation.h"
 #include "host/train/lidar_planes.h"
 #include "host/train/output_frame.h"
@@ -101,6 +102,9 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
   rasterizer.forward(gaussians, camera_of(heldout.front()));
   (void)rasterizer.download_images();
 
+  const HeldoutCovisibility covisibility = heldout_covisibility(scene_dir, scene, data);
+  e.covisibility_unavailable = covisibility.unavailable;
+
   const uint32_t W = data.width, H = data.height;
   double plane_sq = 0;
   size_t plane_n = 0;
@@ -123,6 +127,12 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
       for (size_t p = 0; p < view.image.size(); ++p) sum += std::abs(double{img.image[p]} - view.image[p]);
       m.mae_counts = sum / static_cast<double>(view.image.size()) * (data.stretch_high - data.stretch_low);
     }
+    if (!covisibility.masks.empty()) {
+      const std::vector<uint8_t>& mask = covisibility.masks[i];
+      m.covisible_fraction = static_cast<double>(std::count(mask.begin(), mask.end(), uint8_t{1})) /
+                             static_cast<double>(mask.size());
+      m.covisible_psnr_db = masked_psnr(img.image, view.image, mask);
+    }
     if (planes) {
       const PlaneResidualSum r = depth_plane_residuals(*planes, cam, img.depth, img.alpha);
       if (r.count > 0) m.depth_plane_rmse_m = std::sqrt(r.sum_sq_m2 / static_cast<double>(r.count));
@@ -138,6 +148,19 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
     e.psnr_db += m.psnr_db / n;
     e.ssim += m.ssim / n;
     if (e.bit_depth == 16) e.mae_counts = std::max(e.mae_counts, 0.0) + m.mae_counts / n;
+  }
+  if (!covisibility.masks.empty()) {
+    double psnr_sum = 0, fraction_sum = 0;
+    size_t psnr_n = 0;
+    for (const ViewMetrics& m : e.views) {
+      fraction_sum += m.covisible_fraction;
+      if (std::isfinite(m.covisible_psnr_db)) {
+        psnr_sum += m.covisible_psnr_db;
+        ++psnr_n;
+      }
+    }
+    e.covisible_fraction = fraction_sum / n;
+    if (psnr_n > 0) e.covisible_psnr_db = psnr_sum / static_cast<double>(psnr_n);
   }
   if (plane_n > 0) e.depth_plane_rmse_m = std::sqrt(plane_sq / static_cast<double>(plane_n));
   e.render_ms_median = median(times);
@@ -168,6 +191,8 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
 nlohmann::json to_json(const ModelEvaluation& e) {
   using nlohmann::json;
   auto optional_number = [](double v) { return v >= 0 ? json(v) : json(nullptr); };
+  // -1 (not measured) and NaN (no covisible pixel) as null; a PSNR may be any finite number.
+  auto finite_or_null = [](double v) { return std::isfinite(v) && v != -1 ? json(v) : json(nullptr); };
   json views = json::array();
   for (const ViewMetrics& m : e.views)
     views.push_back({{"name", m.name},
@@ -176,6 +201,8 @@ nlohmann::json to_json(const ModelEvaluation& e) {
                      {"ssim", m.ssim},
                      {"mae_counts", optional_number(m.mae_counts)},
                      {"depth_plane_rmse_m", optional_number(m.depth_plane_rmse_m)},
+                     {"covisible_fraction", optional_number(m.covisible_fraction)},
+                     {"covisible_psnr_db", finite_or_null(m.covisible_psnr_db)},
                      {"render_ms", m.render_ms}});
   json j = {
       {"views", views},
@@ -184,6 +211,13 @@ nlohmann::json to_json(const ModelEvaluation& e) {
       {"ssim", e.ssim},
       {"mae_counts", optional_number(e.mae_counts)},
       {"depth_plane_rmse_m", optional_number(e.depth_plane_rmse_m)},
+      {"covisible_fraction", optional_number(e.covisible_fraction)},
+      {"covisible_psnr_db", finite_or_null(e.covisible_psnr_db)},
+      {"covisibility",
+       e.covisibility_unavailable.empty()
+           ? json("PSNR over the held-out pixels whose true surface point (gt/depth, gt/poses.txt) "
+                  "a training view also sees (DyCheck's co-visibility mask)")
+           : json("not measured: " + e.covisibility_unavailable)},
       {"lpips", kLpipsNote},
       {"image_units", e.bit_depth == 16 ? "intensity in [0, 1]: raw counts stretched from [stretch_low, "
                                           "stretch_high]; mae_counts in raw counts"

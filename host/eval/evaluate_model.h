@@ -6,6 +6,8 @@
 //   peak 1 on the unclamped render, SSIM the 11-tap Gaussian-window (sigma 1.5) SSIM of 3DGS, as the
 //   trainer's evaluation. For 16-bit data also the mean absolute error in raw counts: the [0, 1] error times
 //   (stretch_high - stretch_low), against the frame as training sees it (clamped to the stretch).
+// - co-visibility (scenes with true depth, as synthetic ones): PSNR over the held-out pixels some training
+//   view also sees (host/eval/covisibility.h), beside the PSNR over every pixel.
 // - geometry: metres, in the scene's frame.
 // LPIPS is not computed: it needs pretrained network weights that this project cannot obtain.
 #pragma once
@@ -36,6 +38,9 @@ struct ViewMetrics {
   double mae_counts = -1;          // 16-bit data only; -1 otherwise
   double depth_plane_rmse_m = -1;  // where planes exist; -1 otherwise
   double render_ms = 0;            // forward and readback, wall clock
+  // Where the scene has true depth (host/eval/covisibility.h): the share of the view's pixels that a
+  // training view also sees, and the PSNR over those (NaN if none); -1 otherwise.
+  double covisible_fraction = -1, covisible_psnr_db = -1;
 };
 
 // One held-out view's images at the training resolution (row-major [H][W]).
@@ -48,6 +53,10 @@ struct ViewImages {
 struct ModelEvaluation {
   std::vector<ViewMetrics> views;
   double psnr_db = 0, ssim = 0, mae_counts = -1, depth_plane_rmse_m = -1;  // means over the views
+  // Means over the views (covisible_psnr_db over those with a covisible pixel); -1 where not measured, and
+  // covisibility_unavailable says why.
+  double covisible_fraction = -1, covisible_psnr_db = -1;
+  std::string covisibility_unavailable;
   double render_ms_median = 0;
   uint32_t width = 0, height = 0;
   int bit_depth = 8;

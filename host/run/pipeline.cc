@@ -272,6 +272,12 @@ class Runner {
                     value("psnr_db"), value("ssim"), value("emd_m"), value("emd_floor_m"),
                     value("render_ms_per_frame"), value("gaussians"));
       out_ << line;
+      if (m.value("covisible_psnr_db", json()).is_number()) {
+        std::snprintf(line, sizeof line,
+                      "run: held-out PSNR %.2f dB on the %.1f%% of pixels a training view saw\n",
+                      value("covisible_psnr_db"), 100 * value("covisible_fraction"));
+        out_ << line;
+      }
       if (m.contains("ate_m")) {
         std::snprintf(line, sizeof line, "run: ATE %.4f m", value("ate_m"));
         out_ << line;

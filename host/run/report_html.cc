@@ -43,10 +43,19 @@ std::string row(const std::string& name, const std::string& value, const std::st
   return "<tr><th>" + name + "</th><td>" + value + "</td><td class=note>" + note + "</td></tr>\n";
 }
 
+// A share in [0, 1] as a percentage; a dash, as number() writes, for a missing value.
+std::string percent(const json& share) {
+  return number(share.is_number() ? json(100 * share.get<double>()) : json(), 1);
+}
+
 std::string summary_table(const json& metrics, const json& eval) {
   const json& emd = eval.at("emd");
   std::string t = "<table class=summary>\n";
   t += row("held-out PSNR", number(eval["psnr_db"], 2, " dB"), escape_html(eval.value("image_units", "")));
+  if (eval.value("covisible_psnr_db", json()).is_number())
+    t += row("held-out PSNR, covisible pixels", number(eval["covisible_psnr_db"], 2, " dB"),
+             "over the " + percent(eval.value("covisible_fraction", json())) +
+                 "% of held-out pixels whose true surface a training view also saw (gt/depth)");
   t += row("held-out SSIM", number(eval["ssim"], 4), "11-tap Gaussian window, sigma 1.5");
   if (eval["mae_counts"].is_number())
     t += row("mean absolute error", number(eval["mae_counts"], 1, " counts"), "16-bit raw counts");
@@ -128,11 +137,13 @@ std::string views_html(const json& eval, const fs::path& eval_dir, unsigned max_
 std::string per_view_table(const json& eval) {
   std::string t =
       "<table class=views><tr><th>view</th><th>PSNR dB</th><th>SSIM</th><th>MAE counts</th><th>depth "
-      "RMSE m</th><th>render ms</th></tr>\n";
+      "RMSE m</th><th>render ms</th><th>covisible PSNR dB</th><th>covisible %</th></tr>\n";
   for (const json& v : eval.at("views"))
     t += "<tr><td>" + escape_html(v.value("name", "")) + "</td><td>" + number(v["psnr_db"], 2) + "</td><td>" +
          number(v["ssim"], 4) + "</td><td>" + number(v["mae_counts"], 1) + "</td><td>" +
-         number(v["depth_plane_rmse_m"], 4) + "</td><td>" + number(v["render_ms"], 1) + "</td></tr>\n";
+         number(v["depth_plane_rmse_m"], 4) + "</td><td>" + number(v["render_ms"], 1) + "</td><td>" +
+         number(v.value("covisible_psnr_db", json()), 2) + "</td><td>" +
+         percent(v.value("covisible_fraction", json())) + "</td></tr>\n";
   return t + "</table>\n";
 }
 

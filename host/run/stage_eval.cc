@@ -43,6 +43,8 @@ nlohmann::json result(const StageContext& c) {
     metrics["emd_m"] = e["emd"]["mean_m"];
     metrics["emd_floor_m"] = e["emd"]["floor_m"];
   }
+  for (const char* key : {"covisible_psnr_db", "covisible_fraction"})  // null where not measured
+    metrics[key] = e.value(key, nlohmann::json());
   metrics["lpips"] = e.at("lpips");
   if (e.value("trajectory", nlohmann::json()).is_object())
     metrics.update(pick(e["trajectory"], {"ate_m", "ate_prior_m"}));

@@ -210,6 +210,12 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
     for (int k = 0; k < 3; ++k) os << io::format_double(bias.accel_m_s2[k]) << (k < 2 ? " " : "\n");
   });
 
+  // True depth of every frame at its true pose (eval's co-visibility mask).
+  fs::create_directories(out / "gt/depth");
+  for (size_t i = 0; i < scene.frames.size(); ++i)
+    io::write_image(out / "gt/depth" / io::frame_file_name(scene.frames[i].t_s).filename(),
+                    true_depth_mm(p.world, K, T_world_cam[i]));
+
   // Frames are rendered as write_scene asks for them (a frozen frame repeats its source frame). While
   // write_scene encodes frame i, the next source frame renders and frame i's 8-bit view is written beside
   // it; every frame is a pure function of its index, so this overlap changes no byte.

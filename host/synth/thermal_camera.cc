@@ -45,6 +45,26 @@ double pixel_radiance(const World& world, const io::CameraIntrinsics& K, const E
   return thermal_radiance(world.textures[hit->texture], hit->u_m, hit->v_m, footprint);
 }
 
+io::Image true_depth_mm(const World& world, const io::CameraIntrinsics& K,
+                        const Eigen::Isometry3d& T_world_cam) {
+  io::Image depth;
+  depth.width = K.width;
+  depth.height = K.height;
+  depth.bit_depth = 16;
+  depth.data.assign(static_cast<size_t>(K.width) * K.height, 0);
+  for (int y = 0; y < K.height; ++y)
+    for (int x = 0; x < K.width; ++x) {
+      const Eigen::Vector3d d_cam((x - K.cx) / K.fx, (y - K.cy) / K.fy, 1);
+      const auto hit =
+          world.cast({T_world_cam.translation(), T_world_cam.linear() * d_cam.normalized()}, 0.05, 1e4);
+      if (!hit) continue;
+      const double z_mm = 1000.0 * hit->range_m * d_cam.normalized().z();
+      if (z_mm < 65535.5)
+        depth.data[static_cast<size_t>(y) * K.width + x] = static_cast<uint16_t>(std::lround(z_mm));
+    }
+  return depth;
+}
+
 io::Image render_thermal(const World& world, const ThermalCameraOptions& o,
                          const Eigen::Isometry3d& T_world_cam, uint64_t seed, uint64_t frame_index,
                          int threads) {

@@ -38,6 +38,11 @@ io::Image render_thermal(const World& world, const ThermalCameraOptions& options
                          const Eigen::Isometry3d& T_world_cam, uint64_t seed, uint64_t frame_index,
                          int threads);
 
+// The true depth of every pixel centre: z along the camera's axis in millimetres (16-bit, rounded), 0 where
+// the ray meets nothing (sky) or the depth exceeds 65.535 m. The scene's gt/depth/<frame>.png.
+io::Image true_depth_mm(const World& world, const io::CameraIntrinsics& K,
+                        const Eigen::Isometry3d& T_world_cam);
+
 // The 8-bit automatic-gain view: a per-frame percentile stretch of the raw counts.
 io::Image auto_gain_8bit(const io::Image& raw, const ThermalCameraOptions& options);
 

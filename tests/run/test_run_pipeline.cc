@@ -71,6 +71,19 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
   EXPECT_EQ(eval["trajectory"]["top_view"]["truth"].size(), 16u);
   EXPECT_NE(r.output.find("run: ATE "), std::string::npos) << r.output;
   EXPECT_EQ(eval["views"].size(), eval["heldout_views"].get<size_t>());
+  // The synthetic scene has true depth: each view's covisible share and its PSNR there, where every pixel
+  // is covisible the same as over the whole view.
+  ASSERT_TRUE(eval["covisible_psnr_db"].is_number()) << eval["covisibility"];
+  EXPECT_GT(eval["covisible_fraction"].get<double>(), 0.5);
+  EXPECT_LE(eval["covisible_fraction"].get<double>(), 1.0);
+  size_t fully_covisible = 0;
+  for (const auto& v : eval["views"])
+    if (v["covisible_fraction"].get<double>() == 1.0) {
+      EXPECT_NEAR(v["covisible_psnr_db"].get<double>(), v["psnr_db"].get<double>(), 1e-9) << v;
+      ++fully_covisible;
+    }
+  EXPECT_GT(fully_covisible, 0u) << "this scene's interior held-out views are seen whole by their neighbours";
+  EXPECT_NE(r.output.find("of pixels a training view saw"), std::string::npos) << r.output;
   EXPECT_EQ(read_json_file(dir / "train" / "metrics.json")["heldout_views"], eval["heldout_views"]);
   EXPECT_NEAR(read_json_file(dir / "train" / "metrics.json")["heldout_psnr"].get<double>(),
               eval["psnr_db"].get<double>(), 1e-6);  // the same renders of the same views
