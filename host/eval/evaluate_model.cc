@@ -141,7 +141,9 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
     }
     times.push_back(m.render_ms);
     e.views.push_back(m);
-    if (images) images->push_back({view.name, W, H, img.image, view.image, img.depth, img.alpha});
+    if (images)
+      images->push_back({view.name, W, H, img.image, view.image, img.depth, img.alpha,
+                         covisibility.masks.empty() ? std::vector<uint8_t>{} : covisibility.masks[i]});
   }
   const double n = static_cast<double>(e.views.size());
   for (const ViewMetrics& m : e.views) {

@@ -48,6 +48,7 @@ struct ViewImages {
   std::string name;
   uint32_t width = 0, height = 0;
   std::vector<float> render, target, depth_m, alpha;
+  std::vector<uint8_t> covisible;  // [H][W] 1 where a training view saw the surface; empty: not measured
 };
 
 struct ModelEvaluation {

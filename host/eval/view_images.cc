@@ -14,7 +14,17 @@ const Stops& stops(Palette p) {
                                 {0.98, 0.5, 0.0}, {1.0, 0.85, 0.1},  {1, 1, 1}};
   static const Stops error = {{0, 0, 0}, {0.55, 0.0, 0.0}, {1.0, 0.55, 0.0}, {1, 1, 1}};
   static const Stops depth = {{0.1, 0.05, 0.4}, {0.0, 0.45, 0.55}, {0.3, 0.75, 0.3}, {1.0, 0.95, 0.2}};
-  return p == Palette::kThermal ? thermal : p == Palette::kError ? error : depth;
+  static const Stops uncovered = {{0, 0, 0}, {0.0, 0.1, 0.6}, {0.0, 0.75, 1.0}, {1, 1, 1}};
+  switch (p) {
+    case Palette::kThermal:
+      return thermal;
+    case Palette::kError:
+      return error;
+    case Palette::kErrorUncovered:
+      return uncovered;
+    default:
+      return depth;
+  }
 }
 
 }  // namespace
@@ -83,8 +93,16 @@ nlohmann::json write_view_images(const std::filesystem::path& dir, const ViewIma
                       {"depth_max_m", far}};
   io::write_image(dir / j["render"].get<std::string>(), gray_image(v.render, v.width, v.height));
   io::write_image(dir / j["target"].get<std::string>(), gray_image(v.target, v.width, v.height));
-  io::write_image(dir / j["error"].get<std::string>(),
-                  colour_image(error, v.width, v.height, Palette::kError, 0.0, kErrorFullScale));
+  io::Image error_map = colour_image(error, v.width, v.height, Palette::kError, 0.0, kErrorFullScale);
+  bool uncovered_shown = false;
+  for (size_t p = 0; p < v.covisible.size() && p < error.size(); ++p)
+    if (!v.covisible[p]) {
+      const auto rgb = palette_colour(Palette::kErrorUncovered, error[p] / kErrorFullScale);
+      for (int c = 0; c < 3; ++c) error_map.data[3 * p + c] = rgb[c];
+      uncovered_shown = true;
+    }
+  j["error_uncovered_shown"] = uncovered_shown;
+  io::write_image(dir / j["error"].get<std::string>(), error_map);
   io::write_image(dir / j["false_colour"].get<std::string>(),
                   colour_image(v.render, v.width, v.height, Palette::kThermal, 0.0, 1.0));
   io::write_image(dir / j["depth"].get<std::string>(),

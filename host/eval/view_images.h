@@ -16,9 +16,10 @@ namespace litgs::host {
 
 // The colour ramps, each as a piecewise-linear curve through a few RGB stops at equal spacing.
 enum class Palette {
-  kThermal,  // black, violet, red, orange, yellow, white: the "iron" look of thermal viewers
-  kError,    // black, dark red, orange, white: 0 error black
-  kDepth,    // dark blue, teal, green, yellow: near to far
+  kThermal,         // black, violet, red, orange, yellow, white: the "iron" look of thermal viewers
+  kError,           // black, dark red, orange, white: 0 error black
+  kDepth,           // dark blue, teal, green, yellow: near to far
+  kErrorUncovered,  // black, dark blue, cyan, white: the error where no training view saw the surface
 };
 std::array<uint8_t, 3> palette_colour(Palette palette, double value);  // value in [0, 1] (clamped)
 
@@ -33,7 +34,9 @@ inline constexpr double kErrorFullScale = 0.25;
 
 // Writes DIR/<stem>.{render,target,error,false,depth}.png for the view (stem: the frame name without its
 // extension) and returns {"name", "render", "target", "error", "false_colour", "depth", "depth_min_m",
-// "depth_max_m"} (file names relative to DIR; depth range over pixels with alpha >= 0.5).
+// "depth_max_m", "error_uncovered_shown"} (file names relative to DIR; depth range over pixels with alpha >=
+// 0.5). Where the view has a co-visibility mask, the error map draws the pixels no training view saw in the
+// kErrorUncovered ramp (error_uncovered_shown: true when there are any).
 nlohmann::json write_view_images(const std::filesystem::path& dir, const ViewImages& view);
 
 }  // namespace litgs::host

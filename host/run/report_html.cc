@@ -122,7 +122,8 @@ std::string views_html(const json& eval, const fs::path& eval_dir, unsigned max_
     const std::pair<const char*, std::string> cells[] = {
         {"render", "render"},
         {"target", "real frame"},
-        {"error", "|error| (white: " + number(pictures.at("error_full_scale"), 2) + ")"},
+        {"error", "|error| (white: " + number(pictures.at("error_full_scale"), 2) + ")" +
+                      (v.value("error_uncovered_shown", false) ? "; blue: no training view saw it" : "")},
         {"false_colour", "render, thermal palette"},
         {"depth", "depth " + number(v["depth_min_m"], 2) + "&ndash;" + number(v["depth_max_m"], 2) + " m"}};
     for (const auto& [key, caption] : cells)

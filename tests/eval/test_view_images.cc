@@ -51,6 +51,24 @@ TEST(ViewImages, WritesTheFivePictures) {
   EXPECT_EQ(depth.at(0, 1, 0) + depth.at(0, 1, 1) + depth.at(0, 1, 2), 0);  // transparent: black
   EXPECT_TRUE(std::filesystem::exists(dir / "1.500000.false.png"));
   EXPECT_TRUE(std::filesystem::exists(dir / "1.500000.target.png"));
+  EXPECT_FALSE(j["error_uncovered_shown"].get<bool>());  // no mask: the error map as it was
+
+  // With a co-visibility mask, the pixels no training view saw take the blue ramp: the same error (0.5,
+  // above full scale) is white either way, a mid error is orange where covered and blue where not.
+  v.render = {0, 0.25f, 0.5f, 1, 0.1f, 0.1f, 0, 0};
+  v.covisible = {1, 1, 1, 0, 1, 0, 1, 1};
+  const nlohmann::json masked = write_view_images(dir, v);
+  EXPECT_TRUE(masked["error_uncovered_shown"].get<bool>());
+  const io::Image with_mask = io::read_image(dir / "1.500000.error.png");
+  EXPECT_EQ(with_mask.at(3, 0, 1), 255);
+  const auto covered = palette_colour(Palette::kError, 0.1 / kErrorFullScale);
+  const auto uncovered = palette_colour(Palette::kErrorUncovered, 0.1 / kErrorFullScale);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(with_mask.at(0, 1, c), covered[c]);
+    EXPECT_EQ(with_mask.at(1, 1, c), uncovered[c]);
+  }
+  EXPECT_GT(uncovered[2], uncovered[0]);  // blue, where the covered ramp is red
+  EXPECT_GT(covered[0], covered[2]);
   std::filesystem::remove_all(dir);
 }
 
