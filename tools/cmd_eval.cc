@@ -44,7 +44,7 @@ void print_text(const host::ModelEvaluation& e, const nlohmann::json& trajectory
             << (counts ? ", MAE in raw counts" : "") << ", depth residual in m\n";
   std::printf("%-28s %9s %7s %10s %12s %10s %10s %9s\n", "view", "PSNR dB", "SSIM", "MAE count",
               "depth rms m", "render ms", "covis dB", "covis %");
-  auto percent = [](double fraction) { return fraction >= 0 ? fixed(100 * fraction, 1) : fixed(-1, 1); };
+  auto percent = [](double fraction) { return fixed(fraction < 0 ? fraction : 100 * fraction, 1); };
   for (const host::ViewMetrics& m : e.views)
     std::printf("%-28s %9.3f %7.4f %10s %12s %10.2f %10s %9s\n", m.name.c_str(), m.psnr_db, m.ssim,
                 fixed(m.mae_counts, 1).c_str(), fixed(m.depth_plane_rmse_m, 4).c_str(), m.render_ms,

@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "io/image.h"
 
@@ -167,9 +168,9 @@ HeldoutCovisibility heldout_covisibility(const std::filesystem::path& scene_dir,
       return out;
     }
   }
-  std::vector<DepthView> training;
+  std::vector<DepthView> training;  // moved out: only the held-out views' depth stays in `depth`
   for (size_t v = 0; v < data.views.size(); ++v)
-    if (!data.views[v].heldout) training.push_back(depth[v]);
+    if (!data.views[v].heldout) training.push_back(std::move(depth[v]));
   out.masks.resize(data.views.size());
   for (size_t v = 0; v < data.views.size(); ++v)
     if (data.views[v].heldout)

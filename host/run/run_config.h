@@ -129,8 +129,9 @@ void for_each_field(Config& c, F&& f) {
     "or up to 0.9 dB better, 1.2x (H100) to 1.4x (lavapipe) the time), search (grown while the validation "
     "PSNR of trainings on the training views less a validation eighth still rises, two per budget tried: "
     "3-14x the time on an H100, about 30x on lavapipe, and a cut-short search continues on rerun; not the "
-    "default: it misses the best fixed budget on run's facade, 160k against 320k, -0.25 dB, and street, 80k, "
-    "-0.73 dB, on lavapipe) or auto (from the surface the training views see; README)");
+    "default: on run's facade and street it lands within 0.2 dB of the best fixed budget at some seeds and "
+    "0.25-0.73 dB below it at others, on lavapipe) or auto (from the surface the training views see; "
+    "README)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
   f("train", "init", c.train.init,
