@@ -118,7 +118,7 @@ AblationStudy features_study(const RunConfig& base) {
 }
 
 // The budgets the strategy study compares: 1/4, 1/2 and 1 times a fixed train.max_gaussians; with auto or
-// search, the derived or searched budget beside fixed ones spanning the README's DUNR sweep (5k to 80k).
+// search, the derived or searched budget beside fixed ones spanning docs/budget.md's DUNR sweep (5k to 80k).
 std::vector<std::string> compared_budgets(const std::string& base) {
   if (base == "auto" || base == "search") return {"5000", "20000", "80000", base};
   const bool count = !base.empty() && base.find_first_not_of("0123456789") == std::string::npos &&

@@ -55,7 +55,7 @@ struct RunConfig {
     uint32_t iterations = 2000;
     double downscale = 1.0;
     std::string strategy = "mcmc";
-    std::string max_gaussians = "40000";  // README, "run's budget": 20k, 40k, ... and search through run
+    std::string max_gaussians = "40000";  // README, "The Gaussian budget"; docs/budget.md
     double mcmc_growth = 0.3;
     double lambda_geo = 0.6;
     std::string init = "auto";
