@@ -122,8 +122,9 @@ void for_each_field(Config& c, F&& f) {
   f("train", "iterations", c.train.iterations, "training iterations");
   f("train", "downscale", c.train.downscale, "divide image size and intrinsics by this");
   f("train", "strategy", c.train.strategy,
-    "mcmc (fixed budget; at 320x256 on DUNR better and faster than uncapped adc) | adc (capped by "
-    "max_gaussians: at 160x128 on DUNR 0.2 dB above mcmc at each budget, and slower; README)");
+    "mcmc (fixed budget; through run at 40k over three seeds 0.49 dB above capped adc on DUNR at 320x256, "
+    "within -0.16..+0.05 dB of it on the synthetic presets) | adc (3DGS's densification, capped by "
+    "max_gaussians: faster on the presets, where it stops below the cap; README)");
   f("train", "max_gaussians", c.train.max_gaussians,
     "MCMC budget (adc: cap): a count (40000: through run on DUNR and two synthetic presets as good as 20k "
     "or up to 0.9 dB better, 1.2x (H100) to 1.4x (lavapipe) the time), search (grown while the validation "
