@@ -80,6 +80,9 @@ void run_train(TrainCliOptions o) {
   if (o.budget_search.parsimony_se > 0 && o.max_gaussians != "search")
     throw std::invalid_argument("--budget-parsimony applies to --max-gaussians search only, not '" +
                                 o.max_gaussians + "'");
+  if (o.budget_search.min_gain_db != host::BudgetSearchOptions{}.min_gain_db && o.max_gaussians != "search")
+    throw std::invalid_argument("--budget-min-gain applies to --max-gaussians search only, not '" +
+                                o.max_gaussians + "'");
   const bool asked_to_resume = o.train.resume;
   const bool reuse_finished_trials = restart_cut_short_search(o.max_gaussians, o.train.resume, o.out);
   if (reuse_finished_trials)
@@ -341,6 +344,11 @@ void add_train_command(CLI::App& app) {
                   "With --max-gaussians search: keep the smallest budget whose validation PSNR, paired per "
                   "view, lacks at most this many standard errors against the last budget that gained (1: the "
                   "one-standard-error rule; 0: that budget)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--budget-min-gain", o->budget_search.min_gain_db,
+                  "With --max-gaussians search: dB of validation PSNR a budget must add over the best before "
+                  "it to count as a gain (0: any rise)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option(

@@ -37,8 +37,9 @@ BudgetSearchResult search_budget(const std::function<BudgetTrial(uint32_t budget
     }
     t.budget = budget;
     result.trials.push_back(t);
-    // A NaN score never counts as a gain; a budget the device cannot hold ends the search.
-    if (t.psnr_db >= best + o.min_gain_db) {
+    // A NaN score never counts as a gain, nor a tie (at min_gain_db 0 a gain is any rise); a budget the
+    // device cannot hold ends the search.
+    if (t.psnr_db >= best + o.min_gain_db && t.psnr_db > best) {
       best = t.psnr_db;
       reference = result.trials.size() - 1;
       misses = 0;

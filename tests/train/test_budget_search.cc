@@ -122,6 +122,27 @@ TEST(BudgetSearch, AFallStopsTheSearchAtTheBudgetBeforeIt) {
   EXPECT_EQ(s.ran.back(), 320000u);
 }
 
+TEST(BudgetSearch, WithoutAMinimumGainAnyRiseOverTheBestCounts) {
+  // The facade's deterministic search at seed 0 (docs/budget.md): 320k rose 0.04 dB over 160k.
+  const std::map<uint32_t, double> psnr = {{5000, 33.46},   {10000, 34.40},  {20000, 34.32},
+                                           {40000, 35.40},  {80000, 36.13},  {160000, 36.83},
+                                           {320000, 36.87}, {640000, 36.47}, {1280000, 36.5}};
+  BudgetSearchOptions tenth;
+  tenth.min_gain_db = 0.1;
+  Scripted a{psnr, {}};
+  EXPECT_EQ(search_budget(std::ref(a), 0, tenth).chosen, 160000u);
+  EXPECT_EQ(a.ran.back(), 640000u);
+  BudgetSearchOptions any;
+  any.min_gain_db = 0.0;
+  Scripted b{psnr, {}};
+  EXPECT_EQ(search_budget(std::ref(b), 0, any).chosen, 320000u);
+  EXPECT_EQ(b.ran.back(), 1280000u);  // 640k and 1.28M below 320k: two budgets in a row without a rise
+  // A tie is no rise: it counts towards the plateau.
+  Scripted flat{{{5000, 21.0}, {10000, 21.5}, {20000, 21.5}, {40000, 21.5}}, {}};
+  EXPECT_EQ(search_budget(std::ref(flat), 0, any).chosen, 10000u);
+  EXPECT_EQ(flat.ran.back(), 40000u);
+}
+
 TEST(BudgetSearch, StartsAtTheInitializationsSizeAndStopsAtTheCap) {
   Scripted s{{{30000, 30.0}, {60000, 31.0}, {100000, 32.0}}, {}};
   BudgetSearchOptions o;
