@@ -332,13 +332,12 @@ void add_train_command(CLI::App& app) {
       "--recentred-output", o->train.recentred_output,
       "Write point_cloud.ply in the scene's recentred frame (poses.txt's) instead of the original world "
       "frame (scene + world_offset_m)");
-  cmd->add_option(
-         "--max-gaussians", o->max_gaussians,
-         "Cap of the model size (the MCMC budget): a count, auto (derived from the surface the "
-         "training views see at their resolution: the LiDAR map, else the initialization's points), "
-         "or search (two trainings per doubling budget, each on the training views less its own "
-         "validation eighth, while their mean validation PSNR still gains 0.1 dB, looking one doubling "
-         "past a plateau; then the final training at the budget found)")
+  cmd->add_option("--max-gaussians", o->max_gaussians,
+                  "Cap of the model size (the MCMC budget): a count, auto (derived from the surface the "
+                  "training views see at their resolution: the LiDAR map, else the initialization's points), "
+                  "or search (two trainings per doubling budget, each on the training views less its own "
+                  "validation eighth, while their mean validation PSNR still rises, looking one doubling "
+                  "past a plateau; then the final training at the budget found)")
       ->capture_default_str();
   cmd->add_option("--budget-parsimony", o->budget_search.parsimony_se,
                   "With --max-gaussians search: keep the smallest budget whose validation PSNR, paired per "
@@ -348,7 +347,7 @@ void add_train_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--budget-min-gain", o->budget_search.min_gain_db,
                   "With --max-gaussians search: dB of validation PSNR a budget must add over the best before "
-                  "it to count as a gain (0: any rise)")
+                  "it to count as a gain (0: any rise; 0.1 was the default until 2026-11-27)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option(

@@ -217,8 +217,10 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
               .dump(2)
        << "\n";
   });
-  std::cout << "train: budget " << result.reference << " Gaussians: the last that added at least "
-            << search.min_gain_db << " dB on the validation views";
+  std::cout << "train: budget " << result.reference
+            << " Gaussians: the last that rose above the best before it";
+  if (search.min_gain_db > 0) std::cout << " by at least " << search.min_gain_db << " dB";
+  std::cout << " on the validation views";
   if (search.parsimony_se > 0)
     std::cout << "; kept " << result.chosen << ", the smallest within " << search.parsimony_se
               << " standard error(s) of it per view";

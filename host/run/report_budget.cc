@@ -22,8 +22,9 @@ std::string search_html(const json& b) {
   const uint64_t kept = b.value("gaussians", uint64_t{0});
   std::string h = "<p>Searched (<code>max_gaussians: search</code>): " + std::to_string(b.value("folds", 0)) +
                   " trainings per budget on the training views less a validation subset each; kept <b>" +
-                  std::to_string(kept) + "</b>, the last budget that added at least " +
-                  number(field(b, "min_gain_db"), 2) + " dB of validation PSNR";
+                  std::to_string(kept) +
+                  "</b>, the last budget whose validation PSNR rose above the best before it";
+  if (b.value("min_gain_db", 0.0) > 0) h += " by at least " + number(field(b, "min_gain_db"), 2) + " dB";
   if (b.value("parsimony_se", 0.0) > 0)
     h += " (with parsimony " + number(field(b, "parsimony_se"), 1) + " SE: the smallest within that of " +
          std::to_string(b.value("reference", 0)) + ")";

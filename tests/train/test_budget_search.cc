@@ -39,10 +39,17 @@ std::vector<double> views_below_80k(double shortfall, std::vector<double> wobble
   return wobble;
 }
 
+// The tests of the plateau, patience and parsimony mechanics use a 0.1 dB threshold, whatever the default.
+BudgetSearchOptions tenth_db() {
+  BudgetSearchOptions o;
+  o.min_gain_db = 0.1;
+  return o;
+}
+
 TEST(BudgetSearch, KeepsTheLastBudgetThatGainedAndStopsAfterTwoThatDidNot) {
   Scripted s{{{5000, 21.5}, {10000, 21.8}, {20000, 22.0}, {40000, 22.05}, {80000, 22.08}, {160000, 23.0}},
              {}};
-  const BudgetSearchResult r = search_budget(std::ref(s), 3988);
+  const BudgetSearchResult r = search_budget(std::ref(s), 3988, tenth_db());
   EXPECT_EQ(r.chosen, 20000u);  // 40k and 80k gained under 0.1 dB: stop there; 160k is never tried
   EXPECT_EQ(s.ran, (std::vector<uint32_t>{5000, 10000, 20000, 40000, 80000}));
   ASSERT_EQ(r.trials.size(), 5u);
@@ -60,9 +67,9 @@ TEST(BudgetSearch, LooksOneBudgetPastAPlateau) {
               {160000, 36.05},
               {320000, 35.9}},
              {}};
-  EXPECT_EQ(search_budget(std::ref(s), 0).chosen, 80000u);
+  EXPECT_EQ(search_budget(std::ref(s), 0, tenth_db()).chosen, 80000u);
   EXPECT_EQ(s.ran.back(), 320000u);
-  BudgetSearchOptions impatient;
+  BudgetSearchOptions impatient = tenth_db();
   impatient.patience = 0;
   Scripted t{s.psnr, {}};
   EXPECT_EQ(search_budget(std::ref(t), 0, impatient).chosen, 10000u);
@@ -101,11 +108,11 @@ TEST(BudgetSearch, BudgetsTheInitializationFilledDoNotCountAsAPlateau) {
     t.initial_gaussians = std::min<uint32_t>(budget, 21297);
     return t;
   };
-  EXPECT_EQ(search_budget(train_at, 5000).chosen, 80000u);
+  EXPECT_EQ(search_budget(train_at, 5000, tenth_db()).chosen, 80000u);
   EXPECT_EQ(ran, (std::vector<uint32_t>{5000, 10000, 20000, 40000, 80000, 160000, 320000}));
   // The same scores from a seeding that never fills a budget: the plateau at 10k and 20k ends the search.
   Scripted s{psnr, {}};
-  EXPECT_EQ(search_budget(std::ref(s), 5000).chosen, 5000u);
+  EXPECT_EQ(search_budget(std::ref(s), 5000, tenth_db()).chosen, 5000u);
   EXPECT_EQ(s.ran.back(), 20000u);
 }
 
@@ -127,10 +134,8 @@ TEST(BudgetSearch, WithoutAMinimumGainAnyRiseOverTheBestCounts) {
   const std::map<uint32_t, double> psnr = {{5000, 33.46},   {10000, 34.40},  {20000, 34.32},
                                            {40000, 35.40},  {80000, 36.13},  {160000, 36.83},
                                            {320000, 36.87}, {640000, 36.47}, {1280000, 36.5}};
-  BudgetSearchOptions tenth;
-  tenth.min_gain_db = 0.1;
   Scripted a{psnr, {}};
-  EXPECT_EQ(search_budget(std::ref(a), 0, tenth).chosen, 160000u);
+  EXPECT_EQ(search_budget(std::ref(a), 0, tenth_db()).chosen, 160000u);
   EXPECT_EQ(a.ran.back(), 640000u);
   BudgetSearchOptions any;
   any.min_gain_db = 0.0;
@@ -197,7 +202,7 @@ TEST(BudgetSearch, WithParsimonyKeepsTheSmallestBudgetWithinOneStandardErrorOfTh
              {80000, views_below_80k(0, {0, 0, 0, 0})},
              {160000, views_below_80k(0, {0.02, -0.02, 0.01, 0})},
              {320000, views_below_80k(0.5, {0, 0, 0, 0})}};
-  BudgetSearchOptions one_se;
+  BudgetSearchOptions one_se = tenth_db();
   one_se.parsimony_se = 1;
   Scripted by_default = s;
   const BudgetSearchResult r = search_budget(std::ref(s), 0, one_se);
@@ -211,9 +216,9 @@ TEST(BudgetSearch, WithParsimonyKeepsTheSmallestBudgetWithinOneStandardErrorOfTh
   EXPECT_DOUBLE_EQ(r.trials[4].shortfall_db, 0.0);    // the reference against itself
   EXPECT_NEAR(r.trials[6].shortfall_db, 0.5, 1e-12);  // larger budgets are measured too, never chosen
 
-  // By default (0 standard errors) the last budget that gained is kept, and the shortfalls are still
-  // recorded.
-  const BudgetSearchResult d = search_budget(std::ref(by_default), 0);
+  // Without parsimony (0 standard errors, the default) the last budget that gained is kept, and the
+  // shortfalls are still recorded.
+  const BudgetSearchResult d = search_budget(std::ref(by_default), 0, tenth_db());
   EXPECT_EQ(d.chosen, 80000u);
   EXPECT_EQ(d.reference, 80000u);
   EXPECT_NEAR(d.trials[3].shortfall_db, 0.15, 1e-12);
@@ -227,7 +232,7 @@ TEST(BudgetSearch, AGainEveryViewAgreesOnIsKept) {
       {20000, views_below_80k(0.5, {0, 0, 0, 0})}, {40000, views_below_80k(0.15, {0.01, -0.01, 0.01, -0.01})},
       {80000, views_below_80k(0, {0, 0, 0, 0})},   {160000, views_below_80k(0.1, {0, 0, 0, 0})},
       {320000, views_below_80k(0.3, {0, 0, 0, 0})}};
-  BudgetSearchOptions one_se;
+  BudgetSearchOptions one_se = tenth_db();
   one_se.parsimony_se = 1;
   EXPECT_EQ(search_budget(std::ref(s), 0, one_se).chosen, 80000u);
 }
