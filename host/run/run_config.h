@@ -131,10 +131,8 @@ void for_each_field(Config& c, F&& f) {
     "PSNR of trainings on the training views less a validation eighth still rises, two per budget tried: "
     "3-14x the time on an H100, about 30x on lavapipe, and a cut-short search continues on rerun; not the "
     "default for its cost: through run on lavapipe it keeps the best fixed budget, or one within 0.2 dB of "
-    "it "
-    "with fewer Gaussians, on DUNR and the facade, and one about 0.2 dB below the best on the street) or "
-    "auto "
-    "(from the surface the training views see; README)");
+    "it with fewer Gaussians, on DUNR and the facade, and one about 0.2 dB below the best on the street) or "
+    "auto (from the surface the training views see; README)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
   f("train", "init", c.train.init,

@@ -158,6 +158,11 @@ TEST(Report, BudgetSectionOfASearchMarksTheKeptBudgetAndWhy) {
       {"budget": 80000, "validation_psnr_db": 33.5, "gaussians": 46491, "initial_gaussians": 15000}]})");
   const std::string html = budget_section_html(budget, 20000);
   EXPECT_NE(html.find("kept <b>20000</b>"), std::string::npos) << html;
+  EXPECT_NE(html.find("rose above the best before it by at least 0.10 dB"), std::string::npos) << html;
+  nlohmann::json any_rise = budget;
+  any_rise["min_gain_db"] = 0.0;
+  const std::string any_rise_html = budget_section_html(any_rise, 20000);
+  EXPECT_NE(any_rise_html.find("rose above the best before it."), std::string::npos) << any_rise_html;
   const std::string filled = table_row(html, "10000"), kept = table_row(html, "20000"),
                     failed = table_row(html, "40000");
   EXPECT_NE(filled.find("<td>33.24</td><td>34.16 / 32.32</td>"), std::string::npos) << filled;
