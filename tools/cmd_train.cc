@@ -12,6 +12,8 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "engine/context.h"
 #include "host/train/init_gaussians.h"
@@ -42,6 +44,7 @@ struct TrainCliOptions {
   std::string trace;     // JSON lines appended at every progress report (the report's curves)
   std::string max_gaussians = "2000000";  // a count, auto or search (tools/train_budget.h)
   host::BudgetSearchOptions budget_search;
+  std::vector<std::string> search_options_given;  // the --budget-* options on the command line
   host::TrainingDataOptions data;
   host::TrainOptions train;
 };
@@ -74,15 +77,10 @@ std::string format_eta(double s) {
 }
 
 void run_train(TrainCliOptions o) {
-  if (o.budget_search.folds != host::BudgetSearchOptions{}.folds && o.max_gaussians != "search")
-    throw std::invalid_argument("--budget-folds applies to --max-gaussians search only, not '" +
-                                o.max_gaussians + "'");
-  if (o.budget_search.parsimony_se > 0 && o.max_gaussians != "search")
-    throw std::invalid_argument("--budget-parsimony applies to --max-gaussians search only, not '" +
-                                o.max_gaussians + "'");
-  if (o.budget_search.min_gain_db != host::BudgetSearchOptions{}.min_gain_db && o.max_gaussians != "search")
-    throw std::invalid_argument("--budget-min-gain applies to --max-gaussians search only, not '" +
-                                o.max_gaussians + "'");
+  // Refused when given at all, not when its value differs from the default: an ignored option is a surprise.
+  if (!o.search_options_given.empty() && o.max_gaussians != "search")
+    throw std::invalid_argument(o.search_options_given.front() +
+                                " applies to --max-gaussians search only, not '" + o.max_gaussians + "'");
   const bool asked_to_resume = o.train.resume;
   const bool reuse_finished_trials = restart_cut_short_search(o.max_gaussians, o.train.resume, o.out);
   if (reuse_finished_trials)
@@ -403,7 +401,11 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--level-lambda-smooth", o->train.level_lambda_smooth,
                   "Level model: weight of the pull toward the neighbouring frames' level")
       ->capture_default_str();
-  cmd->callback([o] { run_train(*o); });
+  cmd->callback([cmd, o] {
+    for (const char* name : {"--budget-parsimony", "--budget-min-gain", "--budget-folds"})
+      if (cmd->count(name) > 0) o->search_options_given.push_back(name);
+    run_train(*o);
+  });
 }
 
 }  // namespace litgs::tools
