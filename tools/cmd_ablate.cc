@@ -21,7 +21,8 @@ void add_ablate_command(CLI::App& app) {
   cmd->add_option("--study", o->study,
                   "refine | lambda | features | strategy | all, or several: refine,features")
       ->capture_default_str();
-  cmd->add_option("--config", o->config, "run.yaml: the settings every run starts from")
+  cmd->add_option("--config", o->config,
+                  "run.yaml: the settings every run starts from (run's defaults, but max_gaussians 40000)")
       ->check(CLI::ExistingFile);
   cmd->add_option("--calib", o->calib, "ROS bag input: M2DGR calibration_results.txt")
       ->check(CLI::ExistingFile);
@@ -30,7 +31,8 @@ void add_ablate_command(CLI::App& app) {
     a.input = o->input;
     a.out_dir = std::filesystem::absolute(o->out);
     a.study = o->study;
-    if (!o->config.empty()) a.config = host::run::read_run_config(o->config);
+    if (!o->config.empty())
+      a.config = host::run::read_run_config(o->config, host::run::ablation_base_config());
     if (!o->calib.empty()) a.config.import.calib = o->calib;
     a.engine = this_executable();
     std::string line = "litgs-engine ablate " + o->input + " --out " + o->out + " --study " + o->study;

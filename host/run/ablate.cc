@@ -182,6 +182,12 @@ std::vector<std::string> split_commas(const std::string& text) {
 
 }  // namespace
 
+RunConfig ablation_base_config() {
+  RunConfig c;
+  c.train.max_gaussians = "40000";
+  return c;
+}
+
 std::vector<AblationStudy> ablation_studies(const std::string& names, const RunConfig& base) {
   const std::vector<std::string> known = {"refine", "lambda", "features", "strategy"};
   std::vector<std::string> wanted;

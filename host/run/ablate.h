@@ -40,11 +40,16 @@ struct AblationStudy {
 // std::invalid_argument for another name.
 std::vector<AblationStudy> ablation_studies(const std::string& names, const RunConfig& base);
 
+// The settings every variant starts from: run's defaults, but a fixed budget of 40k Gaussians (run's default
+// searches it). Each variant then differs from the others in its studied option only, where a search per
+// variant would let the budget move with it, and costs one training, not the search's 3-30.
+RunConfig ablation_base_config();
+
 struct AblateOptions {
   std::string input;
   std::filesystem::path out_dir;
   std::string study = "all";
-  RunConfig config;
+  RunConfig config = ablation_base_config();
   std::filesystem::path engine;
 };
 

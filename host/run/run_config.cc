@@ -73,7 +73,7 @@ std::string yaml_text(const std::vector<std::string>& v) {
 
 }  // namespace
 
-RunConfig read_run_config(const std::filesystem::path& path) {
+RunConfig read_run_config(const std::filesystem::path& path, const RunConfig& base) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(path.string());
@@ -82,7 +82,7 @@ RunConfig read_run_config(const std::filesystem::path& path) {
   } catch (const YAML::Exception& e) {
     throw io::IoError(path, e.mark.line + 1, "YAML error: " + e.msg);
   }
-  RunConfig config;
+  RunConfig config = base;
   if (root.IsNull()) return config;  // an empty file: every default
   if (!root.IsMap())
     throw io::IoError(path, 0, "expected sections (import, map, match, refine, train, eval, report)");

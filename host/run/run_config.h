@@ -55,7 +55,8 @@ struct RunConfig {
     uint32_t iterations = 2000;
     double downscale = 1.0;
     std::string strategy = "mcmc";
-    std::string max_gaussians = "40000";  // README, "The Gaussian budget"; docs/budget.md
+    // Grown on validation views (README, "The Gaussian budget"; docs/budget.md); ablate fixes it instead.
+    std::string max_gaussians = "search";
     double mcmc_growth = 0.3;
     double lambda_geo = 0.6;
     std::string init = "auto";
@@ -126,13 +127,13 @@ void for_each_field(Config& c, F&& f) {
     "within -0.16..+0.05 dB of it on the synthetic presets) | adc (3DGS's densification, capped by "
     "max_gaussians: faster on the presets, where it stops below the cap; README)");
   f("train", "max_gaussians", c.train.max_gaussians,
-    "MCMC budget (adc: cap): a count (40000: through run on DUNR and two synthetic presets as good as 20k "
-    "or up to 0.9 dB better, 1.2x (H100) to 1.4x (lavapipe) the time), search (grown while the validation "
-    "PSNR of trainings on the training views less a validation eighth still rises, two per budget tried: "
-    "3-14x the time on an H100, about 30x on lavapipe, and a cut-short search continues on rerun; not the "
-    "default for its cost: through run on lavapipe it keeps the best fixed budget, or one within 0.2 dB of "
-    "it with fewer Gaussians, on DUNR and the facade, and one about 0.2 dB below the best on the street) or "
-    "auto (from the surface the training views see; README)");
+    "MCMC budget (adc: cap): search (the default: doubled while the validation PSNR of trainings on the "
+    "training views less a validation eighth still rises, two trainings per budget tried; through run on "
+    "lavapipe it keeps the best fixed budget, or one within 0.2 dB of it with fewer Gaussians, on DUNR, the "
+    "facade and the corridor, and one 0.23 dB below the best on the street; 3-14x one training's time on an "
+    "H100, about 30x on lavapipe; a cut-short search continues on rerun), a count (40000 for a quick run: "
+    "the best fixed budget on DUNR, 0.66-1.0 dB below the best on the synthetic presets) or auto (from the "
+    "surface the training views see; README)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
   f("train", "init", c.train.init,
@@ -157,7 +158,8 @@ void for_each_field(Config& c, F&& f) {
 
 // Reads run.yaml: sections and keys as above, any of them may be left out (its default stays). An unknown
 // section or key, a wrong type or a YAML syntax error is an io::IoError naming the file and the key.
-RunConfig read_run_config(const std::filesystem::path& path);
+// Keys left out keep `base`'s values.
+RunConfig read_run_config(const std::filesystem::path& path, const RunConfig& base = RunConfig());
 // The configuration as run.yaml text, with each key's comment (run --print-config prints the defaults).
 std::string run_config_yaml(const RunConfig& config);
 // {section: {key: value}} (run.json, manifests).

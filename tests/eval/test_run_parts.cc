@@ -1,11 +1,12 @@
 // The pipeline's parts that need no device: run.yaml, content hashes, INPUT kinds, the report's trace curve
-// and base64.
+// and base64; the ablation's base configuration.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 
+#include "host/run/ablate.h"
 #include "host/run/content_hash.h"
 #include "host/run/input_kind.h"
 #include "host/run/report_budget.h"
@@ -62,6 +63,21 @@ TEST_F(RunParts, ConfigKeysMayBeLeftOut) {
   EXPECT_EQ(c.train.iterations, 50u);
   EXPECT_EQ(c.train.strategy, RunConfig().train.strategy);
   EXPECT_EQ(to_json(read_run_config(write("empty.yaml", ""))), to_json(RunConfig()));
+}
+
+// ablate starts from run's defaults with a fixed budget (a search per variant would move the budget with the
+// studied option); keys its run.yaml leaves out keep that base, keys it gives override it.
+TEST_F(RunParts, AblationBaseFixesTheBudgetThatRunSearches) {
+  EXPECT_EQ(RunConfig().train.max_gaussians, "search");
+  const RunConfig base = ablation_base_config();
+  EXPECT_EQ(base.train.max_gaussians, "40000");
+  const RunConfig partial = read_run_config(write("ablate-partial.yaml", "train:\n  iterations: 50\n"), base);
+  EXPECT_EQ(partial.train.max_gaussians, "40000");
+  EXPECT_EQ(partial.train.iterations, 50u);
+  const RunConfig given =
+      read_run_config(write("ablate-budget.yaml", "train:\n  max_gaussians: 5000\n"), base);
+  EXPECT_EQ(given.train.max_gaussians, "5000");
+  EXPECT_EQ(to_json(read_run_config(write("ablate-empty.yaml", ""), base)), to_json(base));
 }
 
 TEST_F(RunParts, UnknownKeysAndBadValuesAreErrorsNamingThem) {
