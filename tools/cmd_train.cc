@@ -76,6 +76,21 @@ std::string format_eta(double s) {
   return buf;
 }
 
+// One progress report: iteration, losses, last PSNR, Gaussians, speed, ETA and any anomaly.
+std::string progress_text(const host::TrainProgress& p) {
+  const double eta = (p.total - p.iteration) / std::max(p.iterations_per_s, 1e-9);
+  char terms[64] = "";
+  if (std::isfinite(p.geometric_rms_m))
+    std::snprintf(terms, sizeof terms, " (pho %.4f, plane rms %.1f cm)", p.photometric_loss,
+                  100 * p.geometric_rms_m);
+  char line[320];
+  std::snprintf(line, sizeof line, "[%6u/%u] loss %.4f%s  psnr %s  gaussians %zu  %.2f it/s  eta %s",
+                p.iteration, p.total, p.loss, terms,
+                std::isfinite(p.psnr_db) ? std::to_string(p.psnr_db).substr(0, 5).c_str() : "-", p.gaussians,
+                p.iterations_per_s, format_eta(eta).c_str());
+  return line + anomaly_text(p.counters);
+}
+
 void run_train(TrainCliOptions o) {
   // Refused when given at all, not when its value differs from the default: an ignored option is a surprise.
   if (!o.search_options_given.empty() && o.max_gaussians != "search")
@@ -202,35 +217,32 @@ void run_train(TrainCliOptions o) {
   o.train.check();
 
   engine::Context context;
+  const bool tty = ::isatty(STDOUT_FILENO);
   if (search) {
+    // Each trial's progress, as the final training's below: a trial can take minutes to hours on a CPU
+    // device.
+    const auto trial_progress = [&](uint32_t trial_budget, uint32_t fold, const host::TrainProgress& p) {
+      std::cout << (tty ? "\r" : "") << "budget " << trial_budget << " fold " << fold + 1 << "/"
+                << o.budget_search.folds << " " << progress_text(p)
+                << (tty && p.iteration < p.total ? "" : "\n") << std::flush;
+    };
     o.train.max_gaussians = search_max_gaussians(
         context, data,
         [&](uint32_t trial_budget) {
           std::string what;
           return initialize(trial_budget, what);
         },
-        planes.get(), o.train, o.budget_search, o.out, reuse_finished_trials);
+        planes.get(), o.train, o.budget_search, o.out, reuse_finished_trials, trial_progress);
     o.train.check();
     if (init_from_map) model = initialize(o.train.max_gaussians, init_what);
   }
-  const bool tty = ::isatty(STDOUT_FILENO);
   std::cout << "train: " << data.views.size() << " views (" << data.width << "x" << data.height << ", "
             << data.frozen_skipped << " frozen skipped), "
             << (o.train.resume ? "resuming from "
                                : "init " + std::to_string(model.size()) + " Gaussians from ")
             << init_what << ", lambda_geo " << o.train.lambda_geo << ", on " << context.info().name << "\n";
   auto progress = [&](const host::TrainProgress& p) {
-    const double eta = (p.total - p.iteration) / std::max(p.iterations_per_s, 1e-9);
-    char terms[64] = "";
-    if (std::isfinite(p.geometric_rms_m))
-      std::snprintf(terms, sizeof terms, " (pho %.4f, plane rms %.1f cm)", p.photometric_loss,
-                    100 * p.geometric_rms_m);
-    char line[320];
-    std::snprintf(line, sizeof line, "[%6u/%u] loss %.4f%s  psnr %s  gaussians %zu  %.2f it/s  eta %s",
-                  p.iteration, p.total, p.loss, terms,
-                  std::isfinite(p.psnr_db) ? std::to_string(p.psnr_db).substr(0, 5).c_str() : "-",
-                  p.gaussians, p.iterations_per_s, format_eta(eta).c_str());
-    std::cout << (tty ? "\r" : "") << line << anomaly_text(p.counters) << (tty ? "" : "\n") << std::flush;
+    std::cout << (tty ? "\r" : "") << progress_text(p) << (tty ? "" : "\n") << std::flush;
   };
   // --trace: one JSON object per progress report, appended and flushed, so that what an interrupted run
   // reported survives it. session_s counts from this call's start (a resume starts a new session).

@@ -100,11 +100,12 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
   return b.gaussians;
 }
 
-uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData& data,
-                              const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for,
-                              const host::PlanarMap* planes, const host::TrainOptions& options,
-                              const host::BudgetSearchOptions& search, const std::filesystem::path& out,
-                              bool reuse_finished_trials) {
+uint32_t search_max_gaussians(
+    engine::Context& context, const host::TrainingData& data,
+    const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for, const host::PlanarMap* planes,
+    const host::TrainOptions& options, const host::BudgetSearchOptions& search,
+    const std::filesystem::path& out, bool reuse_finished_trials,
+    const std::function<void(uint32_t, uint32_t, const host::TrainProgress&)>& trial_progress) {
   search.check();
   std::vector<host::TrainingData> splits;
   for (uint32_t fold = 0; fold < search.folds; ++fold)
@@ -152,8 +153,10 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
       if (finished) {
         ++reused;
       } else {
-        const host::TrainReport r = host::train(context, splits[fold], initial_at(budget), planes, t, dir, {},
-                                                nullptr, [](const std::string&) {});
+        std::function<void(const host::TrainProgress&)> progress;
+        if (trial_progress) progress = [&](const host::TrainProgress& p) { trial_progress(budget, fold, p); };
+        const host::TrainReport r = host::train(context, splits[fold], initial_at(budget), planes, t, dir,
+                                                progress, nullptr, [](const std::string&) {});
         finished = FinishedTrial{
             r.final_eval.psnr_db, r.final_eval.ssim, {}, static_cast<uint32_t>(r.gaussians), r.wall_s};
         for (const auto& view : r.final_eval.view_psnr_db) finished->view_psnr_db.push_back(view.second);

@@ -14,6 +14,7 @@
 #include "host/train/budget_search.h"
 #include "host/train/lidar_planes.h"
 #include "host/train/train_options.h"
+#include "host/train/trainer.h"
 #include "host/train/training_data.h"
 #include "kernels/splat/splat_types.h"
 
@@ -37,12 +38,15 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
 // training views, each from initial_for(budget) and in OUT/budget-search/<budget>/fold-<f>/ (with its
 // trial.json once finished: tools/budget_trial_record.h); writes OUT/budget.json and returns the budget found
 // by `search`'s rule. With reuse_finished_trials, a training whose trial.json matches is not run again.
-// Prints one line per budget tried.
+// Prints one line per budget tried; `trial_progress` (optional) gets each training's progress reports, with
+// its budget and fold (0-based), at options.progress_every.
 uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData& data,
                               const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for,
                               const host::PlanarMap* planes, const host::TrainOptions& options,
                               const host::BudgetSearchOptions& search, const std::filesystem::path& out,
-                              bool reuse_finished_trials);
+                              bool reuse_finished_trials,
+                              const std::function<void(uint32_t budget, uint32_t fold,
+                                                       const host::TrainProgress&)>& trial_progress = {});
 
 // `train --resume --max-gaussians search` where OUT holds no checkpoint of the final training: the run was
 // cut short in the search, or after it before the final training's first checkpoint, and there is nothing
