@@ -131,7 +131,8 @@ void for_each_field(Config& c, F&& f) {
     "training views less a validation eighth still rises, two trainings per budget tried; through run on "
     "lavapipe it keeps the best fixed budget, or one within 0.2 dB of it with fewer Gaussians, on DUNR, the "
     "facade and the corridor, and one 0.23 dB below the best on the street; 3-14x one training's time on an "
-    "H100, 20-95x on lavapipe; a cut-short search continues on rerun), a count (40000 for a quick run: "
+    "H100 with an earlier rule that tried fewer budgets, 20-95x on lavapipe; a cut-short search continues on "
+    "rerun), a count (40000 for a quick run: "
     "the best fixed budget on DUNR, 0.66-1.0 dB below the best on the synthetic presets) or auto (from the "
     "surface the training views see; README)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
