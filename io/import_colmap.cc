@@ -180,6 +180,7 @@ ColmapImportReport import_colmap(const ColmapImportOptions& o) {
   report.world_offset_m = o.world_offset_m ? *o.world_offset_m : Eigen::Vector3d(mean.array().round());
   scene.config.world_offset_m = report.world_offset_m;
   scene.config.poses_frame = PoseFrame::kCamera;
+  scene.config.poses_origin = PoseOrigin::kAbsolute;  // a global photogrammetric solution
   scene.config.has_lidar_map = false;
   scene.config.source =
       "colmap import of " + o.model.string() + "; no LiDAR or IMU (extrinsics are identity placeholders)";

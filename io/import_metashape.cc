@@ -116,6 +116,7 @@ MetashapeImportReport import_metashape(const MetashapeImportOptions& o) {
   report.world_offset_m = o.world_offset_m ? *o.world_offset_m : Eigen::Vector3d(mean.array().round());
   scene.config.world_offset_m = report.world_offset_m;
   scene.config.poses_frame = PoseFrame::kCamera;
+  scene.config.poses_origin = PoseOrigin::kAbsolute;  // a global photogrammetric solution
   scene.config.has_lidar_map = false;
   scene.config.source = "metashape import of " + o.xml.filename().string() +
                         "; timestamps are seconds of the day from the camera labels; no LiDAR or IMU "

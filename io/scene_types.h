@@ -19,6 +19,10 @@ enum class CameraModel {
 
 // Which moving frame the poses of poses.txt describe: T_world_cam or T_world_imu.
 enum class PoseFrame { kCamera, kImu };
+// Where poses.txt came from. kOdometry: an estimator that drifts (FAST-LIVO2, LIO, a bag's odometry, the
+// synthetic estimator): good between nearby frames, not globally. kAbsolute: a global solution (Metashape,
+// COLMAP with control points): each pose is a prior of its own. refine chooses its priors by it.
+enum class PoseOrigin { kOdometry, kAbsolute };
 
 // The thermal camera. Pixel coordinates put the centre of the top-left pixel at (0, 0) (OpenCV).
 struct CameraIntrinsics {
@@ -36,6 +40,7 @@ struct SceneConfig {
   Eigen::Matrix4d T_imu_lidar = Eigen::Matrix4d::Identity();  // maps LiDAR points into the IMU frame
   double time_offset_cam_lidar_s = 0;  // seconds: the LiDAR-clock time of a camera stamp is t_cam + offset
   PoseFrame poses_frame = PoseFrame::kCamera;
+  PoseOrigin poses_origin = PoseOrigin::kOdometry;  // scene.yaml `poses_origin`, optional (odometry)
   bool has_lidar_map = true;  // false: the scene has no lidar/map.pcd (e.g. a photogrammetry import)
   // Recentring: original world coordinates = scene world coordinates + world_offset_m (keeps float32 work
   // near the origin for data sets that sit far from it).

@@ -154,10 +154,11 @@ SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
     fail(path, 0, "cannot open for reading");
   }
   const Reader r{path};
-  r.only_keys(root,
-              {"format", "version", "units", "camera", "T_cam_lidar", "T_imu_lidar",
-               "time_offset_cam_lidar_s", "poses_frame", "lidar_map", "world_offset_m", "source"},
-              "");
+  r.only_keys(
+      root,
+      {"format", "version", "units", "camera", "T_cam_lidar", "T_imu_lidar", "time_offset_cam_lidar_s",
+       "poses_frame", "poses_origin", "lidar_map", "world_offset_m", "source"},
+      "");
   if (r.text(r.get(root, "format", ""), "format") != "litgs-scene")
     fail(path, r.line(root["format"]), "format: expected 'litgs-scene'");
   r.integer(r.get(root, "version", ""), "version", 1, 1);
@@ -198,6 +199,15 @@ SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
     c.poses_frame = PoseFrame::kImu;
   else
     fail(path, r.line(root["poses_frame"]), "poses_frame: '" + frame + "' is not camera or imu");
+  if (root["poses_origin"]) {
+    const std::string origin = r.text(root["poses_origin"], "poses_origin");
+    if (origin == "odometry")
+      c.poses_origin = PoseOrigin::kOdometry;
+    else if (origin == "absolute")
+      c.poses_origin = PoseOrigin::kAbsolute;
+    else
+      fail(path, r.line(root["poses_origin"]), "poses_origin: '" + origin + "' is not odometry or absolute");
+  }
   c.has_lidar_map = r.boolean(r.get(root, "lidar_map", ""), "lidar_map");
   const auto offset = r.numbers(r.get(root, "world_offset_m", ""), "world_offset_m");
   if (offset.size() != 3) fail(path, r.line(root["world_offset_m"]), "world_offset_m: expected 3 numbers");
@@ -235,6 +245,8 @@ void write_scene_yaml(const std::filesystem::path& path, const SceneConfig& c) {
         << "  # seconds: t_lidar = t_cam + offset\n"
         << "poses_frame: " << (c.poses_frame == PoseFrame::kCamera ? "camera" : "imu")
         << "  # poses.txt holds T_world_cam (camera) or T_world_imu (imu)\n"
+        << "poses_origin: " << (c.poses_origin == PoseOrigin::kAbsolute ? "absolute" : "odometry")
+        << "  # odometry (drifts: a relative prior) or absolute (a global solution: a prior per pose)\n"
         << "lidar_map: " << (c.has_lidar_map ? "true" : "false") << "  # lidar/map.pcd present\n"
         << "world_offset_m: [" << format_double(c.world_offset_m.x()) << ", "
         << format_double(c.world_offset_m.y()) << ", " << format_double(c.world_offset_m.z())

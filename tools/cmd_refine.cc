@@ -31,15 +31,15 @@ void add_refine_command(CLI::App& app) {
       ->capture_default_str();
   c->add_option(
        "--tracks", o->tracks,
-       "Track source: sfm (the front end's SCENE/sfm/, from litgs-engine match), synthetic (from a synth "
-       "scene's ground truth), auto (sfm when present, else synthetic)")
+       "Track source: auto or sfm (the front end's SCENE/sfm/, from litgs-engine match), oracle (projected "
+       "from a synth scene's true poses: an experiment that separates the refinement from the front end)")
       ->capture_default_str();
-  c->add_option("--outliers", o->synthetic.outlier_fraction, "Synthetic tracks: fraction of wrong matches")
+  c->add_option("--outliers", o->synthetic.outlier_fraction, "Oracle tracks: fraction of wrong matches")
       ->capture_default_str();
-  c->add_option("--pixel-noise", o->synthetic.pixel_noise_px, "Synthetic tracks: pixel noise (px)")
+  c->add_option("--pixel-noise", o->synthetic.pixel_noise_px, "Oracle tracks: pixel noise (px)")
       ->capture_default_str();
   c->add_option("--anchor-track-length", o->synthetic.anchor_track_length,
-                "Synthetic tracks: an anchor's track lasts up to N frames, then a new one starts where it is "
+                "Oracle tracks: an anchor's track lasts up to N frames, then a new one starts where it is "
                 "seen again (0: one track through every frame that sees it)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
@@ -47,25 +47,34 @@ void add_refine_command(CLI::App& app) {
        "--min-frame-observations", o->refine.min_frame_observations,
        "Stop (keeping the priors) when more than half of the frames have fewer observations (0: off)")
       ->capture_default_str();
-  c->add_flag("--absolute-priors", o->refine.ba.absolute_priors,
-              "The prior poses are absolute (Metashape, COLMAP with control points), not an odometry: a pose "
-              "prior on every frame");
+  c->add_option("--holdout-every", o->refine.holdout.every,
+                "Hold every Nth track back from the solve; refined poses that explain them worse than the "
+                "priors are not kept (0: no guard)")
+      ->capture_default_str();
+  auto absolute = std::make_shared<bool>(false);
+  c->add_option(
+       "--priors", o->priors,
+       "auto (from scene.yaml's poses_origin: Metashape and COLMAP imports are absolute) | absolute (a "
+       "pose prior on every frame) | odometry (relative priors between neighbouring frames)")
+      ->capture_default_str();
+  c->add_flag("--absolute-priors", *absolute, "The same as --priors absolute");
   c->add_option("--control-points", o->control_points_csv,
                 "Surveyed control points (CSV: ID,X,Y,Z,accuracy) to check the poses with (needs --markers)")
       ->check(CLI::ExistingFile);
   c->add_option("--markers", o->markers_xml,
                 "Metashape camera XML with the control points' image observations")
       ->check(CLI::ExistingFile);
-  c->callback([scene, o, anchors, planes] {
+  c->callback([scene, o, anchors, planes, absolute] {
+    if (*absolute) o->priors = "absolute";
     o->refine.use_anchors = *anchors;
     o->refine.use_planes = *planes;
     const host::refine::SceneRefineReport r = host::refine::refine_scene(*scene, *o);
     const auto& rr = r.refine;
-    std::cout << std::fixed << std::setprecision(3) << "refine: " << rr.status << "; " << r.tracks
-              << " tracks; " << rr.frames << " frames, " << r.points_written << " points ("
-              << rr.anchor_association.anchored_tracks << " anchored), " << rr.rounds.size() << " rounds in "
-              << rr.seconds << " s; reprojection RMS " << rr.before.reprojection_rms_px << " -> "
-              << rr.after.reprojection_rms_px << " px";
+    std::cout << std::fixed << std::setprecision(3) << "refine: " << rr.outcome << " (" << rr.status << "); "
+              << r.tracks << " tracks, " << r.priors << " priors; " << rr.frames << " frames, "
+              << r.points_written << " points (" << rr.anchor_association.anchored_tracks << " anchored), "
+              << rr.rounds.size() << " rounds in " << rr.seconds << " s; reprojection RMS "
+              << rr.before.reprojection_rms_px << " -> " << rr.after.reprojection_rms_px << " px";
     if (rr.after.behind_camera > 0)
       std::cout << " (" << rr.after.behind_camera << " observations behind their camera left out)";
     std::cout << ", plane RMS " << rr.before.plane_rms_m << " -> " << rr.after.plane_rms_m << " m";

@@ -31,6 +31,11 @@ void add_synth_command(CLI::App& app) {
                         "limits and default frame counts scale with it)");
   CLI::Option* w = synth->add_option("--width", *width, "Image width in pixels (default 320)");
   CLI::Option* h = synth->add_option("--height", *height, "Image height in pixels (default 256)");
+  synth
+      ->add_option("--appearance", o->appearance,
+                   "textured (weathered surfaces, blur, column noise: calibrated against real frames) | flat "
+                   "(the smooth blocks of earlier versions)")
+      ->capture_default_str();
   synth->add_flag("--force", o->force, "Replace the scene files in a non-empty --out");
   synth->add_flag("--drift", o->drift,
                   "A known sensor level drift (slow gain and offset warm-up, an offset jump at the first NUC "

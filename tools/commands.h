@@ -28,6 +28,7 @@ void add_serve_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 void add_train_command(CLI::App& app);
 void add_match_command(CLI::App& app);
+void add_compare_frames_command(CLI::App& app);  // tools/cmd_compare_frames.cc
 void add_map_command(CLI::App& app);
 void add_refine_command(CLI::App& app);
 void print_lidar_map_report(const host::LidarMapReport& report, const std::string& where);  // cmd_map.cc

@@ -52,6 +52,12 @@ void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli
       ->capture_default_str();
   cmd.add_option("--poses", cli->poses, "Priors: estimated (poses.txt) | truth (gt/poses.txt)")
       ->capture_default_str();
+  cmd.add_flag("!--no-split-conflicts", o.split_conflicts,
+               "Refuse a match that would put two keypoints of one image in a track (default: split such "
+               "tracks by the prior poses)");
+  cmd.add_option("--conflict-px", o.conflicts.max_error_px,
+                 "Splitting conflicting tracks: reprojection bound through the prior poses, pixels")
+      ->capture_default_str();
   cmd.add_option("--min-views", o.triangulation.min_views, "Views that must agree with a point")
       ->capture_default_str();
   cmd.add_option("--min-angle", o.triangulation.min_angle_deg, "Triangulation angle, degrees")
@@ -88,7 +94,10 @@ void print_summary(std::ostream& out, const std::string& title, const host::fron
       << "  pairs           " << m.pairs_tried << " tried, " << m.pairs_verified << " verified\n"
       << std::setprecision(3) << "  inlier ratio    " << m.inlier_ratio << " (" << m.verified_matches
       << " verified / " << m.mutual_matches << " mutual matches)\n"
-      << "  tracks          " << m.tracks << " (" << m.track_conflicts << " conflicting matches dropped)\n"
+      << "  tracks          " << m.tracks << " (" << m.track_conflicts << " of " << m.track_matches
+      << " verified matches lost to conflicts; " << m.conflicting_components << " conflicting tracks split, "
+      << m.conflict_keypoints_kept << " of their keypoints kept, " << m.conflict_keypoints_dropped
+      << " dropped)\n"
       << "  points          " << m.points << "\n"
       << std::setprecision(2) << "  track length    " << m.mean_track_length << " (mean)\n"
       << std::setprecision(3) << "  reprojection    " << m.mean_error_px << " px (mean)\n";

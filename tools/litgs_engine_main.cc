@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   litgs::tools::add_ablate_command(app);
   litgs::tools::add_export_command(app);
   litgs::tools::add_match_command(app);
+  litgs::tools::add_compare_frames_command(app);
   litgs::tools::add_map_command(app);
   litgs::tools::add_refine_command(app);
   try {

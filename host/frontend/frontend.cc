@@ -93,7 +93,19 @@ Structure triangulate_tracks(const Context& c, const std::vector<io::SfmPairMatc
   for (const auto& f : c.features) counts.push_back(f.keypoints.size());
   std::vector<std::vector<io::SfmKeypoint>> keypoints;
   for (const auto& f : c.features) keypoints.push_back(f.keypoints);
-  s.tracks = build_tracks(counts, matches, same_location_representatives(keypoints));
+  ComponentSplitter split;
+  if (c.o.split_conflicts)
+    split = [&c](const io::SfmTrack& component, const std::vector<std::array<size_t, 2>>& edges) {
+      const ObservationView view = [&c](const io::SfmObservation& o) -> std::optional<TriangulationView> {
+        if (!c.poses[o.image]) return std::nullopt;
+        const Eigen::Vector2d& px = c.undistorted[o.image][o.keypoint];
+        return TriangulationView{c.poses[o.image]->R_cam_world,
+                                 c.poses[o.image]->t_cam_world,
+                                 {(px.x() - c.K.cx) / c.K.fx, (px.y() - c.K.cy) / c.K.fy}};
+      };
+      return split_conflicting_component(component, edges, view, c.K.fx, c.K.fy, c.o.conflicts);
+    };
+  s.tracks = build_tracks(counts, matches, same_location_representatives(keypoints), split);
   s.points.resize(s.tracks.tracks.size());
   parallel_for(s.tracks.tracks.size(), c.o.threads, [&](size_t t) {
     std::vector<TriangulationView> views;
@@ -169,6 +181,10 @@ void summarize(FrontendResult& r, const Structure& s) {
                        : 0.0;
   m.tracks = s.tracks.tracks.size();
   m.track_conflicts = s.tracks.conflicts;
+  m.track_matches = s.tracks.matches;
+  m.conflicting_components = s.tracks.conflicting_components;
+  m.conflict_keypoints_kept = s.tracks.conflict_observations_kept;
+  m.conflict_keypoints_dropped = s.tracks.conflict_observations_dropped;
   double length = 0, error = 0;
   for (const auto& p : r.data.points) {
     length += static_cast<double>(p.observations.size());
@@ -194,6 +210,7 @@ void FrontendOptions::check() const {
   verify.check();
   pairs.check();
   triangulation.check();
+  conflicts.check();
   if (threads < 0) throw std::invalid_argument("threads must be >= 0");
 }
 
@@ -368,6 +385,8 @@ std::string frontend_json(const FrontendResult& r) {
               {"triangulation_max_error_px", o.triangulation.max_error_px},
               {"min_angle_deg", o.triangulation.min_angle_deg},
               {"min_views", o.triangulation.min_views},
+              {"split_conflicts", o.split_conflicts},
+              {"conflict_max_error_px", o.conflicts.max_error_px},
               {"threads", resolve_threads(o.threads)},
               {"poses", o.true_poses ? "gt/poses.txt" : "poses.txt"}}},
             {"summary",
@@ -385,6 +404,15 @@ std::string frontend_json(const FrontendResult& r) {
               {"inlier_ratio", m.inlier_ratio},
               {"tracks", m.tracks},
               {"track_conflicts", m.track_conflicts},
+              {"track_matches", m.track_matches},
+              {"conflicts",
+               {{"split", o.split_conflicts},
+                {"components", m.conflicting_components},
+                {"keypoints_kept", m.conflict_keypoints_kept},
+                {"keypoints_dropped", m.conflict_keypoints_dropped},
+                {"lost_match_share", m.track_matches ? static_cast<double>(m.track_conflicts) /
+                                                           static_cast<double>(m.track_matches)
+                                                     : 0.0}}},
               {"points", m.points},
               {"mean_track_length", m.mean_track_length},
               {"mean_reprojection_error_px", m.mean_error_px},

@@ -11,6 +11,7 @@
 #include "host/frontend/matching.h"
 #include "host/frontend/pair_selection.h"
 #include "host/frontend/preprocess.h"
+#include "host/frontend/track_conflicts.h"
 #include "host/frontend/triangulation.h"
 #include "host/frontend/verification.h"
 #include "io/sfm_files.h"
@@ -25,6 +26,10 @@ struct FrontendOptions {
   bool prior_epipolar = true;  // reject matches far from the prior poses' epipolar lines
   PairOptions pairs;
   TriangulationOptions triangulation;
+  // Tracks that would hold two keypoints of one image are split by the prior poses (track_conflicts.h);
+  // false: the later match is refused (images without a prior pose are never split).
+  bool split_conflicts = true;
+  ConflictOptions conflicts;
   int threads = 0;  // 0: all cores
   // Priors from gt/poses.txt instead of poses.txt (synthetic experiments that separate the front end from
   // the estimator's drift); an error if the scene has none.
@@ -51,7 +56,11 @@ struct FrontendSummary {
   size_t pairs_tried = 0, pairs_verified = 0;
   size_t mutual_matches = 0, verified_matches = 0, rejected_by_prior = 0;
   double inlier_ratio = 0;  // verified / mutual over all pairs tried (the sequence's)
-  size_t tracks = 0, track_conflicts = 0, points = 0;
+  size_t tracks = 0, points = 0;
+  // Verified matches lost to conflicts (their keypoints ended in different tracks, or in none), out of
+  // track_matches; the components split and their keypoints kept in a track or dropped.
+  size_t track_conflicts = 0, track_matches = 0;
+  size_t conflicting_components = 0, conflict_keypoints_kept = 0, conflict_keypoints_dropped = 0;
   size_t rejected_no_angle = 0, rejected_depth = 0, rejected_error = 0, rejected_few_views = 0;
   double mean_track_length = 0, mean_error_px = 0;
   // Scenes with gt/planes.txt: each point's distance to the nearest true plane, median and mean (metres);

@@ -1,6 +1,7 @@
 #include "host/frontend/tracks.h"
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <numeric>
 #include <stdexcept>
@@ -20,8 +21,8 @@ class Components {
     return x;
   }
   void set_image(size_t x, uint32_t image) { images_[x] = {image}; }
-  // False (nothing changed) if the components share an image.
-  bool unite(size_t a, size_t b) {
+  // False (nothing changed) if the components share an image, unless `allow_conflict`.
+  bool unite(size_t a, size_t b, bool allow_conflict = false) {
     a = find(a);
     b = find(b);
     if (a == b) return true;
@@ -29,7 +30,8 @@ class Components {
     std::vector<uint32_t>& ib = images_[b];
     std::vector<uint32_t> merged;
     std::set_union(ia.begin(), ia.end(), ib.begin(), ib.end(), std::back_inserter(merged));
-    if (merged.size() != ia.size() + ib.size()) return false;
+    if (!allow_conflict && merged.size() != ia.size() + ib.size()) return false;
+    merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
     if (ia.size() < ib.size()) std::swap(a, b);
     parent_[b] = a;
     images_[a] = std::move(merged);
@@ -57,7 +59,8 @@ std::vector<std::vector<uint32_t>> same_location_representatives(
 
 TrackSet build_tracks(const std::vector<size_t>& keypoints_per_image,
                       const std::vector<io::SfmPairMatches>& pairs,
-                      const std::vector<std::vector<uint32_t>>& representatives) {
+                      const std::vector<std::vector<uint32_t>>& representatives,
+                      const ComponentSplitter& split) {
   std::vector<size_t> offset(keypoints_per_image.size() + 1, 0);
   for (size_t i = 0; i < keypoints_per_image.size(); ++i) offset[i + 1] = offset[i] + keypoints_per_image[i];
   Components c(offset.back());
@@ -72,29 +75,69 @@ TrackSet build_tracks(const std::vector<size_t>& keypoints_per_image,
   };
   TrackSet out;
   std::vector<char> used(offset.back(), 0);
+  std::vector<std::array<size_t, 2>> joined;  // the matches (global keypoints) that were united
   for (const auto& p : pairs)
     for (const auto& m : p.matches) {
       if (!m.inlier) continue;
       const size_t a = global(p.image_a, m.keypoint_a), b = global(p.image_b, m.keypoint_b);
-      if (c.unite(a, b)) {
+      if (a == b) continue;
+      ++out.matches;
+      if (c.unite(a, b, static_cast<bool>(split))) {
         used[a] = used[b] = 1;
+        joined.push_back({a, b});
       } else {
         ++out.conflicts;
       }
     }
   // Group keypoints by root, in keypoint order (so by image, then keypoint).
-  std::vector<int64_t> track_of_root(offset.back(), -1);
+  std::vector<int64_t> component_of_root(offset.back(), -1);
+  std::vector<io::SfmTrack> components;
+  std::vector<size_t> local(offset.back(), 0);  // a keypoint's index in its component
   for (size_t i = 0; i < keypoints_per_image.size(); ++i)
     for (size_t k = offset[i]; k < offset[i + 1]; ++k) {
       if (!used[k]) continue;
       const size_t root = c.find(k);
-      if (track_of_root[root] < 0) {
-        track_of_root[root] = static_cast<int64_t>(out.tracks.size());
-        out.tracks.emplace_back();
+      if (component_of_root[root] < 0) {
+        component_of_root[root] = static_cast<int64_t>(components.size());
+        components.emplace_back();
       }
-      out.tracks[static_cast<size_t>(track_of_root[root])].observations.push_back(
-          {static_cast<uint32_t>(i), static_cast<uint32_t>(k - offset[i])});
+      auto& obs = components[static_cast<size_t>(component_of_root[root])].observations;
+      local[k] = obs.size();
+      obs.push_back({static_cast<uint32_t>(i), static_cast<uint32_t>(k - offset[i])});
     }
+  if (!split) {
+    out.tracks = std::move(components);
+    return out;
+  }
+  std::vector<std::vector<std::array<size_t, 2>>> edges(components.size());
+  for (const auto& [a, b] : joined)
+    edges[static_cast<size_t>(component_of_root[c.find(a)])].push_back({local[a], local[b]});
+  // The output track of each keypoint (-1: none), to count the matches the split separated.
+  std::vector<int64_t> track_of(offset.back(), -1);
+  for (size_t ci = 0; ci < components.size(); ++ci) {
+    const io::SfmTrack& comp = components[ci];
+    bool conflict = false;
+    for (size_t k = 1; k < comp.observations.size(); ++k)
+      conflict |= comp.observations[k].image == comp.observations[k - 1].image;
+    std::vector<io::SfmTrack> pieces;
+    if (conflict) {
+      ConflictSplit parts = split(comp, edges[ci]);
+      ++out.conflicting_components;
+      out.conflict_observations_dropped += parts.dropped;
+      out.conflict_observations_kept += comp.observations.size() - parts.dropped;
+      pieces = std::move(parts.tracks);
+    } else {
+      pieces.push_back(comp);
+    }
+    for (auto& t : pieces) {
+      std::sort(t.observations.begin(), t.observations.end(),
+                [](const auto& x, const auto& y) { return x.image < y.image; });
+      for (const auto& o : t.observations)
+        track_of[offset[o.image] + o.keypoint] = static_cast<int64_t>(out.tracks.size());
+      out.tracks.push_back(std::move(t));
+    }
+  }
+  for (const auto& [a, b] : joined) out.conflicts += track_of[a] < 0 || track_of[a] != track_of[b];
   return out;
 }
 

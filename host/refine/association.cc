@@ -111,6 +111,7 @@ AnchorAssociationReport associate_anchors(std::vector<TrackPoint>& points,
   std::vector<std::tuple<size_t, double, size_t, size_t>> pairs;  // votes, -mean distance, anchor, track
   for (size_t a = 0; a < anchors.size(); ++a) {
     if (!votes[a].empty()) ++report.anchors_in_view;
+    const size_t first = pairs.size();
     for (const auto& [track, n] : votes[a]) {
       size_t shared = 0;  // frames that see the anchor and observe the track
       for (const auto& ob : points[track].obs)
@@ -123,6 +124,10 @@ AnchorAssociationReport associate_anchors(std::vector<TrackPoint>& points,
       const Eigen::Vector3d e = *X - anchors[a].p;
       if (e.dot(anchors[a].cov.ldlt().solve(e)) <= o.gate_chi2)  // NaN fails too
         pairs.emplace_back(n, -dist[a][track] / static_cast<double>(n), a, track);
+    }
+    if (o.reject_ambiguous && pairs.size() > first + 1) {
+      pairs.resize(first);
+      ++report.ambiguous_anchors;
     }
   }
   std::sort(pairs.rbegin(), pairs.rend());

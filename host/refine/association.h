@@ -30,12 +30,18 @@ struct AnchorAssociationOptions {
   // 99% quantile of chi^2 with 3 degrees of freedom. Pixel agreement alone takes neighbouring tracks (11%
   // of the synthetic street's pairs even with the true poses).
   double gate_chi2 = 11.34;
+  // An anchor that two or more tracks pass the gate for is ambiguous and takes none: on a textured wall an
+  // estimator's map point (a patch at a high gradient) and a detector's keypoint need not be the same
+  // physical point, and a neighbour within the gate pulls the poses by centimetres (the facade's own
+  // tracks: docs/refinement.md).
+  bool reject_ambiguous = true;
 };
 
 struct AnchorAssociationReport {
   size_t anchors_in_view = 0;  // anchors seen by at least one frame
   size_t anchored_tracks = 0;
   size_t occluded_projections = 0;
+  size_t ambiguous_anchors = 0;  // passed by two or more tracks: not used (reject_ambiguous)
 };
 
 // Sets TrackPoint::anchor. `map` may be null (no occlusion check).

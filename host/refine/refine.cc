@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <stdexcept>
 
@@ -25,7 +26,7 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 // A frame whose observations all repeat the previous frame's exactly (a camera's non-uniformity
 // correction freezes the image): its observations say nothing about its own pose.
-size_t drop_frozen_frames(std::vector<TrackPoint>& points, size_t frames) {
+std::vector<bool> drop_frozen_frames(std::vector<TrackPoint>& points, size_t frames) {
   std::vector<size_t> shared(frames, 0), moved(frames, 0);
   for (const auto& p : points)
     for (size_t i = 1; i < p.obs.size(); ++i)
@@ -34,16 +35,11 @@ size_t drop_frozen_frames(std::vector<TrackPoint>& points, size_t frames) {
         moved[p.obs[i].frame] += (p.obs[i].uv - p.obs[i - 1].uv).norm() > 1e-6;
       }
   std::vector<bool> frozen(frames, false);
-  size_t count = 0;
-  for (size_t f = 1; f < frames; ++f)
-    if (shared[f] >= 5 && moved[f] == 0) {
-      frozen[f] = true;
-      ++count;
-    }
+  for (size_t f = 1; f < frames; ++f) frozen[f] = shared[f] >= 5 && moved[f] == 0;
   for (auto& p : points)
     for (auto& ob : p.obs)
       if (ob.frame < frames && frozen[ob.frame]) ob.active = false;
-  return count;
+  return frozen;
 }
 
 void deactivate_weak_points(std::vector<TrackPoint>& points, size_t* dropped) {
@@ -86,6 +82,7 @@ void RefineOptions::check() const {
   if (threads < 1) throw std::invalid_argument("refine: threads must be >= 1");
   if (max_iterations < 1) throw std::invalid_argument("refine: max_iterations must be >= 1");
   weights.check();
+  holdout.check();
 }
 
 ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::vector<CameraPose>& poses,
@@ -139,9 +136,12 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
       if (ob.frame >= n)
         throw std::invalid_argument("refine: an observation names frame " + std::to_string(ob.frame) +
                                     " of " + std::to_string(n));
+  // Held back before anything else looks at the tracks: they judge the solve at the end.
+  const std::vector<TrackPoint> held_out = hold_out_tracks(in.points, o.holdout);
   report.points = in.points.size();
   for (const auto& p : in.points) report.observations += p.obs.size();
-  report.frozen_frames = drop_frozen_frames(in.points, n);
+  const std::vector<bool> frozen = drop_frozen_frames(in.points, n);
+  report.frozen_frames = static_cast<size_t>(std::count(frozen.begin(), frozen.end(), true));
   for (const auto& p : in.points) report.untriangulated_points += !p.active;
   deactivate_weak_points(in.points, &report.untriangulated_points);
 
@@ -178,6 +178,11 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
   report.before = residual_stats(in.points, poses, in.camera);  // round 1 restates it after association
   const std::vector<size_t> per_frame = frame_observations(in.points, n);
   for (size_t c : per_frame) report.weak_frames += c < o.min_frame_observations;
+  report.fewest_frame_observations = SIZE_MAX;
+  for (size_t f = 0; f < n; ++f)
+    if (!frozen[f])
+      report.fewest_frame_observations = std::min(report.fewest_frame_observations, per_frame[f]);
+  if (report.fewest_frame_observations == SIZE_MAX) report.fewest_frame_observations = 0;
   if (n > 0) {
     std::vector<double> counts(per_frame.begin(), per_frame.end());
     report.median_frame_observations = median(counts);
@@ -281,6 +286,18 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
     rr.seconds = seconds_since(round_start);
     report.rounds.push_back(rr);
   }
+  if (o.holdout.every > 0 && !report.rounds.empty()) {
+    report.holdout = judge_on_held_out(held_out, in.priors, poses, in.camera, o.holdout);
+    report.notes.push_back(report.holdout.summary);
+    if (!report.holdout.keep_refined) {
+      poses = in.priors;
+      report.outcome = "kept the priors";
+      report.status = "kept the priors: the refined poses explain the held-back tracks worse (median " +
+                      std::to_string(report.holdout.refined_median_px) + " px against " +
+                      std::to_string(report.holdout.prior_median_px) + " px through the priors)";
+    }
+  }
+  if (report.stopped_early && report.outcome == "refined") report.outcome = "stopped";
   report.after = residual_stats(in.points, poses, in.camera);
   report.seconds = seconds_since(start);
   return report;

@@ -9,6 +9,7 @@
 
 #include "host/refine/association.h"
 #include "host/refine/bundle_adjustment.h"
+#include "host/refine/holdout_guard.h"
 #include "host/refine/weights.h"
 
 namespace litgs::host::refine {
@@ -31,6 +32,9 @@ struct RefineOptions {
   // cannot refine the poses (a few noisy points per frame move them the wrong way): refine stops before
   // solving and keeps the priors. 0: off.
   size_t min_frame_observations = 30;
+  // Tracks held back from the solve to judge it (holdout_guard.h): refined poses that explain them worse
+  // than the priors are not kept.
+  HoldoutOptions holdout;
   WeightOptions weights;
   AnchorAssociationOptions anchor_association;
   PlaneAssociationOptions plane_association;
@@ -72,13 +76,18 @@ struct RoundReport {
 };
 
 struct RefineReport {
-  std::string status = "converged";  // or the reason it stopped early
+  std::string status = "converged";  // or the reason it stopped early, or why the priors were kept
   bool stopped_early = false;
+  // "refined": the refined poses are the output; "kept the priors": the solve ran but the held-back tracks
+  // judged it worse; "stopped": it stopped before or during the solve (the priors or the last good round).
+  std::string outcome = "refined";
+  HoldoutVerdict holdout;
   size_t frames = 0, points = 0, observations = 0, anchors = 0;
   size_t frozen_frames = 0;          // frames whose observations repeat the previous frame's: dropped
   size_t untriangulated_points = 0;  // inactive from the start (non-finite or fewer than 2 observations)
   size_t weak_frames = 0;  // frames with fewer than min_frame_observations active observations at the start
   double median_frame_observations = 0;
+  size_t fewest_frame_observations = 0;  // over the frames not frozen, at the start
   AnchorAssociationReport anchor_association;
   size_t guarded_anchor_covariances = 0;
   double anchor_weight_median_raw = 0;  // m^-3

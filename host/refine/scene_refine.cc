@@ -66,19 +66,20 @@ std::vector<io::TumPose> to_tum(const std::vector<CameraPose>& poses, const io::
 // "synthetic: litgs-engine synth --preset NAME --seed S ..." -> the preset's world.
 synth::World synthetic_world(const io::SceneConfig& config, const fs::path& dir) {
   std::istringstream in(config.source);
-  std::string word, preset;
+  std::string word, preset, appearance = "textured";
   uint64_t seed = 1;
   while (in >> word) {
     if (word == "--preset") in >> preset;
     if (word == "--seed") in >> seed;
+    if (word == "--appearance") in >> appearance;
   }
   if (config.source.rfind("synthetic:", 0) != 0 || preset.empty())
     throw std::invalid_argument(
         (dir / "scene.yaml").string() +
-        ": --tracks synthetic needs a scene made by litgs-engine synth (its source line names "
+        ": --tracks oracle needs a scene made by litgs-engine synth (its source line names "
         "the preset); this one says \"" +
         config.source + "\"");
-  synth::World world = synth::make_preset(preset, seed).world;
+  synth::World world = synth::make_preset(preset, seed, synth::parse_appearance(appearance)).world;
   world.build_index();
   return world;
 }
@@ -141,6 +142,15 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
   double alpha_mean = 0;
   for (double a : r.alphas) alpha_mean += a / static_cast<double>(std::max<size_t>(1, r.alphas.size()));
   nlohmann::json j = {{"status", r.status},
+                      {"outcome", r.outcome},
+                      {"holdout",
+                       {{"tracks", r.holdout.tracks},
+                        {"tracks_used", r.holdout.tracks_used},
+                        {"observations", r.holdout.observations},
+                        {"measured", r.holdout.measured},
+                        {"prior_median_px", r.holdout.prior_median_px},
+                        {"refined_median_px", r.holdout.refined_median_px},
+                        {"keep_refined", r.holdout.keep_refined}}},
                       {"stopped_early", r.stopped_early},
                       {"frames", r.frames},
                       {"points", r.points},
@@ -149,9 +159,11 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                       {"frozen_frames", r.frozen_frames},
                       {"weak_frames", r.weak_frames},
                       {"median_frame_observations", r.median_frame_observations},
+                      {"fewest_frame_observations", r.fewest_frame_observations},
                       {"anchors", r.anchors},
                       {"anchored_tracks", r.anchor_association.anchored_tracks},
                       {"anchors_in_view", r.anchor_association.anchors_in_view},
+                      {"ambiguous_anchors", r.anchor_association.ambiguous_anchors},
                       {"guarded_anchor_covariances", r.guarded_anchor_covariances},
                       {"anchor_weight_median_m-3", r.anchor_weight_median_raw},
                       {"alpha_mean", alpha_mean},
@@ -161,6 +173,7 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                       {"seconds", r.seconds},
                       {"notes", r.notes},
                       {"tracks", sr.tracks},
+                      {"priors", sr.priors},
                       {"options",
                        {{"rounds", o.refine.rounds},
                         {"anchors", o.refine.use_anchors},
@@ -169,7 +182,8 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                         {"alpha_max", o.refine.weights.alpha_max},
                         {"window", o.refine.window},
                         {"threads", o.refine.threads},
-                        {"absolute_priors", o.refine.ba.absolute_priors}}}};
+                        {"holdout_every", o.refine.holdout.every},
+                        {"absolute_priors", sr.priors.rfind("absolute", 0) == 0}}}};
   if (sr.control)
     j["control_points"] = {{"observations", sr.control->observations},
                            {"unmatched_cameras", sr.control->unmatched_cameras},
@@ -196,7 +210,16 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   ro.check_images = false;
   const io::Scene scene = io::read_scene(dir, ro);
   const io::CameraIntrinsics& k = scene.config.camera;
-  const std::string source = o.tracks != "auto" ? o.tracks : io::has_sfm(dir / "sfm") ? "sfm" : "synthetic";
+  if (o.priors != "auto" && o.priors != "absolute" && o.priors != "odometry")
+    throw std::invalid_argument("refine: priors must be auto, absolute or odometry, not '" + o.priors + "'");
+  RefineOptions refine_options = o.refine;
+  refine_options.ba.absolute_priors =
+      o.priors == "auto" ? scene.config.poses_origin == io::PoseOrigin::kAbsolute : o.priors == "absolute";
+  if (o.tracks == "synthetic")
+    throw std::invalid_argument(
+        "refine: --tracks synthetic is now called oracle (tracks projected from the true poses: an "
+        "experiment, not the method)");
+  const std::string source = o.tracks == "auto" ? "sfm" : o.tracks;
   RefineInput in;
   in.camera = {k.fx, k.fy, k.cx, k.cy, k.width, k.height};
   const fs::path prior_path = dir / "poses_prior.txt";
@@ -222,16 +245,17 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
     report.has_truth = true;
   }
   report.tracks = source;
+  report.priors = std::string(refine_options.ba.absolute_priors ? "absolute" : "odometry") +
+                  (o.priors == "auto" ? " (scene.yaml poses_origin)" : " (asked for)");
   if (source == "sfm") {
     if (!io::has_sfm(dir / "sfm"))
       throw std::invalid_argument((dir / "sfm").string() +
                                   ": no front-end tracks here (run litgs-engine match SCENE first)");
     in.points = sfm_tracks(io::read_sfm(dir / "sfm"), k, in.priors, &report.sfm);
-  } else if (source == "synthetic") {
+  } else if (source == "oracle") {
     if (truth.empty())
       throw std::invalid_argument(dir.string() +
-                                  ": no front-end tracks (sfm/) and no gt/poses.txt for synthetic ones; "
-                                  "run litgs-engine match SCENE first");
+                                  ": --tracks oracle needs gt/poses.txt (tracks projected from the truth)");
     const synth::World world = synthetic_world(scene.config, dir);
     std::vector<Eigen::Vector3d> anchors_true;
     if (fs::exists(dir / "gt/anchors.txt"))
@@ -240,7 +264,7 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
     if (fs::exists(dir / "gt/frozen.txt")) so.frozen_frames = read_frozen(dir / "gt/frozen.txt");
     in.points = synthetic_tracks(world, truth, in.priors, in.camera, anchors_true, so);
   } else {
-    throw std::invalid_argument("refine: unknown track source '" + o.tracks + "' (auto, sfm, synthetic)");
+    throw std::invalid_argument("refine: unknown track source '" + o.tracks + "' (auto, sfm, oracle)");
   }
   PlanarMap planar;
   if (scene.map && o.refine.use_planes) {
@@ -248,7 +272,7 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
     in.map = &planar;
   }
   std::vector<CameraPose> poses = in.priors;
-  report.refine = refine(in, poses, o.refine);
+  report.refine = refine(in, poses, refine_options);
 
   if (markers)
     report.control = control_point_errors(*markers, control_points, scene.config.world_offset_m, in.camera,

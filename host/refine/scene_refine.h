@@ -17,11 +17,16 @@ namespace litgs::host::refine {
 
 struct SceneRefineOptions {
   RefineOptions refine;
-  // Where the tracks come from. "sfm": the front end's SCENE/sfm/ (`litgs-engine match`, sfm_tracks.h);
-  // "synthetic": from a synthetic scene's ground truth (synthetic_tracks.h); "auto": sfm/ when the scene
-  // has it, else synthetic.
+  // Where the tracks come from. "auto" and "sfm": the front end's SCENE/sfm/ (`litgs-engine match`,
+  // sfm_tracks.h; an error naming the fix when it is missing). "oracle": projected from a synthetic
+  // scene's true poses and world (synthetic_tracks.h): for experiments that separate the refinement from
+  // the front end, never a result of the method.
   std::string tracks = "auto";
   SyntheticTrackOptions synthetic;
+  // The priors' kind: "auto" reads scene.yaml's poses_origin (absolute for Metashape and COLMAP imports:
+  // a pose prior on every frame; odometry: relative priors between neighbours); "absolute" | "odometry"
+  // override it. refine.absolute_priors is set from it.
+  std::string priors = "auto";
   // With both: the surveyed control points' reprojection through the prior and the refined poses.
   std::filesystem::path control_points_csv, markers_xml;
 };
@@ -32,7 +37,8 @@ struct SceneRefineReport {
   double ate_before_m = 0, ate_after_m = 0;  // SE(3)-aligned, against gt/poses.txt at the frame times
   double plane_rms_true_m = -1;  // refined points on true planes (gt/map.pcd plane ids): RMS distance
   size_t points_written = 0;
-  std::string tracks;  // the source used: "sfm" or "synthetic"
+  std::string tracks;  // the source used: "sfm" or "oracle"
+  std::string priors;  // the priors used: "absolute" or "odometry", and why
   SfmTrackReport sfm;  // with tracks == "sfm"
   std::optional<ControlPointErrors> control;
 };

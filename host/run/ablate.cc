@@ -82,8 +82,8 @@ AblationStudy lambda_study() {
 
 AblationStudy features_study(const RunConfig& base) {
   AblationStudy s{"features", {"features", "CLAHE"}, {}, {}, ""};
-  // With synthetic tracks refine (and so train) does not depend on the features: stop after match.
-  const bool tracks_from_frontend = base.refine.tracks != "synthetic";
+  // With oracle tracks refine (and so train) does not depend on the features: stop after match.
+  const bool tracks_from_frontend = base.refine.tracks != "oracle";
   for (const char* f : {"orb", "sift", "akaze"})
     for (const bool clahe : {false, true})
       s.variants.push_back({std::string(f) + (clahe ? "-clahe" : ""),
@@ -110,9 +110,9 @@ AblationStudy features_study(const RunConfig& base) {
     s.measured.push_back(column("PSNR (dB)", "eval", "psnr_db", 2));
   } else {
     s.note =
-        "ATE, plane residual and PSNR are not measured per feature type here: refine.tracks is synthetic "
-        "(tracks "
-        "from the synthetic scene's truth), so refinement and training do not depend on the front end.";
+        "ATE, plane residual and PSNR are not measured per feature type here: refine.tracks is oracle "
+        "(tracks projected from the synthetic scene's truth, an experiment), so refinement and training do "
+        "not depend on the front end.";
   }
   return s;
 }

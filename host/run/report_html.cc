@@ -100,8 +100,13 @@ std::string stages_table(const json& run) {
   std::string t =
       "<table class=stages><tr><th>stage</th><th>status</th><th>seconds</th><th>peak host memory</th></tr>\n";
   for (const json& s : run.value("stages", json::array())) {
-    t += "<tr><td>" + escape_html(s.value("name", "")) + "</td><td>" + escape_html(s.value("status", "")) +
-         "</td><td>" + number(s.value("seconds", json()), 1) + "</td><td>" +
+    std::string status = s.value("status", "");
+    // refine says what it did: refined, kept the priors (the held-back tracks judged it worse) or stopped.
+    if (const json m = s.value("metrics", json::object()); m.is_object() && m.contains("outcome"))
+      status += ": " + m["outcome"].get<std::string>() +
+                (m.contains("tracks") ? " (" + m["tracks"].get<std::string>() + " tracks)" : "");
+    t += "<tr><td>" + escape_html(s.value("name", "")) + "</td><td>" + escape_html(status) + "</td><td>" +
+         number(s.value("seconds", json()), 1) + "</td><td>" +
          (s.contains("peak_host_bytes") ? number(json(s["peak_host_bytes"].get<double>() / 1e6), 0, " MB")
                                         : "&ndash;") +
          "</td></tr>\n";

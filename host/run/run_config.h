@@ -110,8 +110,8 @@ void for_each_field(Config& c, F&& f) {
   f("match", "extra_args", c.match.extra_args, "more flags for `litgs-engine match`, as is");
   f("refine", "enabled", c.refine.enabled, "refine the poses (poses.txt; the input kept as poses_prior.txt)");
   f("refine", "tracks", c.refine.tracks,
-    "track source, as `refine --tracks`: auto (the front end's sfm/ when match ran, else synthetic) | sfm | "
-    "synthetic (from a synth scene's ground truth: stands in for a front end on its smooth frames)");
+    "track source, as `refine --tracks`: auto or sfm (the front end's sfm/, written by match) | oracle "
+    "(projected from a synth scene's true poses: an experiment, not the method)");
   f("refine", "anchors", c.refine.anchors, "anchor weights and priors");
   f("refine", "planes", c.refine.planes, "LiDAR point-to-plane term (off where the scene has no LiDAR map)");
   f("refine", "rounds", c.refine.rounds, "rounds of association, solve and rejection");

@@ -41,11 +41,19 @@ struct Preset {
   double map_voxel_m = 0.1;   // voxel of the downsampled LiDAR map
 };
 
+// How the surfaces look to the thermal camera. kTextured (the default): weathering at several scales,
+// per-brick and per-panel spread, rain streaks, heat bleeding around openings, optics blur and column noise,
+// calibrated against real long-wave frames (docs/synthetic-appearance.md). kFlat: the smooth blocks of
+// earlier versions (uniform walls, faint joints), on which a feature detector finds little.
+enum class Appearance { kTextured, kFlat };
+Appearance parse_appearance(const std::string& name);  // "textured" | "flat"; invalid_argument otherwise
+std::string appearance_name(Appearance appearance);
+
 // The preset names, the default first.
 std::vector<std::string> preset_names();
 
 // The preset `name` (std::invalid_argument listing the valid names otherwise). The seed varies the
 // textures' noise and the rig's small calibration offsets; the layout is fixed per preset.
-Preset make_preset(const std::string& name, uint64_t seed);
+Preset make_preset(const std::string& name, uint64_t seed, Appearance appearance = Appearance::kTextured);
 
 }  // namespace litgs::host::synth

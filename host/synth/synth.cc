@@ -92,6 +92,8 @@ std::string SynthOptions::check() const {
     return "height: must be in [16, 8192], got " + std::to_string(*height);
   if (out.empty()) return "out: no output directory given";
   if (threads < 0 || threads > 64) return "threads: must be in [0, 64]";
+  if (appearance != "textured" && appearance != "flat")
+    return "appearance: must be textured or flat, got '" + appearance + "'";
   return "";
 }
 
@@ -99,7 +101,7 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (const std::string problem = options.check(); !problem.empty())
     throw std::invalid_argument("synth: " + problem);
-  Preset p = make_preset(options.preset, options.seed);
+  Preset p = make_preset(options.preset, options.seed, parse_appearance(options.appearance));
   if (options.frame_rate_hz) {  // the same stretch of the world, sampled more or less densely
     p.max_frames = static_cast<int>(std::floor(p.max_frames * *options.frame_rate_hz / p.frame_rate_hz));
     p.frames = static_cast<int>(std::lround(p.frames * *options.frame_rate_hz / p.frame_rate_hz));
@@ -192,7 +194,8 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   std::ostringstream source;
   source << "synthetic: litgs-engine synth --preset " << p.name << " --seed " << options.seed << " --frames "
          << n << " --width " << K.width << " --height " << K.height << (options.drift ? " --drift" : "")
-         << " (" << p.description << ")";
+         << (options.appearance != "textured" ? " --appearance " + options.appearance : "") << " ("
+         << p.description << ")";
   c.source = source.str();
 
   // Ground truth that the io reader does not know: written first, scene.yaml still comes last.

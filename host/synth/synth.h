@@ -23,6 +23,9 @@ struct SynthOptions {
   // A known level drift of the raw counts (host/synth/level_drift.h): a slow warm-up in gain and offset and
   // a jump at the first NUC freeze; the true per-frame gain and offset go to gt/levels.txt.
   bool drift = false;
+  // "textured" (the default: weathered surfaces calibrated against real frames) | "flat" (the smooth
+  // blocks of earlier versions); presets.h, Appearance.
+  std::string appearance = "textured";
 
   // Empty if valid, else the first bad field and why (std::invalid_argument from generate_* carries it).
   std::string check() const;

@@ -17,6 +17,8 @@ std::string ThermalCameraOptions::check() const {
   if (!(temporal_noise_raw >= 0)) return "temporal_noise_raw: must be >= 0";
   if (!(fixed_pattern_raw >= 0)) return "fixed_pattern_raw: must be >= 0";
   if (!(vignetting_raw >= 0)) return "vignetting_raw: must be >= 0";
+  if (!(column_noise_raw >= 0)) return "column_noise_raw: must be >= 0";
+  if (!(blur_px >= 0 && blur_px <= 5)) return "blur_px: must be in [0, 5]";
   if (!(agc_low_percentile >= 0 && agc_low_percentile < agc_high_percentile && agc_high_percentile <= 100))
     return "agc_low_percentile/agc_high_percentile: need 0 <= low < high <= 100";
   return "";
@@ -65,37 +67,78 @@ io::Image true_depth_mm(const World& world, const io::CameraIntrinsics& K,
   return depth;
 }
 
+namespace {
+
+// Separable Gaussian blur of a row-major image in place (edges clamped): the optics' point spread.
+void gaussian_blur(std::vector<double>& image, int width, int height, double sigma_px) {
+  if (sigma_px <= 0) return;
+  const int radius = static_cast<int>(std::ceil(3 * sigma_px));
+  std::vector<double> kernel(2 * radius + 1);
+  double sum = 0;
+  for (int k = -radius; k <= radius; ++k)
+    sum += kernel[k + radius] = std::exp(-k * k / (2 * sigma_px * sigma_px));
+  for (double& k : kernel) k /= sum;
+  std::vector<double> tmp(image.size());
+  auto pass = [&](const std::vector<double>& in, std::vector<double>& out, bool along_x) {
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        double acc = 0;
+        for (int k = -radius; k <= radius; ++k) {
+          const int xx = along_x ? std::clamp(x + k, 0, width - 1) : x;
+          const int yy = along_x ? y : std::clamp(y + k, 0, height - 1);
+          acc += kernel[k + radius] * in[static_cast<size_t>(yy) * width + xx];
+        }
+        out[static_cast<size_t>(y) * width + x] = acc;
+      }
+  };
+  pass(image, tmp, true);
+  pass(tmp, image, false);
+}
+
+}  // namespace
+
 io::Image render_thermal(const World& world, const ThermalCameraOptions& o,
                          const Eigen::Isometry3d& T_world_cam, uint64_t seed, uint64_t frame_index,
                          int threads) {
   const io::CameraIntrinsics K = o.intrinsics();
-  io::Image image;
-  image.width = o.width;
-  image.height = o.height;
-  image.bit_depth = 16;
-  image.data.assign(static_cast<size_t>(o.width) * o.height, 0);
-  const uint64_t frame_key =
-      hash_combine(hash_combine(seed, static_cast<uint64_t>(Stream::kThermal)), frame_index);
-  const uint64_t pattern_key =
-      hash_combine(hash_combine(seed, static_cast<uint64_t>(Stream::kThermal)), ~0ull);
-  const double r2_corner = K.cx * K.cx + K.cy * K.cy;
+  const size_t pixels = static_cast<size_t>(o.width) * o.height;
+  // The scene's radiance through the optics first, then the sensor's noise on top of it.
+  std::vector<double> radiance(pixels);
   auto render_rows = [&](int y0, int step) {
     for (int y = y0; y < o.height; y += step)
-      for (int x = 0; x < o.width; ++x) {
-        const uint64_t pixel = static_cast<uint64_t>(y) * o.width + x;
-        double raw = pixel_radiance(world, K, T_world_cam, x, y);
-        const double r2 = ((x - K.cx) * (x - K.cx) + (y - K.cy) * (y - K.cy)) / r2_corner;
-        raw -= o.vignetting_raw * r2;
-        raw += o.fixed_pattern_raw * hash_normal(hash_combine(pattern_key, pixel));
-        raw += o.temporal_noise_raw * hash_normal(hash_combine(frame_key, pixel));
-        image.data[pixel] = static_cast<uint16_t>(std::clamp(std::lround(raw), 0l, 65535l));
-      }
+      for (int x = 0; x < o.width; ++x)
+        radiance[static_cast<size_t>(y) * o.width + x] = pixel_radiance(world, K, T_world_cam, x, y);
   };
   threads = std::clamp(threads, 1, 64);
   std::vector<std::thread> pool;
   for (int i = 1; i < threads; ++i) pool.emplace_back(render_rows, i, threads);
   render_rows(0, threads);
   for (auto& t : pool) t.join();
+  gaussian_blur(radiance, o.width, o.height, o.blur_px);
+
+  const uint64_t frame_key =
+      hash_combine(hash_combine(seed, static_cast<uint64_t>(Stream::kThermal)), frame_index);
+  const uint64_t pattern_key =
+      hash_combine(hash_combine(seed, static_cast<uint64_t>(Stream::kThermal)), ~0ull);
+  const uint64_t column_key = hash_combine(pattern_key, 0xc01ull);
+  const double r2_corner = K.cx * K.cx + K.cy * K.cy;
+  io::Image image;
+  image.width = o.width;
+  image.height = o.height;
+  image.bit_depth = 16;
+  image.data.assign(pixels, 0);
+  for (int y = 0; y < o.height; ++y)
+    for (int x = 0; x < o.width; ++x) {
+      const uint64_t pixel = static_cast<uint64_t>(y) * o.width + x;
+      double raw = radiance[pixel];
+      const double r2 = ((x - K.cx) * (x - K.cx) + (y - K.cy) * (y - K.cy)) / r2_corner;
+      raw -= o.vignetting_raw * r2;
+      raw += o.fixed_pattern_raw * hash_normal(hash_combine(pattern_key, pixel));
+      if (o.column_noise_raw > 0)
+        raw += o.column_noise_raw * hash_normal(hash_combine(column_key, static_cast<uint64_t>(x)));
+      raw += o.temporal_noise_raw * hash_normal(hash_combine(frame_key, pixel));
+      image.data[pixel] = static_cast<uint16_t>(std::clamp(std::lround(raw), 0l, 65535l));
+    }
   return image;
 }
 

@@ -21,6 +21,8 @@ struct ThermalCameraOptions {
   double temporal_noise_raw = 3;    // per pixel and frame (standard deviation, counts)
   double fixed_pattern_raw = 2;     // per pixel, the same in every frame (residual non-uniformity)
   double vignetting_raw = 60;       // counts lost at the image corners (quadratic in the radius)
+  double column_noise_raw = 0;      // per column, the same in every frame (the readout's column pattern)
+  double blur_px = 0;               // the optics' blur: Gaussian sigma in pixels (0: none)
   double agc_low_percentile = 1;    // 8-bit view: this percentile maps to 0
   double agc_high_percentile = 99;  // and this one to 255
 

@@ -43,6 +43,24 @@ double joint_coverage(double x, double p, double w, double h) {
   return (pulse_integral(shifted + h / 2, p, w) - pulse_integral(shifted - h / 2, p, w)) / h;
 }
 
+// Multi-scale value noise in about [-1, 1] * sum of amplitudes; octaves below twice the footprint fade.
+double weathering(const ThermalTexture& t, double u, double v, double footprint_m) {
+  double sum = 0, amplitude = 1, scale = t.detail_scale_m;
+  for (int k = 0; k < t.detail_octaves; ++k, amplitude *= t.detail_gain, scale /= 2) {
+    const double resolved = std::clamp(scale / (2 * footprint_m + 1e-12) - 1, 0.0, 1.0);
+    if (resolved <= 0) break;
+    sum += resolved * amplitude * value_noise(u / scale, v / scale, t.seed + 0x77 * (k + 1));
+  }
+  return sum;
+}
+
+double halo_heat(const WarmHalo& h, double u, double v) {
+  const double du = std::max({h.u0_m - u, 0.0, u - h.u1_m});
+  const double below = std::max(h.v0_m - v, 0.0), above = std::max(v - h.v1_m, 0.0) / 2;
+  const double dv = std::max(below, above);
+  return h.raw * std::exp(-(du * du + dv * dv) / (2 * h.radius_m * h.radius_m));
+}
+
 }  // namespace
 
 double thermal_radiance(const ThermalTexture& t, double u, double v, double footprint_m) {
@@ -61,6 +79,13 @@ double thermal_radiance(const ThermalTexture& t, double u, double v, double foot
     const double cv = joint_coverage(v, t.cell_v_m, t.joint_m, footprint_m);
     raw += t.joint_raw * (cu + cv - cu * cv);
   }
+  if (t.detail_octaves > 0) raw += t.detail_raw * weathering(t, u, v, footprint_m);
+  if (t.streak_raw != 0) {
+    // Narrow along u (0.12 m), long along v (3 m), only the positive lobes: stains run down from sills.
+    const double s = value_noise(u / 0.12, v / 3.0, t.seed ^ 0x57ea4ull);
+    raw -= t.streak_raw * std::max(0.0, s);
+  }
+  for (const WarmHalo& h : t.halos) raw += halo_heat(h, u, v);
   if (t.spot_raw != 0) {
     const double du = u - t.spot_u_m, dv = v - t.spot_v_m;
     raw += t.spot_raw * std::exp(-(du * du + dv * dv) / (2 * t.spot_radius_m * t.spot_radius_m));

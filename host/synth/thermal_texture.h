@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 namespace litgs::host::synth {
 
@@ -10,6 +11,14 @@ enum class ThermalPattern {
   kUniform,  // smooth value noise only: large areas of almost no thermal gradient
   kBrick,    // running-bond bricks: cooler mortar joints, per-brick offsets
   kPanel,    // rectangular cladding panels (or floor tiles): cooler seams, per-panel offsets
+};
+
+// Warm air leaking around an opening (a window, a door): heat bleeding into the wall around the rectangle
+// [u0, u1] x [v0, v1], fading with the distance d to it as exp(-d^2 / 2 r^2), slower above it (heat rises).
+struct WarmHalo {
+  double u0_m = 0, v0_m = 0, u1_m = 0, v1_m = 0;
+  double raw = 0;         // counts above the wall at the rectangle's edge
+  double radius_m = 0.3;  // fading radius below and beside it; twice that above
 };
 
 struct ThermalTexture {
@@ -26,7 +35,16 @@ struct ThermalTexture {
   double spot_raw = 0;                // peak of a warm spot (engine, radiator), counts above base; 0: none
   double spot_u_m = 0, spot_v_m = 0;  // centre of the warm spot in (u, v)
   double spot_radius_m = 1;           // its Gaussian radius (metres)
-  uint64_t seed = 0;                  // varies the noise and per-cell offsets between surfaces
+  // Weathering: moisture, stains and emissivity patches as multi-scale value noise (fBm), the largest
+  // features `detail_scale_m`, each finer octave half the size at `detail_gain` of the amplitude. Octaves
+  // finer than the pixel footprint fade out, so a distant wall does not alias.
+  double detail_raw = 0;      // amplitude of the coarsest octave (counts)
+  double detail_scale_m = 1;  // its feature size (metres)
+  double detail_gain = 0.7;   // amplitude ratio between octaves
+  int detail_octaves = 0;     // 0: no weathering
+  double streak_raw = 0;      // rain runoff: vertical streaks (narrow along u, long along v), counts
+  std::vector<WarmHalo> halos;
+  uint64_t seed = 0;  // varies the noise and per-cell offsets between surfaces
 };
 
 // Radiance in raw counts at (u, v). `footprint_m` is the pixel's footprint on the surface: joints are box-

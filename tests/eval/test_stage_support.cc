@@ -68,31 +68,33 @@ TEST_F(SceneCopyTest, CopiesLinksAndLeavesOutAsAsked) {
   EXPECT_EQ(text(in / "lidar/map.pcd"), "lidar/map.pcd");
 }
 
-// Metashape and COLMAP poses are a global solution: refine gets a prior on every frame unless run.yaml says.
+// Metashape and COLMAP poses are a global solution: refine gets a prior on every frame unless run.yaml says;
+// other inputs leave it to refine, which reads the scene's poses_origin.
 TEST(RefineStagePlan, AbsolutePriorsFollowTheInputUnlessSet) {
   StageContext c;
   c.out_dir = fs::temp_directory_path() / "litgs-refine-plan";
   c.results["import"] = {{"scene", (c.out_dir / "import" / "scene").string()}};
-  const auto has_flag = [&] {
+  const auto priors = [&] {
     const auto command = refine_stage().plan(c).command;
-    return std::find(command.begin(), command.end(), "--absolute-priors") != command.end();
+    const auto at = std::find(command.begin(), command.end(), "--priors");
+    return at == command.end() || at + 1 == command.end() ? std::string("(none)") : *(at + 1);
   };
   for (const InputKind kind : {InputKind::kMetashape, InputKind::kColmap}) {
     c.kind = kind;
-    EXPECT_TRUE(has_flag()) << kind_name(kind);
+    EXPECT_EQ(priors(), "absolute") << kind_name(kind);
   }
   for (const InputKind kind :
        {InputKind::kScene, InputKind::kSynthetic, InputKind::kRosBag, InputKind::kLivo2}) {
     c.kind = kind;
-    EXPECT_FALSE(has_flag()) << kind_name(kind);
+    EXPECT_EQ(priors(), "auto") << kind_name(kind);
   }
   c.config.refine.absolute_priors = "true";
-  EXPECT_TRUE(has_flag());
+  EXPECT_EQ(priors(), "absolute");
   c.kind = InputKind::kMetashape;
   c.config.refine.absolute_priors = "false";
-  EXPECT_FALSE(has_flag());
+  EXPECT_EQ(priors(), "odometry");
   c.config.refine.absolute_priors = "yes";
-  EXPECT_THROW(has_flag(), std::invalid_argument);
+  EXPECT_THROW(priors(), std::invalid_argument);
 }
 
 TEST_F(SceneCopyTest, MissingSceneIsAnError) {
@@ -129,10 +131,10 @@ TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
   all[3].variants[0].apply(c);
   EXPECT_EQ(c.train.strategy, "adc");
   EXPECT_EQ(c.train.max_gaussians, "2000");
-  // The default tracks (auto) are the front end's: each feature type runs through eval. With synthetic
+  // The default tracks (auto) are the front end's: each feature type runs through eval. With oracle
   // tracks refine and train do not depend on the features, so the study stops after match.
   EXPECT_EQ(all[2].variants[0].until, "eval");
-  base.refine.tracks = "synthetic";
+  base.refine.tracks = "oracle";
   EXPECT_EQ(ablation_studies("features", base)[0].variants[0].until, "match");
   EXPECT_THROW(ablation_studies("colour", base), std::invalid_argument);
 }

@@ -142,7 +142,7 @@ std::string init_refined(std::string yaml) {
   return yaml.replace(yaml.find("init: random"), 12, "init: refined");
 }
 
-// A stage with nothing to do says why: no scans, no ground truth for synthetic tracks; refine without a
+// A stage with nothing to do says why: no scans, no ground truth for oracle tracks; refine without a
 // LiDAR map runs without the plane term.
 TEST(RunStages, NothingToDoSaysWhy) {
   const fs::path dir = kRoot / "why", scene = kRoot / "why-scene";
@@ -166,17 +166,17 @@ TEST(RunStages, NothingToDoSaysWhy) {
       << r.output;
   EXPECT_NE(read_json_file(dir / "refine" / "manifest.json")["command"].dump().find("--no-planes"),
             std::string::npos);
-  // Without ground truth the synthetic tracks cannot be made: refine is skipped, and its old folder goes.
+  // Without ground truth the oracle tracks cannot be made: refine is skipped, and its old folder goes.
   fs::remove_all(scene / "gt");
   r = run_engine(run_args(scene.string(), dir, config, "--until refine"));
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(stage_status(dir, "refine"),
-            "skipped: refine.tracks is synthetic and the scene has no gt/poses.txt to make them from");
+            "skipped: refine.tracks is oracle and the scene has no gt/poses.txt to make them from");
   EXPECT_FALSE(fs::exists(dir / "refine"));
   // run's default track source (auto) refines a scene without ground truth, as real data, from the front
   // end's tracks (match's sfm/); none or too few of them here, so refine keeps the priors and says so.
   std::string yaml_auto = small_run_yaml();
-  yaml_auto.replace(yaml_auto.find("tracks: synthetic"), 17, "tracks: auto");
+  yaml_auto.replace(yaml_auto.find("tracks: oracle"), 14, "tracks: auto");
   const fs::path auto_tracks = write_text(kRoot / "why-auto.yaml", yaml_auto);
   r = run_engine(run_args(scene.string(), dir, auto_tracks, "--until refine"));
   ASSERT_EQ(r.status, 0) << r.output;
@@ -192,7 +192,7 @@ TEST(RunStages, NothingToDoSaysWhy) {
   r = run_engine(run_args(scene.string(), dir, refined_init, "--until train"));
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("stage 'train' failed: train.init is refined but the refine stage did not run "
-                          "(refine.tracks is synthetic and the scene has no gt/poses.txt"),
+                          "(refine.tracks is oracle and the scene has no gt/poses.txt"),
             std::string::npos)
       << r.output;
 }

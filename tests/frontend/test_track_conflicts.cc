@@ -1,0 +1,102 @@
+// Tracks through repetitive texture (host/frontend/track_conflicts.h): a component holding two keypoints of
+// one image is split by the prior poses, keeping the observations that agree with one 3D point.
+#include <gtest/gtest.h>
+
+#include "host/frontend/track_conflicts.h"
+#include "host/frontend/tracks.h"
+
+namespace litgs::host::frontend {
+namespace {
+
+constexpr double kF = 300;
+
+// Four cameras 0.3 m apart along x, looking along +z at a wall at z = 5 with a brick every 0.25 m.
+TriangulationView camera(int i, const Eigen::Vector3d& X_world) {
+  TriangulationView v;
+  v.t_cam_world = Eigen::Vector3d(-0.3 * i, 0, 0);  // camera centre at (0.3 i, 0, 0)
+  const Eigen::Vector3d c = X_world + v.t_cam_world;
+  v.xy = {c.x() / c.z(), c.y() / c.z()};
+  return v;
+}
+
+TEST(FrontendTrackConflicts, RepetitiveTextureKeepsTheConsistentBrickAndDropsItsNeighbour) {
+  const Eigen::Vector3d brick(0.5, 0.1, 5), neighbour(0.75, 0.1, 5);
+  // Observations sorted by image; image 2 also saw the neighbour brick, matched by mistake to image 1.
+  io::SfmTrack component;
+  component.observations = {{0, 0}, {1, 0}, {2, 0}, {2, 1}, {3, 0}};
+  const std::vector<Eigen::Vector3d> seen = {brick, brick, brick, neighbour, brick};
+  const std::vector<std::array<size_t, 2>> edges = {{0, 1}, {1, 2}, {1, 3}, {2, 4}};
+  const ObservationView view = [&](const io::SfmObservation& o) -> std::optional<TriangulationView> {
+    for (size_t k = 0; k < component.observations.size(); ++k)
+      if (component.observations[k].image == o.image && component.observations[k].keypoint == o.keypoint)
+        return camera(static_cast<int>(o.image), seen[k]);
+    return std::nullopt;
+  };
+  const ConflictSplit split = split_conflicting_component(component, edges, view, kF, kF, {});
+  ASSERT_EQ(split.tracks.size(), 1u);
+  EXPECT_EQ(split.tracks[0].observations, (std::vector<io::SfmObservation>{{0, 0}, {1, 0}, {2, 0}, {3, 0}}));
+  EXPECT_EQ(split.dropped, 1u);
+}
+
+TEST(FrontendTrackConflicts, TwoBricksChainedByOneWrongMatchBecomeTwoTracks) {
+  // Brick A seen by images 0..2, brick B by images 1..3; a wrong match joined A in image 2 with B in image
+  // 1. The split gives both tracks back whole.
+  const Eigen::Vector3d A(0.5, 0.1, 5), B(0.75, -0.2, 5);
+  io::SfmTrack component;
+  component.observations = {{0, 0}, {1, 0}, {1, 1}, {2, 0}, {2, 1}, {3, 1}};
+  const std::vector<Eigen::Vector3d> seen = {A, A, B, A, B, B};
+  const std::vector<std::array<size_t, 2>> edges = {{0, 1}, {1, 3}, {2, 4}, {4, 5}, {2, 3}};
+  const ObservationView view = [&](const io::SfmObservation& o) -> std::optional<TriangulationView> {
+    for (size_t k = 0; k < component.observations.size(); ++k)
+      if (component.observations[k].image == o.image && component.observations[k].keypoint == o.keypoint)
+        return camera(static_cast<int>(o.image), seen[k]);
+    return std::nullopt;
+  };
+  const ConflictSplit split = split_conflicting_component(component, edges, view, kF, kF, {});
+  ASSERT_EQ(split.tracks.size(), 2u);
+  EXPECT_EQ(split.dropped, 0u);
+  for (const auto& t : split.tracks) EXPECT_EQ(t.observations.size(), 3u);
+}
+
+TEST(FrontendTrackConflicts, UnposedImagesAreNeverSplitIntoATrack) {
+  io::SfmTrack component;
+  component.observations = {{0, 0}, {0, 1}, {1, 0}};
+  const ConflictSplit split = split_conflicting_component(
+      component, {{0, 2}, {1, 2}}, [](const io::SfmObservation&) { return std::nullopt; }, kF, kF, {});
+  EXPECT_TRUE(split.tracks.empty());
+  EXPECT_EQ(split.dropped, 3u);
+}
+
+TEST(FrontendTracks, WithASplitterConflictsAreSplitAndTheLostMatchesCounted) {
+  // A chain 0:0 - 1:0 - 2:0 and a match 0:0 - 2:1: with a splitter the component {0:0, 1:0, 2:0, 2:1}
+  // reaches it whole (this splitter keeps image 2's keypoint 0); 1:1 - 2:2 is a track of its own.
+  std::vector<io::SfmPairMatches> pairs = {
+      {0, 1, {{0, 0, true}}},
+      {1, 2, {{0, 0, true}, {1, 2, true}}},
+      {0, 2, {{0, 1, true}}},
+  };
+  size_t calls = 0;
+  const ComponentSplitter split = [&](const io::SfmTrack& c,
+                                      const std::vector<std::array<size_t, 2>>& edges) {
+    ++calls;
+    EXPECT_EQ(c.observations, (std::vector<io::SfmObservation>{{0, 0}, {1, 0}, {2, 0}, {2, 1}}));
+    EXPECT_EQ(edges.size(), 3u);
+    ConflictSplit s;
+    s.tracks.push_back({});
+    s.tracks[0].observations = {{0, 0}, {1, 0}, {2, 0}};
+    s.dropped = 1;
+    return s;
+  };
+  const TrackSet t = build_tracks({1, 2, 3}, pairs, {}, split);
+  EXPECT_EQ(calls, 1u);
+  EXPECT_EQ(t.matches, 4u);
+  EXPECT_EQ(t.conflicts, 1u);  // the 0:0 - 2:1 match
+  EXPECT_EQ(t.conflicting_components, 1u);
+  EXPECT_EQ(t.conflict_observations_kept, 3u);
+  EXPECT_EQ(t.conflict_observations_dropped, 1u);
+  ASSERT_EQ(t.tracks.size(), 2u);
+  EXPECT_EQ(t.tracks[1].observations, (std::vector<io::SfmObservation>{{1, 1}, {2, 2}}));
+}
+
+}  // namespace
+}  // namespace litgs::host::frontend

@@ -1,0 +1,80 @@
+// The guard against a refinement that makes the poses worse (host/refine/holdout_guard.h): tracks held back
+// from the solve judge it, without ground truth.
+#include <gtest/gtest.h>
+
+#include "host/refine/holdout_guard.h"
+#include "refine_test_scene.h"
+
+namespace litgs::host::refine::testing {
+namespace {
+
+TEST(RefineHoldoutGuard, HoldsBackEveryNthTrack) {
+  std::vector<TrackPoint> points(20);
+  for (size_t i = 0; i < points.size(); ++i) points[i].X = Eigen::Vector3d(static_cast<double>(i), 0, 0);
+  HoldoutOptions o;
+  o.every = 4;
+  const std::vector<TrackPoint> held = hold_out_tracks(points, o);
+  ASSERT_EQ(held.size(), 5u);
+  EXPECT_EQ(points.size(), 15u);
+  EXPECT_EQ(held[0].X.x(), 3);
+  EXPECT_EQ(held[4].X.x(), 19);
+  o.every = 1;
+  EXPECT_THROW(hold_out_tracks(points, o), std::invalid_argument);
+}
+
+TEST(RefineHoldoutGuard, AGoodRefinementIsKeptAndExplainsTheHeldBackTracksBetter) {
+  TestScene s;
+  make_test_scene(s, {});
+  std::vector<CameraPose> poses = s.input.priors;
+  const RefineReport r = refine(s.input, poses, {});
+  EXPECT_EQ(r.outcome, "refined");
+  ASSERT_TRUE(r.holdout.measured);
+  EXPECT_GT(r.holdout.tracks_used, 10u);
+  EXPECT_LT(r.holdout.refined_median_px, r.holdout.prior_median_px);
+  EXPECT_LT(ate(poses, s.truth), ate(s.input.priors, s.truth));
+}
+
+// Built to fail: the tracks the solve sees are corrupted in the second half of the sequence (every
+// observation 12 px to the right, as a wrong time offset or a bad calibration would do), the held-back ones
+// are not. The solve turns those cameras to fit; the held-back tracks show it, and the priors are kept.
+TEST(RefineHoldoutGuard, ARefinementThatMakesThePosesWorseKeepsThePriors) {
+  TestScene s;
+  TestSceneOptions so;
+  so.drift_per_m = 0.0005;
+  so.rotation_drift_per_m = 0.0002;
+  so.anchors = 0;
+  make_test_scene(s, so);
+  const HoldoutOptions guard;
+  for (size_t i = 0; i < s.input.points.size(); ++i) {
+    if (i % guard.every == guard.every - 1) continue;  // held back: left true
+    for (auto& ob : s.input.points[i].obs)
+      if (ob.frame >= 20) ob.uv.x() += 12;
+  }
+  const std::vector<CameraPose> priors = s.input.priors;
+  std::vector<CameraPose> poses = priors;
+  RefineOptions o;
+  o.use_planes = false;  // nothing else to hold the cameras: the corrupted tracks win the solve
+  const RefineReport r = refine(s.input, poses, o);
+  std::cout << "  " << r.status << "\n";
+  ASSERT_TRUE(r.holdout.measured);
+  EXPECT_GT(r.holdout.refined_median_px, r.holdout.prior_median_px);
+  EXPECT_EQ(r.outcome, "kept the priors");
+  for (size_t f = 0; f < poses.size(); ++f) EXPECT_EQ(poses[f].p, priors[f].p) << "frame " << f;
+
+  // The same solve without the guard returns the corrupted poses: what the guard prevented.
+  TestScene s2;
+  make_test_scene(s2, so);
+  for (size_t i = 0; i < s2.input.points.size(); ++i) {
+    if (i % guard.every == guard.every - 1) continue;
+    for (auto& ob : s2.input.points[i].obs)
+      if (ob.frame >= 20) ob.uv.x() += 12;
+  }
+  std::vector<CameraPose> unguarded = s2.input.priors;
+  o.holdout.every = 0;
+  const RefineReport r2 = refine(s2.input, unguarded, o);
+  EXPECT_EQ(r2.outcome, "refined");
+  EXPECT_GT(ate(unguarded, s2.truth), ate(s2.input.priors, s2.truth));
+}
+
+}  // namespace
+}  // namespace litgs::host::refine::testing
