@@ -15,10 +15,14 @@ void add_refine_command(CLI::App& app) {
       app.add_subcommand("refine", "Refine the scene's poses: anchors, LiDAR planes, bundle adjustment");
   auto scene = std::make_shared<std::filesystem::path>();
   auto o = std::make_shared<host::refine::SceneRefineOptions>();
-  auto anchors = std::make_shared<bool>(true);
   auto planes = std::make_shared<bool>(true);
   c->add_option("scene", *scene, "Scene directory")->required()->check(CLI::ExistingDirectory);
-  c->add_flag("!--no-anchors", *anchors, "No anchor weights or anchor priors");
+  c->add_option("--anchors", o->anchors,
+                "The estimator's anchors (weights and priors): auto (with oracle tracks only; on the front "
+                "end's tracks they made the poses worse) | on | off")
+      ->capture_default_str();
+  auto no_anchors = std::make_shared<bool>(false);
+  c->add_flag("--no-anchors", *no_anchors, "The same as --anchors off");
   c->add_flag("!--no-planes", *planes, "No LiDAR point-to-plane term");
   c->add_option("--alpha-min", o->refine.weights.alpha_min,
                 "Anchors' share of a frame's weight, slowest frames")
@@ -57,6 +61,14 @@ void add_refine_command(CLI::App& app) {
        "auto (from scene.yaml's poses_origin: Metashape and COLMAP imports are absolute) | absolute (a "
        "pose prior on every frame) | odometry (relative priors between neighbouring frames)")
       ->capture_default_str();
+  c->add_option("--odometry-rotation-sigma", o->refine.ba.odometry_sigma_r_rad,
+                "Odometry priors: orientation prior on every frame, radians (plus 0.0005 per metre travelled; 0: "
+                "off)")
+      ->capture_default_str();
+  c->add_option("--scan-check-every", o->scan_check.every,
+                "Check the LiDAR scans of every Nth frame against the map's planes after the solve; refined "
+                "poses that fit them worse than the priors are not kept (0: no check)")
+      ->capture_default_str();
   c->add_flag("--absolute-priors", *absolute, "The same as --priors absolute");
   c->add_option("--control-points", o->control_points_csv,
                 "Surveyed control points (CSV: ID,X,Y,Z,accuracy) to check the poses with (needs --markers)")
@@ -64,9 +76,9 @@ void add_refine_command(CLI::App& app) {
   c->add_option("--markers", o->markers_xml,
                 "Metashape camera XML with the control points' image observations")
       ->check(CLI::ExistingFile);
-  c->callback([scene, o, anchors, planes, absolute] {
+  c->callback([scene, o, no_anchors, planes, absolute] {
     if (*absolute) o->priors = "absolute";
-    o->refine.use_anchors = *anchors;
+    if (*no_anchors) o->anchors = "off";
     o->refine.use_planes = *planes;
     const host::refine::SceneRefineReport r = host::refine::refine_scene(*scene, *o);
     const auto& rr = r.refine;

@@ -87,7 +87,8 @@ struct RefineReport {
   size_t untriangulated_points = 0;  // inactive from the start (non-finite or fewer than 2 observations)
   size_t weak_frames = 0;  // frames with fewer than min_frame_observations active observations at the start
   double median_frame_observations = 0;
-  size_t fewest_frame_observations = 0;  // over the frames not frozen, at the start
+  size_t fewest_frame_observations = 0;    // over the frames with any observation, at the start
+  size_t frames_without_observations = 0;  // not detected as frozen here (e.g. skipped by the front end)
   AnchorAssociationReport anchor_association;
   size_t guarded_anchor_covariances = 0;
   double anchor_weight_median_raw = 0;  // m^-3

@@ -151,6 +151,13 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                         {"prior_median_px", r.holdout.prior_median_px},
                         {"refined_median_px", r.holdout.refined_median_px},
                         {"keep_refined", r.holdout.keep_refined}}},
+                      {"scan_check",
+                       {{"scans", sr.scans.scans},
+                        {"points", sr.scans.points},
+                        {"measured", sr.scans.measured},
+                        {"prior_mean_m", sr.scans.prior_mean_m},
+                        {"refined_mean_m", sr.scans.refined_mean_m},
+                        {"keep_refined", sr.scans.keep_refined}}},
                       {"stopped_early", r.stopped_early},
                       {"frames", r.frames},
                       {"points", r.points},
@@ -160,6 +167,7 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                       {"weak_frames", r.weak_frames},
                       {"median_frame_observations", r.median_frame_observations},
                       {"fewest_frame_observations", r.fewest_frame_observations},
+                      {"frames_without_observations", r.frames_without_observations},
                       {"anchors", r.anchors},
                       {"anchored_tracks", r.anchor_association.anchored_tracks},
                       {"anchors_in_view", r.anchor_association.anchors_in_view},
@@ -176,7 +184,7 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                       {"priors", sr.priors},
                       {"options",
                        {{"rounds", o.refine.rounds},
-                        {"anchors", o.refine.use_anchors},
+                        {"anchors", sr.anchors},
                         {"planes", o.refine.use_planes},
                         {"alpha_min", o.refine.weights.alpha_min},
                         {"alpha_max", o.refine.weights.alpha_max},
@@ -202,6 +210,32 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
   return j;
 }
 
+// The scans of every Nth frame (LiDAR stamps: frame time + time_offset_cam_lidar_s, within 1 ms) against the
+// map's planes through both pose sets; refined poses that fit them worse give way to the priors.
+void guard_with_scans(const fs::path& dir, const io::Scene& scene, const std::vector<CameraPose>& priors,
+                      const ScanCheckOptions& o, PlanarMap& planar, RefineReport& refine_report,
+                      ScanVerdict& verdict, std::vector<CameraPose>& poses) {
+  if (planar.points.empty()) planar = fit_planes(scene.map->positions, {});
+  std::vector<CheckedScan> scans;
+  for (size_t f = 0; f < scene.frames.size(); f += o.every) {
+    const double t = scene.frames[f].t_s + scene.config.time_offset_cam_lidar_s;
+    for (const auto& s : scene.scans)
+      if (std::abs(s.t_s - t) < 1e-3) {
+        scans.push_back({f, io::read_pcd(dir / s.file).positions});
+        break;
+      }
+  }
+  verdict = judge_on_scans(planar, scans, priors, poses, scene.config.T_cam_lidar, o);
+  refine_report.notes.push_back(verdict.summary);
+  if (!verdict.keep_refined) {
+    poses = priors;
+    refine_report.outcome = "kept the priors";
+    refine_report.status = "kept the priors: the refined poses put the LiDAR scans farther from the map's planes "
+                           "(mean " + std::to_string(verdict.refined_mean_m) + " m against " +
+                           std::to_string(verdict.prior_mean_m) + " m through the priors)";
+  }
+}
+
 }  // namespace
 
 SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o) {
@@ -213,6 +247,8 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   if (o.priors != "auto" && o.priors != "absolute" && o.priors != "odometry")
     throw std::invalid_argument("refine: priors must be auto, absolute or odometry, not '" + o.priors + "'");
   RefineOptions refine_options = o.refine;
+  if (o.anchors != "auto" && o.anchors != "on" && o.anchors != "off")
+    throw std::invalid_argument("refine: anchors must be auto, on or off, not '" + o.anchors + "'");
   refine_options.ba.absolute_priors =
       o.priors == "auto" ? scene.config.poses_origin == io::PoseOrigin::kAbsolute : o.priors == "absolute";
   if (o.tracks == "synthetic")
@@ -245,6 +281,8 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
     report.has_truth = true;
   }
   report.tracks = source;
+  refine_options.use_anchors = o.anchors == "on" || (o.anchors == "auto" && source == "oracle");
+  report.anchors = refine_options.use_anchors;
   report.priors = std::string(refine_options.ba.absolute_priors ? "absolute" : "odometry") +
                   (o.priors == "auto" ? " (scene.yaml poses_origin)" : " (asked for)");
   if (source == "sfm") {
@@ -273,6 +311,8 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   }
   std::vector<CameraPose> poses = in.priors;
   report.refine = refine(in, poses, refine_options);
+  if (report.refine.outcome == "refined" && o.scan_check.every > 0 && scene.map && !scene.scans.empty())
+    guard_with_scans(dir, scene, in.priors, o.scan_check, planar, report.refine, report.scans, poses);
 
   if (markers)
     report.control = control_point_errors(*markers, control_points, scene.config.world_offset_m, in.camera,

@@ -10,6 +10,7 @@
 
 #include "host/refine/control_points.h"
 #include "host/refine/refine.h"
+#include "host/refine/scan_check.h"
 #include "host/refine/sfm_tracks.h"
 #include "host/refine/synthetic_tracks.h"
 
@@ -27,6 +28,15 @@ struct SceneRefineOptions {
   // a pose prior on every frame; odometry: relative priors between neighbours); "absolute" | "odometry"
   // override it. refine.absolute_priors is set from it.
   std::string priors = "auto";
+  // The upstream estimator's anchors: "auto" uses them with oracle tracks only. On the front end's own
+  // tracks an anchor (a map point at a high gradient) is associated with whichever keypoint lies within a
+  // pixel or two of it, rarely the same physical point, and the anchor priors pulled the synthetic facade's
+  // poses from 9-18 mm to 20-34 mm (without them: 7-9 mm; docs/refinement.md). "on" | "off" override it;
+  // refine.use_anchors is set from it.
+  std::string anchors = "auto";
+  // After a solve, the LiDAR scans of every Nth frame against the map's planes (scan_check.h): refined
+  // poses that put them farther from the map than the priors do are not kept.
+  ScanCheckOptions scan_check;
   // With both: the surveyed control points' reprojection through the prior and the refined poses.
   std::filesystem::path control_points_csv, markers_xml;
 };
@@ -38,9 +48,11 @@ struct SceneRefineReport {
   double plane_rms_true_m = -1;  // refined points on true planes (gt/map.pcd plane ids): RMS distance
   size_t points_written = 0;
   std::string tracks;  // the source used: "sfm" or "oracle"
-  std::string priors;  // the priors used: "absolute" or "odometry", and why
+  std::string priors;   // the priors used: "absolute" or "odometry", and why
+  bool anchors = false;  // used
   SfmTrackReport sfm;  // with tracks == "sfm"
   std::optional<ControlPointErrors> control;
+  ScanVerdict scans;
 };
 
 SceneRefineReport refine_scene(const std::filesystem::path& scene_dir, const SceneRefineOptions& options);

@@ -42,7 +42,7 @@ struct RunConfig {
   struct Refine {
     bool enabled = true;
     std::string tracks = "auto";
-    bool anchors = true;
+    std::string anchors = "auto";
     bool planes = true;
     uint32_t rounds = 5;  // refine's default (host/refine/refine.h)
     // auto: a pose prior on every frame (`refine --absolute-priors`) when INPUT is a Metashape or COLMAP
@@ -112,7 +112,9 @@ void for_each_field(Config& c, F&& f) {
   f("refine", "tracks", c.refine.tracks,
     "track source, as `refine --tracks`: auto or sfm (the front end's sfm/, written by match) | oracle "
     "(projected from a synth scene's true poses: an experiment, not the method)");
-  f("refine", "anchors", c.refine.anchors, "anchor weights and priors");
+  f("refine", "anchors", c.refine.anchors,
+    "anchor weights and priors, as `refine --anchors`: auto (with oracle tracks only: on the front end's "
+    "tracks they made the poses worse, docs/refinement.md) | on | off");
   f("refine", "planes", c.refine.planes, "LiDAR point-to-plane term (off where the scene has no LiDAR map)");
   f("refine", "rounds", c.refine.rounds, "rounds of association, solve and rejection");
   f("refine", "absolute_priors", c.refine.absolute_priors,

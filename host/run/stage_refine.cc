@@ -42,7 +42,7 @@ StagePlan plan(const StageContext& c) {
   plan_on_scene_copy(
       c, "refine", SceneCopy{scene, {"poses.txt", "poses_prior.txt"}, {"refine", "refine.json"}},
       option_flags(flags_from,
-                   {"tracks", "anchors=!--no-anchors", "planes=!--no-planes", "rounds", "threads", "priors"}),
+                   {"tracks", "anchors", "planes=!--no-planes", "rounds", "threads", "priors"}),
       o.extra_args, p);
   return p;
 }

@@ -74,6 +74,7 @@ TEST(RefineStagePlan, AbsolutePriorsFollowTheInputUnlessSet) {
   StageContext c;
   c.out_dir = fs::temp_directory_path() / "litgs-refine-plan";
   c.results["import"] = {{"scene", (c.out_dir / "import" / "scene").string()}};
+  fs::create_directories(c.out_dir / "import" / "scene" / "sfm");  // match ran: refine has tracks
   const auto priors = [&] {
     const auto command = refine_stage().plan(c).command;
     const auto at = std::find(command.begin(), command.end(), "--priors");

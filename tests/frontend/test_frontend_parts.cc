@@ -96,6 +96,39 @@ TEST(FrontendTriangulation, PointBehindTheCamerasIsRejected) {
   EXPECT_NE(p.outcome, TriangulationOutcome::kOk);
 }
 
+// A Gaussian blob centred between pixels: the detector's keypoint sits on it (pixel centres at integer
+// coordinates, the scene camera's convention) within a tenth of a pixel.
+TEST(FrontendFeatures, SiftKeypointsSitOnTheFeature) {
+  for (const FeatureType type : {FeatureType::kSift}) {
+    for (const auto& [cx, cy] : {std::pair{40.3, 30.7}, std::pair{52.5, 41.0}, std::pair{61.0, 35.25}}) {
+      Gray8 image;
+      image.width = 100;
+      image.height = 80;
+      for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) {
+          const double r2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
+          image.pixels.push_back(static_cast<uint8_t>(std::lround(30 + 200 * std::exp(-r2 / (2 * 4.0 * 4.0)))));
+        }
+      FeatureOptions o;
+      o.type = type;
+      o.grid_cols = o.grid_rows = 0;
+      const ImageFeatures f = detect_features(image, o);
+      ASSERT_FALSE(f.keypoints.empty()) << feature_name(type);
+      double best = 1e9, dx = 0, dy = 0;
+      for (const auto& k : f.keypoints) {
+        const double d = std::hypot(k.x - cx, k.y - cy);
+        if (d < best) {
+          best = d;
+          dx = k.x - cx;
+          dy = k.y - cy;
+        }
+      }
+      EXPECT_LT(std::abs(dx), 0.1) << feature_name(type) << " at " << cx << ", " << cy;
+      EXPECT_LT(std::abs(dy), 0.1) << feature_name(type) << " at " << cx << ", " << cy;
+    }
+  }
+}
+
 TEST(FrontendTracks, UnionFindJoinsChainsAndRefusesTwoKeypointsOfOneImage) {
   // Image 0 kp 0 - image 1 kp 0 - image 2 kp 0: one track of three. Then image 2 kp 1 - image 0 kp 0 would
   // put two keypoints of image 2 in that track: a conflict, dropped. Image 1 kp 1 - image 2 kp 1: a second

@@ -63,6 +63,60 @@ TEST(SynthTexture, BrickJointsAreCoolerAndFadeToTheMeanWhenFiltered) {
   EXPECT_NEAR(thermal_radiance(t, 0.1, 0.03, 2.6), expected, 1.0);
 }
 
+TEST(SynthTexture, WeatheringIsDeterministicAndFadesWhenThePixelIsCoarserThanItsOctaves) {
+  ThermalTexture t;
+  t.noise_raw = 0;
+  t.detail_raw = 30;
+  t.detail_octaves = 6;
+  t.detail_scale_m = 1;
+  t.seed = 7;
+  // A pure function of (u, v, footprint, seed).
+  EXPECT_EQ(thermal_radiance(t, 0.37, 1.21, 0.01), thermal_radiance(t, 0.37, 1.21, 0.01));
+  // Spread over a patch: fine footprints see every octave, a footprint coarser than the largest octave
+  // sees none (the surface's mean).
+  auto spread = [&](double footprint) {
+    double lo = 1e9, hi = -1e9;
+    for (int i = 0; i < 400; ++i) {
+      const double r = thermal_radiance(t, 0.013 * i, 0.007 * i, footprint);
+      lo = std::min(lo, r);
+      hi = std::max(hi, r);
+    }
+    return hi - lo;
+  };
+  EXPECT_GT(spread(0.002), 20.0);
+  EXPECT_EQ(spread(1.0), 0.0);
+  t.seed = 8;
+  EXPECT_NE(thermal_radiance(t, 0.37, 1.21, 0.01), [&] {
+    ThermalTexture u = t;
+    u.seed = 7;
+    return thermal_radiance(u, 0.37, 1.21, 0.01);
+  }());
+}
+
+TEST(SynthTexture, HeatLeaksAroundAnOpeningAndRisesAboveIt) {
+  ThermalTexture t;
+  t.noise_raw = 0;
+  t.halos.push_back({1.0, 1.0, 2.0, 2.0, 50, 0.3});
+  EXPECT_NEAR(thermal_radiance(t, 1.5, 2.0, 0), t.base_raw + 50, 1e-9);  // at the edge
+  const double above = thermal_radiance(t, 1.5, 2.3, 0), below = thermal_radiance(t, 1.5, 0.7, 0);
+  EXPECT_GT(above, below);  // heat rises: the halo reaches twice as far above
+  EXPECT_NEAR(below - t.base_raw, 50 * std::exp(-0.5), 1e-9);
+  EXPECT_NEAR(thermal_radiance(t, 5, 5, 0), t.base_raw, 1e-6);
+}
+
+TEST(SynthPresets, TheTexturedAppearanceAddsDetailTheFlatOneLacks) {
+  for (const std::string& name : preset_names()) {
+    const Preset textured = make_preset(name, 1), flat = make_preset(name, 1, Appearance::kFlat);
+    ASSERT_EQ(textured.world.rects.size(), flat.world.rects.size()) << name;  // the same geometry
+    for (const auto& t : flat.world.textures) EXPECT_EQ(t.detail_octaves, 0) << name;
+    for (const auto& t : textured.world.textures) EXPECT_GT(t.detail_octaves, 0) << name;
+    EXPECT_GT(textured.camera.blur_px, 0) << name;
+    EXPECT_EQ(flat.camera.blur_px, 0) << name;
+  }
+  EXPECT_EQ(parse_appearance("flat"), Appearance::kFlat);
+  EXPECT_THROW(parse_appearance("shiny"), std::invalid_argument);
+}
+
 TEST(SynthGeometry, RectHitsHolesAndCylinders) {
   World w;
   w.add_texture({});
