@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cctype>
 #include <map>
 #include <stdexcept>
 
@@ -23,6 +24,16 @@ void BagImportOptions::check() const {
   if (topics.thermal.empty()) throw std::invalid_argument("topics.thermal: required");
   if (image_extension != ".png" && image_extension != ".tiff")
     throw std::invalid_argument("image_extension: must be .png or .tiff, got " + image_extension);
+}
+
+std::string m2dgr_imu_block(const std::string& topic) {
+  std::string t = topic;
+  for (char& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (t.find("handsfree") != std::string::npos) return "Handsfree IMU";
+  if (t.find("camera") != std::string::npos || t.find("realsense") != std::string::npos)
+    return "realsense d435i IMU";
+  if (t.find("xsens") != std::string::npos || t == "/imu/data") return "Xsens IMU";
+  return "";
 }
 
 BagImportReport import_bag(const BagImportOptions& o) {
@@ -49,7 +60,26 @@ BagImportReport import_bag(const BagImportOptions& o) {
   T_cam_lidar.topRightCorner<3, 1>() =
       -cam.T_lidar_cam.topLeftCorner<3, 3>().transpose() * cam.T_lidar_cam.topRightCorner<3, 1>();
   scene.config.T_cam_lidar = T_cam_lidar;
-  report.notes.push_back("T_imu_lidar is identity: the calibration's camera block does not give it");
+  const std::string imu_block = o.imu_block == "auto" ? m2dgr_imu_block(o.topics.imu) : o.imu_block;
+  if (imu_block.empty() || imu_block == "none") {
+    report.notes.push_back("T_imu_lidar is identity: " +
+                           (imu_block.empty()
+                                ? "the IMU topic '" + o.topics.imu + "' names no IMU block of " +
+                                      o.calib.filename().string() + " (--imu-block NAME)"
+                                : std::string("--imu-block none")));
+  } else {
+    const M2dgrCamera imu = read_m2dgr_camera(o.calib, imu_block);
+    if (!imu.has_extrinsic) fail(o.calib, 0, "block '" + imu_block + "' lacks its extrinsic [to LIDAR]");
+    // "Extrinsic [to LIDAR]" maps the sensor's points into the LiDAR frame: T_lidar_imu.
+    Eigen::Matrix4d T_imu_lidar = Eigen::Matrix4d::Identity();
+    T_imu_lidar.topLeftCorner<3, 3>() = imu.T_lidar_cam.topLeftCorner<3, 3>().transpose();
+    T_imu_lidar.topRightCorner<3, 1>() =
+        -imu.T_lidar_cam.topLeftCorner<3, 3>().transpose() * imu.T_lidar_cam.topRightCorner<3, 1>();
+    scene.config.T_imu_lidar = T_imu_lidar;
+    report.notes.push_back("T_imu_lidar from the block '" + imu_block + "' (IMU topic " + o.topics.imu +
+                           "): the IMU sits " + format_double(imu.T_lidar_cam.topRightCorner<3, 1>().norm()) +
+                           " m from the LiDAR");
+  }
 
   // One pass over the bag; frames and scans are staged as files, keyed by time.
   const fs::path staging = o.out / ".bag-staging";

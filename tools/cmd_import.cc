@@ -85,6 +85,11 @@ void add_import_bag(CLI::App* import) {
   c->add_option("--bag", o->bag, "ROS 1 bag")->required()->check(CLI::ExistingFile);
   c->add_option("--calib", o->calib, "M2DGR calibration_results.txt")->required()->check(CLI::ExistingFile);
   c->add_option("--calib-block", o->calib_block, "Camera block of the calibration")->capture_default_str();
+  c->add_option(
+       "--imu-block", o->imu_block,
+       "IMU block of the calibration for T_imu_lidar: auto (by the IMU topic), none (identity), or a "
+       "block name such as 'Xsens IMU'")
+      ->capture_default_str();
   c->add_option("--out", o->out, "Scene directory to write")->required();
   c->add_option("--thermal-topic", o->topics.thermal, "sensor_msgs/Image topic")->capture_default_str();
   c->add_option("--lidar-topic", o->topics.lidar, "sensor_msgs/PointCloud2 topic")->capture_default_str();

@@ -61,9 +61,10 @@ void add_refine_command(CLI::App& app) {
        "auto (from scene.yaml's poses_origin: Metashape and COLMAP imports are absolute) | absolute (a "
        "pose prior on every frame) | odometry (relative priors between neighbouring frames)")
       ->capture_default_str();
-  c->add_option("--odometry-rotation-sigma", o->refine.ba.odometry_sigma_r_rad,
-                "Odometry priors: orientation prior on every frame, radians (plus 0.0005 per metre travelled; 0: "
-                "off)")
+  c->add_option(
+       "--odometry-rotation-sigma", o->refine.ba.odometry_sigma_r_rad,
+       "Odometry priors: orientation prior on every frame, radians (plus 0.0005 per metre travelled; 0: "
+       "off)")
       ->capture_default_str();
   c->add_option("--scan-check-every", o->scan_check.every,
                 "Check the LiDAR scans of every Nth frame against the map's planes after the solve; refined "
@@ -91,6 +92,8 @@ void add_refine_command(CLI::App& app) {
       std::cout << " (" << rr.after.behind_camera << " observations behind their camera left out)";
     std::cout << ", plane RMS " << rr.before.plane_rms_m << " -> " << rr.after.plane_rms_m << " m";
     if (r.has_truth) std::cout << "; ATE " << r.ate_before_m << " -> " << r.ate_after_m << " m";
+    if (r.ate_rejected_m >= 0)
+      std::cout << " (the solve the guards turned down: " << r.ate_rejected_m << " m)";
     std::cout << "\n";
     if (r.control)
       std::cout << "control points: median reprojection " << r.control->median_prior_px

@@ -184,9 +184,11 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
       if (f > 0) travelled += (priors[f].p - priors[f - 1].p).norm();
       if (!variable(f)) continue;
       add_pose(f);
-      auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(new AbsolutePose{
-          priors[f].q, priors[f].p, 0.0, 1 / (w.odometry_sigma_r_rad + w.odometry_sigma_r_per_m * travelled)});
-      problem.AddResidualBlock(cost, new ceres::CauchyLoss(1.0), poses[f].q.coeffs().data(), poses[f].p.data());
+      auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(
+          new AbsolutePose{priors[f].q, priors[f].p, 0.0,
+                           1 / (w.odometry_sigma_r_rad + w.odometry_sigma_r_per_m * travelled)});
+      problem.AddResidualBlock(cost, new ceres::CauchyLoss(1.0), poses[f].q.coeffs().data(),
+                               poses[f].p.data());
       ++s.prior_residuals;
     }
   }

@@ -290,6 +290,7 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
     report.holdout = judge_on_held_out(held_out, in.priors, poses, in.camera, o.holdout);
     report.notes.push_back(report.holdout.summary);
     if (!report.holdout.keep_refined) {
+      report.rejected_poses = poses;
       poses = in.priors;
       report.outcome = "kept the priors";
       report.status = "kept the priors: the refined poses explain the held-back tracks worse (median " +

@@ -15,10 +15,11 @@
 namespace litgs::host::refine {
 
 struct RefineOptions {
-  // Rounds of association, solve and rejection. 5, not 3: the anchors join in the second round and need
-  // rounds after it (synthetic street ATE 32 -> 10 mm, facade 6.1 -> 5.8 mm, corridor 3 mm either way; DUNR's
-  // control points 2.99 -> 2.96 px; docs/experiments.md, 2026-11-25 night).
-  size_t rounds = 5;
+  // Rounds of association, solve and rejection. 8: on the front end's own tracks (more wrong matches than
+  // the oracle's) the rejection between rounds keeps paying after round 5 (synthetic facade seeds 3 and 4:
+  // 18 -> 7 mm and 10 -> 6 mm from 5 to 8 rounds without the scan check; docs/results.md). With oracle
+  // tracks 5 were enough (docs/experiments.md, 2026-11-25 night).
+  size_t rounds = 8;
   bool use_anchors = true, use_planes = true;
   size_t window = 20;             // frames per local window (step: half of it); 0: no local pass
   double reject_k = 3;            // rejection bound: median + k * 1.4826 * MAD ...
@@ -82,6 +83,7 @@ struct RefineReport {
   // judged it worse; "stopped": it stopped before or during the solve (the priors or the last good round).
   std::string outcome = "refined";
   HoldoutVerdict holdout;
+  std::vector<CameraPose> rejected_poses;  // the solve's poses when a guard kept the priors instead
   size_t frames = 0, points = 0, observations = 0, anchors = 0;
   size_t frozen_frames = 0;          // frames whose observations repeat the previous frame's: dropped
   size_t untriangulated_points = 0;  // inactive from the start (non-finite or fewer than 2 observations)

@@ -69,7 +69,8 @@ ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>&
       const Eigen::Vector3d x_cam = R_cl * s.points_lidar[k] + t_cl;
       const double dp = distance(priors[s.frame].q * x_cam + priors[s.frame].p);
       const double dr = distance(refined[s.frame].q * x_cam + refined[s.frame].p);
-      if (!std::isfinite(dp) || !std::isfinite(dr) || dp > o.max_distance_m || dr > o.max_distance_m) continue;
+      if (!std::isfinite(dp) || !std::isfinite(dr) || dp > o.max_distance_m || dr > o.max_distance_m)
+        continue;
       sum_prior += dp;
       sum_refined += dr;
       ++v.points;
@@ -82,11 +83,14 @@ ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>&
     v.keep_refined = v.refined_mean_m <= (1 + o.tolerance) * v.prior_mean_m;
   }
   char text[320];
-  std::snprintf(text, sizeof text,
-                "scans of every Nth frame (%zu, %zu points): mean point-to-plane %.4f m through the priors, %.4f m "
-                "through the refined poses%s",
-                v.scans, v.points, v.prior_mean_m, v.refined_mean_m,
-                !v.measured ? ": no verdict" : v.keep_refined ? "" : ": worse");
+  std::snprintf(
+      text, sizeof text,
+      "scans of every Nth frame (%zu, %zu points): mean point-to-plane %.4f m through the priors, %.4f m "
+      "through the refined poses%s",
+      v.scans, v.points, v.prior_mean_m, v.refined_mean_m,
+      !v.measured      ? ": no verdict"
+      : v.keep_refined ? ""
+                       : ": worse");
   v.summary = text;
   return v;
 }

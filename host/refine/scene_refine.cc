@@ -205,6 +205,7 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
   if (sr.has_truth) {
     j["ate_before_m"] = sr.ate_before_m;
     j["ate_after_m"] = sr.ate_after_m;
+    if (sr.ate_rejected_m >= 0) j["ate_rejected_m"] = sr.ate_rejected_m;
     j["plane_rms_true_m"] = sr.plane_rms_true_m;
   }
   return j;
@@ -228,11 +229,14 @@ void guard_with_scans(const fs::path& dir, const io::Scene& scene, const std::ve
   verdict = judge_on_scans(planar, scans, priors, poses, scene.config.T_cam_lidar, o);
   refine_report.notes.push_back(verdict.summary);
   if (!verdict.keep_refined) {
+    refine_report.rejected_poses = poses;
     poses = priors;
     refine_report.outcome = "kept the priors";
-    refine_report.status = "kept the priors: the refined poses put the LiDAR scans farther from the map's planes "
-                           "(mean " + std::to_string(verdict.refined_mean_m) + " m against " +
-                           std::to_string(verdict.prior_mean_m) + " m through the priors)";
+    refine_report.status =
+        "kept the priors: the refined poses put the LiDAR scans farther from the map's planes "
+        "(mean " +
+        std::to_string(verdict.refined_mean_m) + " m against " + std::to_string(verdict.prior_mean_m) +
+        " m through the priors)";
   }
 }
 
@@ -322,6 +326,10 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
         absolute_trajectory_error(to_tum(in.priors, {}), to_tum(truth, {}), AteAlignment::kSE3).rmse_m;
     report.ate_after_m =
         absolute_trajectory_error(to_tum(poses, {}), to_tum(truth, {}), AteAlignment::kSE3).rmse_m;
+    if (!report.refine.rejected_poses.empty())
+      report.ate_rejected_m = absolute_trajectory_error(to_tum(report.refine.rejected_poses, {}),
+                                                        to_tum(truth, {}), AteAlignment::kSE3)
+                                  .rmse_m;
     if (!scene.gt->planes.empty()) {
       double sum2 = 0;
       size_t count = 0;

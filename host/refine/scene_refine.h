@@ -45,12 +45,13 @@ struct SceneRefineReport {
   RefineReport refine;
   bool has_truth = false;
   double ate_before_m = 0, ate_after_m = 0;  // SE(3)-aligned, against gt/poses.txt at the frame times
+  double ate_rejected_m = -1;  // of the solve a guard turned down (-1: none); the truth's view of the verdict
   double plane_rms_true_m = -1;  // refined points on true planes (gt/map.pcd plane ids): RMS distance
   size_t points_written = 0;
-  std::string tracks;  // the source used: "sfm" or "oracle"
-  std::string priors;   // the priors used: "absolute" or "odometry", and why
+  std::string tracks;    // the source used: "sfm" or "oracle"
+  std::string priors;    // the priors used: "absolute" or "odometry", and why
   bool anchors = false;  // used
-  SfmTrackReport sfm;  // with tracks == "sfm"
+  SfmTrackReport sfm;    // with tracks == "sfm"
   std::optional<ControlPointErrors> control;
   ScanVerdict scans;
 };

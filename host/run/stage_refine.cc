@@ -41,8 +41,7 @@ StagePlan plan(const StageContext& c) {
   }
   plan_on_scene_copy(
       c, "refine", SceneCopy{scene, {"poses.txt", "poses_prior.txt"}, {"refine", "refine.json"}},
-      option_flags(flags_from,
-                   {"tracks", "anchors", "planes=!--no-planes", "rounds", "threads", "priors"}),
+      option_flags(flags_from, {"tracks", "anchors", "planes=!--no-planes", "rounds", "threads", "priors"}),
       o.extra_args, p);
   return p;
 }
@@ -50,8 +49,8 @@ StagePlan plan(const StageContext& c) {
 nlohmann::json result(const StageContext& c) {
   const fs::path scene = c.stage_dir("refine") / "scene";
   const nlohmann::json r = read_stage_json(scene / "refine.json");
-  nlohmann::json metrics =
-      pick(r, {"status", "outcome", "tracks", "frames", "points", "ate_before_m", "ate_after_m", "seconds"});
+  nlohmann::json metrics = pick(r, {"status", "outcome", "tracks", "frames", "points", "ate_before_m",
+                                    "ate_after_m", "ate_rejected_m", "seconds"});
   if (r.contains("holdout") && r["holdout"].value("measured", false))
     metrics["holdout_median_px"] = {r["holdout"]["prior_median_px"], r["holdout"]["refined_median_px"]};
   metrics["reprojection_rms_px"] = {r["before"]["reprojection_rms_px"], r["after"]["reprojection_rms_px"]};

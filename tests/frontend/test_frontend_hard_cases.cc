@@ -3,6 +3,8 @@
 // camera over a textured plane gives points on the plane.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "host/frontend/frontend.h"
 #include "io/error.h"
 #include "io/sfm_files.h"
@@ -52,6 +54,39 @@ TEST_F(FrontendScene, TranslationOverATexturedPlaneGivesPointsOnThePlane) {
   EXPECT_EQ(back.points.size(), r.data.points.size());
   EXPECT_EQ(back.tracks.size(), r.data.tracks.size());
   EXPECT_TRUE(std::filesystem::exists(dir_ / "sfm/frontend.json"));
+}
+
+// One frame smeared by motion (a 15-pixel horizontal box blur, as a fast pan would): it gives far fewer
+// keypoints than the sharp frames; the sharp frames still match and triangulate points on the plane, and
+// nothing is non-finite.
+TEST_F(FrontendScene, MotionBlurredFrame) {
+  std::vector<io::Image> images;
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < 4; ++i) {
+    poses.push_back(plane_view({0.4 * i, 0.05 * i, 0}));
+    images.push_back(testing::render_plane(k_, poses.back()));
+  }
+  io::Image& blurred = images[2];
+  const io::Image sharp = blurred;
+  for (int y = 0; y < blurred.height; ++y)
+    for (int x = 0; x < blurred.width; ++x) {
+      int sum = 0, n = 0;
+      for (int d = -7; d <= 7; ++d) {
+        const int xx = std::clamp(x + d, 0, blurred.width - 1);
+        sum += sharp.data[static_cast<size_t>(y) * blurred.width + xx];
+        ++n;
+      }
+      blurred.data[static_cast<size_t>(y) * blurred.width + x] = static_cast<uint16_t>(sum / n);
+    }
+  testing::write_plane_scene(dir_, k_, poses, images);
+  const FrontendResult r = run_frontend(dir_, options());
+  expect_finite(r);
+  const size_t blurred_keypoints = r.data.images[2].keypoints.size();
+  EXPECT_LT(blurred_keypoints, r.data.images[0].keypoints.size() / 2);
+  EXPECT_GT(r.summary.points, 100u);
+  size_t off_plane = 0;
+  for (const auto& p : r.data.points) off_plane += std::abs(p.xyz.z() - testing::kPlaneZ) > 0.05;
+  EXPECT_LT(off_plane, r.data.points.size() / 20);
 }
 
 TEST_F(FrontendScene, UniformFrames) {

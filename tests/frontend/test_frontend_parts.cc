@@ -107,7 +107,8 @@ TEST(FrontendFeatures, SiftKeypointsSitOnTheFeature) {
       for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x) {
           const double r2 = (x - cx) * (x - cx) + (y - cy) * (y - cy);
-          image.pixels.push_back(static_cast<uint8_t>(std::lround(30 + 200 * std::exp(-r2 / (2 * 4.0 * 4.0)))));
+          image.pixels.push_back(
+              static_cast<uint8_t>(std::lround(30 + 200 * std::exp(-r2 / (2 * 4.0 * 4.0)))));
         }
       FeatureOptions o;
       o.type = type;

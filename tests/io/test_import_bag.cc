@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <random>
@@ -102,6 +103,13 @@ TEST_F(ImportBagTest, ImportsTinyM2dgrLikeBag) {
   const M2dgrCamera cam = read_m2dgr_camera(o.calib);
   EXPECT_LT((s.config.T_cam_lidar * cam.T_lidar_cam - Eigen::Matrix4d::Identity()).norm(), 1e-12);
   EXPECT_EQ(s.config.poses_frame, PoseFrame::kImu);
+  // T_imu_lidar from the block of the IMU topic (/handsfree/imu): the IMU 0.27 m behind and 0.18 m below.
+  const M2dgrCamera imu = read_m2dgr_camera(o.calib, "Handsfree IMU");
+  EXPECT_LT((s.config.T_imu_lidar * imu.T_lidar_cam - Eigen::Matrix4d::Identity()).norm(), 1e-12);
+  EXPECT_NEAR(s.config.T_imu_lidar(0, 3), 0.27255, 1e-12);
+  EXPECT_NE(std::find_if(r.notes.begin(), r.notes.end(),
+                         [](const std::string& n) { return n.find("'Handsfree IMU'") != std::string::npos; }),
+            r.notes.end());
   EXPECT_FALSE(s.config.has_lidar_map);
   ASSERT_EQ(s.frames.size(), 2u);
   EXPECT_EQ(s.frames[1].t_s, 1628410457.15);
@@ -120,6 +128,20 @@ TEST_F(ImportBagTest, ImportsTinyM2dgrLikeBag) {
   EXPECT_EQ(scan.intensity[1], 30.f);
   ASSERT_TRUE(s.gt.has_value());
   EXPECT_FALSE(s.gt->poses.front().has_rotation);  // M2DGR's tracker: translation only
+}
+
+TEST(ImportBagImuBlock, TheImuTopicPicksTheCalibrationBlock) {
+  EXPECT_EQ(m2dgr_imu_block("/handsfree/imu"), "Handsfree IMU");
+  EXPECT_EQ(m2dgr_imu_block("/camera/imu"), "realsense d435i IMU");
+  EXPECT_EQ(m2dgr_imu_block("/imu/data"), "Xsens IMU");
+  EXPECT_EQ(m2dgr_imu_block("/dvs/imu"), "");
+  // Each block reads: the realsense block is a rotation as well as a 0.7 m lever arm.
+  for (const char* block : {"Handsfree IMU", "realsense d435i IMU", "Xsens IMU"}) {
+    const M2dgrCamera b = read_m2dgr_camera(testing::data_dir() / "m2dgr/calibration_results.txt", block);
+    EXPECT_TRUE(b.has_extrinsic) << block;
+    const Eigen::Vector3d lever = b.T_lidar_cam.topRightCorner<3, 1>();
+    EXPECT_GT(lever.norm(), 0.2) << block;
+  }
 }
 
 TEST_F(ImportBagTest, BadBagsAreNamed) {

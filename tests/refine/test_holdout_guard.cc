@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "host/refine/holdout_guard.h"
+#include "host/refine/scan_check.h"
 #include "refine_test_scene.h"
 
 namespace litgs::host::refine::testing {
@@ -74,6 +75,28 @@ TEST(RefineHoldoutGuard, ARefinementThatMakesThePosesWorseKeepsThePriors) {
   const RefineReport r2 = refine(s2.input, unguarded, o);
   EXPECT_EQ(r2.outcome, "refined");
   EXPECT_GT(ate(unguarded, s2.truth), ate(s2.input.priors, s2.truth));
+}
+
+// The LiDAR side: an empty scan (a dropped LiDAR message) counts for nothing; the scans of a plane taken
+// through poses shifted off it are worse than through the true poses.
+TEST(RefineScanCheck, AnEmptyScanCountsForNothingAndAShiftedPoseIsWorse) {
+  std::vector<Eigen::Vector3d> wall;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 20; ++j) wall.push_back(Eigen::Vector3d(0.1 * i, 5.0, 0.1 * j));
+  const PlanarMap map = fit_planes(wall, {});
+  std::vector<CameraPose> truth(2), shifted(2);
+  shifted[1].p = Eigen::Vector3d(0, 0.05, 0);  // 5 cm towards the wall
+  std::vector<CheckedScan> scans = {{0, {}}, {1, {}}};
+  for (int i = 5; i < 35; ++i) scans[1].points_lidar.push_back(Eigen::Vector3d(0.1 * i, 5.0, 0.95));
+  const ScanVerdict v = judge_on_scans(map, scans, truth, shifted, Eigen::Matrix4d::Identity(), {});
+  EXPECT_EQ(v.scans, 1u);  // the empty one is skipped
+  ASSERT_TRUE(v.measured);
+  EXPECT_LT(v.prior_mean_m, 1e-6);
+  EXPECT_NEAR(v.refined_mean_m, 0.05, 1e-6);
+  EXPECT_FALSE(v.keep_refined);
+  const ScanVerdict none = judge_on_scans(map, {{0, {}}}, truth, shifted, Eigen::Matrix4d::Identity(), {});
+  EXPECT_FALSE(none.measured);
+  EXPECT_TRUE(none.keep_refined);
 }
 
 }  // namespace
