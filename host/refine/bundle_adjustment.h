@@ -39,8 +39,8 @@ struct BaWeights {
   // An odometry's orientation is absolute up to a slow drift (gravity fixes roll and pitch; yaw drifts with
   // distance): every frame gets an orientation prior of this sigma plus the per-metre term times the
   // distance from the first frame. Without it the images and planes leave a rotation of the whole
-  // trajectory about the wall's normal free: the synthetic facade's refined poses were 3 mrad off in
-  // orientation (0.7 mrad for the priors) while the SE(3)-aligned ATE hid it. 0: off.
+  // trajectory nearly free, and the refined orientations drifted further from the truth than the priors'
+  // while the SE(3)-aligned ATE hid it (docs/experiments.md, 2026-11-27 night). 0: off.
   double odometry_sigma_r_rad = 0.002;
   double odometry_sigma_r_per_m = 0.0005;
   double gauge_sigma_t_m = 0.01;     // the first frame's pose prior: the odometry's per-frame accuracy

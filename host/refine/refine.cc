@@ -179,9 +179,14 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
   const std::vector<size_t> per_frame = frame_observations(in.points, n);
   for (size_t c : per_frame) report.weak_frames += c < o.min_frame_observations;
   report.fewest_frame_observations = SIZE_MAX;
-  for (size_t f = 0; f < n; ++f)
-    if (!frozen[f])
-      report.fewest_frame_observations = std::min(report.fewest_frame_observations, per_frame[f]);
+  for (size_t f = 0; f < n; ++f) {
+    // A frame without any observation was left out upstream (the front end skips NUC-frozen frames).
+    if (frozen[f] || per_frame[f] == 0) {
+      report.frames_without_observations += !frozen[f];
+      continue;
+    }
+    report.fewest_frame_observations = std::min(report.fewest_frame_observations, per_frame[f]);
+  }
   if (report.fewest_frame_observations == SIZE_MAX) report.fewest_frame_observations = 0;
   if (n > 0) {
     std::vector<double> counts(per_frame.begin(), per_frame.end());

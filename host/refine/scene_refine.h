@@ -30,8 +30,8 @@ struct SceneRefineOptions {
   std::string priors = "auto";
   // The upstream estimator's anchors: "auto" uses them with oracle tracks only. On the front end's own
   // tracks an anchor (a map point at a high gradient) is associated with whichever keypoint lies within a
-  // pixel or two of it, rarely the same physical point, and the anchor priors pulled the synthetic facade's
-  // poses from 9-18 mm to 20-34 mm (without them: 7-9 mm; docs/refinement.md). "on" | "off" override it;
+  // pixel or two of it, rarely the same physical point, and the anchor priors made the synthetic facade's
+  // poses worse (docs/refinement.md, "Anchors with the front end's tracks"). "on" | "off" override it;
   // refine.use_anchors is set from it.
   std::string anchors = "auto";
   // After a solve, the LiDAR scans of every Nth frame against the map's planes (scan_check.h): refined

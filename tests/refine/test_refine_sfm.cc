@@ -114,20 +114,22 @@ TEST(RefineSfm, FlatFramesGiveTooFewTracksAndRefineKeepsThePriors) {
   std::filesystem::remove_all(dir);
 }
 
-// On the default (textured) frames the front end's own tracks refine the poses: the solve runs, the held-
-// back tracks keep it, and the trajectory error (against gt/poses.txt, which neither stage reads) drops.
+// On the default scene (the textured facade, 60 frames, seed 1) the front end's own tracks refine the
+// poses: the solve runs, both guards keep it, and the trajectory error (against gt/poses.txt, which neither
+// stage reads) drops below half. Other seeds and presets, some of which the guards turn down: ci/refine-bench
+// (docs/results.md).
 TEST(RefineSfm, TexturedFramesRefineThePosesFromTheEnginesOwnTracks) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "litgs_refine_sfm_scene";
   std::filesystem::remove_all(dir);
   synth::SynthOptions so;
-  so.frames = 20;
   so.out = dir;
   so.threads = 2;
   synth::generate_synthetic_scene(so);
   frontend::FrontendOptions fo;
   fo.threads = 2;
   frontend::write_frontend(dir, frontend::run_frontend(dir, fo));
-  const SceneRefineOptions defaults;
+  SceneRefineOptions defaults;
+  defaults.refine.threads = 2;
   const SceneRefineReport r = refine_scene(dir, defaults);
   std::cout << "  " << r.refine.status << ": " << r.sfm.from_front_end_points << " front-end points, "
             << r.sfm.triangulated_here << " triangulated here; ATE " << r.ate_before_m << " -> "
@@ -136,8 +138,9 @@ TEST(RefineSfm, TexturedFramesRefineThePosesFromTheEnginesOwnTracks) {
   EXPECT_EQ(r.refine.outcome, "refined") << r.refine.status;
   EXPECT_GE(r.refine.fewest_frame_observations, 30u);
   EXPECT_TRUE(r.refine.holdout.measured);
+  EXPECT_TRUE(r.scans.measured);
   EXPECT_LT(r.refine.after.reprojection_rms_px, r.refine.before.reprojection_rms_px);
-  EXPECT_LT(r.ate_after_m, r.ate_before_m);
+  EXPECT_LT(r.ate_after_m, 0.5 * r.ate_before_m);
   std::ifstream in(dir / "refine.json");
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j.at("tracks"), "sfm");
