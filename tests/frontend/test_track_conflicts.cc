@@ -19,6 +19,16 @@ TriangulationView camera(int i, const Eigen::Vector3d& X_world) {
   return v;
 }
 
+// Each observation of `component` sees the point `seen` lists for it (same order).
+ObservationView view_of(const io::SfmTrack& component, const std::vector<Eigen::Vector3d>& seen) {
+  return [&component, &seen](const io::SfmObservation& o) -> std::optional<TriangulationView> {
+    for (size_t k = 0; k < component.observations.size(); ++k)
+      if (component.observations[k].image == o.image && component.observations[k].keypoint == o.keypoint)
+        return camera(static_cast<int>(o.image), seen[k]);
+    return std::nullopt;
+  };
+}
+
 TEST(FrontendTrackConflicts, RepetitiveTextureKeepsTheConsistentBrickAndDropsItsNeighbour) {
   const Eigen::Vector3d brick(0.5, 0.1, 5), neighbour(0.75, 0.1, 5);
   // Observations sorted by image; image 2 also saw the neighbour brick, matched by mistake to image 1.
@@ -26,12 +36,7 @@ TEST(FrontendTrackConflicts, RepetitiveTextureKeepsTheConsistentBrickAndDropsIts
   component.observations = {{0, 0}, {1, 0}, {2, 0}, {2, 1}, {3, 0}};
   const std::vector<Eigen::Vector3d> seen = {brick, brick, brick, neighbour, brick};
   const std::vector<std::array<size_t, 2>> edges = {{0, 1}, {1, 2}, {1, 3}, {2, 4}};
-  const ObservationView view = [&](const io::SfmObservation& o) -> std::optional<TriangulationView> {
-    for (size_t k = 0; k < component.observations.size(); ++k)
-      if (component.observations[k].image == o.image && component.observations[k].keypoint == o.keypoint)
-        return camera(static_cast<int>(o.image), seen[k]);
-    return std::nullopt;
-  };
+  const ObservationView view = view_of(component, seen);
   const ConflictSplit split = split_conflicting_component(component, edges, view, kF, kF, {});
   ASSERT_EQ(split.tracks.size(), 1u);
   EXPECT_EQ(split.tracks[0].observations, (std::vector<io::SfmObservation>{{0, 0}, {1, 0}, {2, 0}, {3, 0}}));
@@ -46,12 +51,7 @@ TEST(FrontendTrackConflicts, TwoBricksChainedByOneWrongMatchBecomeTwoTracks) {
   component.observations = {{0, 0}, {1, 0}, {1, 1}, {2, 0}, {2, 1}, {3, 1}};
   const std::vector<Eigen::Vector3d> seen = {A, A, B, A, B, B};
   const std::vector<std::array<size_t, 2>> edges = {{0, 1}, {1, 3}, {2, 4}, {4, 5}, {2, 3}};
-  const ObservationView view = [&](const io::SfmObservation& o) -> std::optional<TriangulationView> {
-    for (size_t k = 0; k < component.observations.size(); ++k)
-      if (component.observations[k].image == o.image && component.observations[k].keypoint == o.keypoint)
-        return camera(static_cast<int>(o.image), seen[k]);
-    return std::nullopt;
-  };
+  const ObservationView view = view_of(component, seen);
   const ConflictSplit split = split_conflicting_component(component, edges, view, kF, kF, {});
   ASSERT_EQ(split.tracks.size(), 2u);
   EXPECT_EQ(split.dropped, 0u);

@@ -46,11 +46,15 @@ TEST(RefineHoldoutGuard, ARefinementThatMakesThePosesWorseKeepsThePriors) {
   so.anchors = 0;
   make_test_scene(s, so);
   const HoldoutOptions guard;
-  for (size_t i = 0; i < s.input.points.size(); ++i) {
-    if (i % guard.every == guard.every - 1) continue;  // held back: left true
-    for (auto& ob : s.input.points[i].obs)
-      if (ob.frame >= 20) ob.uv.x() += 12;
-  }
+  // Every track the guard does not hold back, 12 px to the right from frame 20 on.
+  const auto corrupt = [&guard](std::vector<TrackPoint>& points) {
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (i % guard.every == guard.every - 1) continue;  // held back: left true
+      for (auto& ob : points[i].obs)
+        if (ob.frame >= 20) ob.uv.x() += 12;
+    }
+  };
+  corrupt(s.input.points);
   const std::vector<CameraPose> priors = s.input.priors;
   std::vector<CameraPose> poses = priors;
   RefineOptions o;
@@ -65,11 +69,7 @@ TEST(RefineHoldoutGuard, ARefinementThatMakesThePosesWorseKeepsThePriors) {
   // The same solve without the guard returns the corrupted poses: what the guard prevented.
   TestScene s2;
   make_test_scene(s2, so);
-  for (size_t i = 0; i < s2.input.points.size(); ++i) {
-    if (i % guard.every == guard.every - 1) continue;
-    for (auto& ob : s2.input.points[i].obs)
-      if (ob.frame >= 20) ob.uv.x() += 12;
-  }
+  corrupt(s2.input.points);
   std::vector<CameraPose> unguarded = s2.input.priors;
   o.holdout.every = 0;
   const RefineReport r2 = refine(s2.input, unguarded, o);
