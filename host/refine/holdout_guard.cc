@@ -12,18 +12,17 @@
 namespace litgs::host::refine {
 namespace {
 
-// A track's point fitted to `poses`: the consensus midpoint, then Gauss-Newton on the pixel error of all
-// its observations (a point that fits its poses best, so that what remains is the poses' disagreement).
+// Gauss-Newton on the pixel error of `obs` through `poses`, from X: the point that fits its poses best, so
+// that what remains is the poses' disagreement.
 std::optional<Eigen::Vector3d> fit_point(const std::vector<Observation>& obs,
-                                         const std::vector<CameraPose>& poses, const PinholeCamera& camera) {
-  auto X = triangulate(obs, poses, camera);
-  if (!X) return std::nullopt;
+                                         const std::vector<CameraPose>& poses, const PinholeCamera& camera,
+                                         Eigen::Vector3d X) {
   for (int it = 0; it < 5; ++it) {
     Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
     for (const auto& o : obs) {
       const CameraPose& c = poses[o.frame];
-      const Eigen::Vector3d pc = c.q.conjugate() * (*X - c.p);
+      const Eigen::Vector3d pc = c.q.conjugate() * (X - c.p);
       if (!(pc.z() > 1e-6)) continue;
       const Eigen::Vector2d r(camera.fx * pc.x() / pc.z() + camera.cx - o.uv.x(),
                               camera.fy * pc.y() / pc.z() + camera.cy - o.uv.y());
@@ -36,10 +35,10 @@ std::optional<Eigen::Vector3d> fit_point(const std::vector<Observation>& obs,
     }
     const Eigen::Vector3d step = H.ldlt().solve(-g);
     if (!step.allFinite()) break;
-    *X += step;
+    X += step;
     if (step.norm() < 1e-9) break;
   }
-  if (!X->allFinite()) return std::nullopt;
+  if (!X.allFinite()) return std::nullopt;
   return X;
 }
 
@@ -77,10 +76,20 @@ HoldoutVerdict judge_on_held_out(const std::vector<TrackPoint>& held_out,
     for (const auto& ob : t.obs)
       if (ob.frame < priors.size() && ob.frame < refined.size()) obs.push_back(ob);
     if (obs.size() < 2) continue;
-    const auto Xp = fit_point(obs, priors, camera), Xr = fit_point(obs, refined, camera);
+    // The track's consensus point through each pose set; the observations that agree with either (wrong
+    // matches agree with neither) are fitted and scored through both, so that the medians compare.
+    const auto Xp0 = triangulate(obs, priors, camera), Xr0 = triangulate(obs, refined, camera);
+    if (!Xp0 || !Xr0) continue;
+    std::vector<Observation> agreeing;
+    for (const auto& ob : obs)
+      if (reprojection_error_px(priors[ob.frame], camera, *Xp0, ob.uv) <= o.agree_px ||
+          reprojection_error_px(refined[ob.frame], camera, *Xr0, ob.uv) <= o.agree_px)
+        agreeing.push_back(ob);
+    if (agreeing.size() < 2) continue;
+    const auto Xp = fit_point(agreeing, priors, camera, *Xp0),
+               Xr = fit_point(agreeing, refined, camera, *Xr0);
     if (!Xp || !Xr) continue;
-    // Each observation scored through both: wrong matches inflate both sides alike, so medians compare.
-    for (const auto& ob : obs) {
+    for (const auto& ob : agreeing) {
       const double ep = reprojection_error_px(priors[ob.frame], camera, *Xp, ob.uv);
       const double er = reprojection_error_px(refined[ob.frame], camera, *Xr, ob.uv);
       if (!std::isfinite(ep) || !std::isfinite(er)) continue;

