@@ -191,7 +191,7 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                         {"window", o.refine.window},
                         {"threads", o.refine.threads},
                         {"holdout_every", o.refine.holdout.every},
-                        {"absolute_priors", sr.priors.rfind("absolute", 0) == 0}}}};
+                        {"absolute_priors", sr.absolute_priors}}}};
   if (sr.control)
     j["control_points"] = {{"observations", sr.control->observations},
                            {"unmatched_cameras", sr.control->unmatched_cameras},
@@ -287,6 +287,7 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   report.tracks = source;
   refine_options.use_anchors = o.anchors == "on" || (o.anchors == "auto" && source == "oracle");
   report.anchors = refine_options.use_anchors;
+  report.absolute_priors = refine_options.ba.absolute_priors;
   report.priors = std::string(refine_options.ba.absolute_priors ? "absolute" : "odometry") +
                   (o.priors == "auto" ? " (scene.yaml poses_origin)" : " (asked for)");
   if (source == "sfm") {

@@ -48,10 +48,11 @@ struct SceneRefineReport {
   double ate_rejected_m = -1;  // of the solve a guard turned down (-1: none); the truth's view of the verdict
   double plane_rms_true_m = -1;  // refined points on true planes (gt/map.pcd plane ids): RMS distance
   size_t points_written = 0;
-  std::string tracks;    // the source used: "sfm" or "oracle"
-  std::string priors;    // the priors used: "absolute" or "odometry", and why
-  bool anchors = false;  // used
-  SfmTrackReport sfm;    // with tracks == "sfm"
+  std::string tracks;            // the source used: "sfm" or "oracle"
+  std::string priors;            // the priors used: "absolute" or "odometry", and why
+  bool anchors = false;          // used
+  bool absolute_priors = false;  // a pose prior on every frame (see priors)
+  SfmTrackReport sfm;            // with tracks == "sfm"
   std::optional<ControlPointErrors> control;
   ScanVerdict scans;
 };
