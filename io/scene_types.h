@@ -42,11 +42,23 @@ struct SceneConfig {
   PoseFrame poses_frame = PoseFrame::kCamera;
   PoseOrigin poses_origin = PoseOrigin::kOdometry;  // scene.yaml `poses_origin`, optional (odometry)
   bool has_lidar_map = true;  // false: the scene has no lidar/map.pcd (e.g. a photogrammetry import)
+  // scene.yaml `lidar_holdout_every`, optional (0): the scans that lidar/map.pcd leaves out so that the
+  // geometry can be measured against measurements the training map never held (is_heldout_scan).
+  int lidar_holdout_every = 0;
   // Recentring: original world coordinates = scene world coordinates + world_offset_m (keeps float32 work
   // near the origin for data sets that sit far from it).
   Eigen::Vector3d world_offset_m = Eigen::Vector3d::Zero();
   std::string source;  // free text: where the scene came from
 };
+
+// Scan i of lidar/scans/ (by increasing time) is held out of the map when this holds: scans 0, N, 2N, ...
+inline constexpr int kDefaultLidarHoldoutEvery = 8;
+inline bool is_heldout_scan(size_t scan_index, int holdout_every) {
+  return holdout_every > 0 && scan_index % static_cast<size_t>(holdout_every) == 0;
+}
+// The map of the held-out scans, built as lidar/map.pcd is (host/lidar_map): the reference of `eval`'s
+// geometry on scenes without ground truth.
+inline constexpr const char* kHeldoutScansMap = "lidar/heldout.pcd";
 
 // One thermal frame: thermal/<t_s>.png|.tiff (the stem is the timestamp).
 struct SceneFrame {

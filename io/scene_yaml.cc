@@ -157,7 +157,7 @@ SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
   r.only_keys(
       root,
       {"format", "version", "units", "camera", "T_cam_lidar", "T_imu_lidar", "time_offset_cam_lidar_s",
-       "poses_frame", "poses_origin", "lidar_map", "world_offset_m", "source"},
+       "poses_frame", "poses_origin", "lidar_map", "lidar_holdout_every", "world_offset_m", "source"},
       "");
   if (r.text(r.get(root, "format", ""), "format") != "litgs-scene")
     fail(path, r.line(root["format"]), "format: expected 'litgs-scene'");
@@ -209,6 +209,8 @@ SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
       fail(path, r.line(root["poses_origin"]), "poses_origin: '" + origin + "' is not odometry or absolute");
   }
   c.has_lidar_map = r.boolean(r.get(root, "lidar_map", ""), "lidar_map");
+  if (root["lidar_holdout_every"])
+    c.lidar_holdout_every = r.integer(root["lidar_holdout_every"], "lidar_holdout_every", 0, 1 << 20);
   const auto offset = r.numbers(r.get(root, "world_offset_m", ""), "world_offset_m");
   if (offset.size() != 3) fail(path, r.line(root["world_offset_m"]), "world_offset_m: expected 3 numbers");
   c.world_offset_m = {offset[0], offset[1], offset[2]};
@@ -248,6 +250,8 @@ void write_scene_yaml(const std::filesystem::path& path, const SceneConfig& c) {
         << "poses_origin: " << (c.poses_origin == PoseOrigin::kAbsolute ? "absolute" : "odometry")
         << "  # odometry (drifts: a relative prior) or absolute (a global solution: a prior per pose)\n"
         << "lidar_map: " << (c.has_lidar_map ? "true" : "false") << "  # lidar/map.pcd present\n"
+        << "lidar_holdout_every: " << c.lidar_holdout_every
+        << "  # scans 0, N, 2N, ... left out of lidar/map.pcd (0: none); lidar/heldout.pcd holds them\n"
         << "world_offset_m: [" << format_double(c.world_offset_m.x()) << ", "
         << format_double(c.world_offset_m.y()) << ", " << format_double(c.world_offset_m.z())
         << "]  # original coordinates = scene coordinates + this\n"

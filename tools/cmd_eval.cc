@@ -62,9 +62,21 @@ void print_text(const host::ModelEvaluation& e, const nlohmann::json& trajectory
               << " m, std " << fixed(e.emd->std_m, 4) << " over " << e.emd->rounds << " draws of "
               << e.emd->samples << " points; Gaussian centres "
               << (e.emd->weighted_by_opacity ? "by opacity" : "uniformly") << " against "
-              << e.geometry_reference << ", exact assignment)\n";
+              << e.geometry_reference << ", exact assignment; both inside the observed region)\n";
   else
-    std::cout << "eval: EMD not measured (--no-geometry, or no reference cloud)\n";
+    std::cout << "eval: EMD not measured (--no-geometry, no reference cloud, or nothing in the observed "
+                 "region)\n";
+  if (e.region)
+    std::cout << "eval: observed region: " << percent(e.region->reference_observed_fraction()) << " % of "
+              << e.geometry_reference << " (" << e.region->reference_observed << " of "
+              << e.region->reference_points << " points) is seen by a training view, "
+              << e.region->gaussians_in_region << " of " << e.region->gaussians
+              << " Gaussians lie in it; coverage " << percent(e.region->covered_fraction())
+              << " % of the seen points have a Gaussian centre within " << fixed(e.region->coverage_radius_m, 2)
+              << " m\n";
+  if (e.geometry_reference_trained)
+    std::cout << "eval: note: the geometry reference is the map that trained the model (circular): rebuild "
+                 "it with `litgs-engine map --force` to hold scans out\n";
   if (e.centre_plane_counted > 0)
     std::cout << "eval: Gaussian centres to planes (" << e.plane_reference << "): RMS "
               << fixed(e.centre_plane_rms_m, 4) << " m, median " << fixed(e.centre_plane_median_m, 4)

@@ -15,6 +15,9 @@ void print_lidar_map_report(const host::LidarMapReport& r, const std::string& wh
             << " deskewed), " << r.input_points << " points -> " << r.map_points << " map points ("
             << r.planar_points << " planar) in " << r.seconds << " s, peak memory " << r.peak_rss_mb
             << " MB; written to " << where << "\n";
+  if (r.scans_heldout > 0)
+    std::cout << "map: " << r.scans_heldout << " scans held out of the map (" << r.heldout_points
+              << " points, lidar/heldout.pcd beside it): eval measures geometry against them\n";
   for (const auto& note : r.notes) std::cout << "  note: " << note << "\n";
 }
 
@@ -30,6 +33,9 @@ void add_map_command(CLI::App& app) {
   c->add_option("--out", *out, "Write the map here instead of lidar/map.pcd (scene.yaml untouched)");
   c->add_flag("--force", *force, "Replace an existing lidar/map.pcd");
   c->add_flag("!--no-deskew", o->deskew, "Ignore the scans' per-point time field");
+  c->add_option("--holdout-every", o->holdout_every,
+                "Leave scans 0, N, 2N, ... out of the map, for eval's geometry and refine's scan check (0: none)")
+      ->capture_default_str();
   c->callback([scene, out, force, o] {
     const host::LidarMapReport r = host::write_scene_lidar_map(*scene, *o, *out, *force);
     print_lidar_map_report(r, out->empty() ? (*scene / "lidar/map.pcd").string() : out->string());

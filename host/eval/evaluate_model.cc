@@ -14,6 +14,7 @@
 #include "host/train/true_planes.h"
 #include "io/gaussian_ply.h"
 #include "io/image.h"
+#include "io/pcd.h"
 #include "io/scene.h"
 #include "kernels/loss/loss_reference.h"
 #include "kernels/splat/rasterizer.h"
@@ -81,12 +82,19 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
   e.stretch_high = data.stretch_high;
   e.gaussians = model.size();
 
+  // The LiDAR scans the map held out, where there are any: measurements the training never saw.
+  std::optional<io::PointCloud> heldout_scans;
+  if (o.geometry && std::filesystem::exists(scene_dir / io::kHeldoutScansMap))
+    heldout_scans = io::read_pcd(scene_dir / io::kHeldoutScansMap);
   std::unique_ptr<PlanarMap> planes = true_planar_map(scene);
   if (planes) {
     e.plane_reference = "gt/planes.txt";
+  } else if (heldout_scans && o.geometry) {
+    planes = std::make_unique<PlanarMap>(fit_planes(heldout_scans->positions, PlaneFitOptions{}));
+    e.plane_reference = std::string("LiDAR plane fits of the held-out scans (") + io::kHeldoutScansMap + ")";
   } else if (scene.map && o.geometry) {
     planes = std::make_unique<PlanarMap>(fit_planes(scene.map->positions, PlaneFitOptions{}));
-    e.plane_reference = "LiDAR plane fits (lidar/map.pcd)";
+    e.plane_reference = "LiDAR plane fits of the training map (lidar/map.pcd: circular)";
   }
 
   engine::Context context;
@@ -120,18 +128,19 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
     m.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     m.name = view.name;
     m.t_s = view.t_s;
-    m.psnr_db = kernels::psnr(img.image, view.image);
-    m.ssim = kernels::ssim_reference(img.image, view.image, 1, W, H);
+    const std::vector<float> shown = shown_as_written(img.image);
+    m.psnr_db = kernels::psnr(shown, view.image);
+    m.ssim = kernels::ssim_reference(shown, view.image, 1, W, H);
     if (e.bit_depth == 16) {
       double sum = 0;
-      for (size_t p = 0; p < view.image.size(); ++p) sum += std::abs(double{img.image[p]} - view.image[p]);
+      for (size_t p = 0; p < view.image.size(); ++p) sum += std::abs(double{shown[p]} - view.image[p]);
       m.mae_counts = sum / static_cast<double>(view.image.size()) * (data.stretch_high - data.stretch_low);
     }
     if (!covisibility.masks.empty()) {
       const std::vector<uint8_t>& mask = covisibility.masks[i];
       m.covisible_fraction = static_cast<double>(std::count(mask.begin(), mask.end(), uint8_t{1})) /
                              static_cast<double>(mask.size());
-      m.covisible_psnr_db = masked_psnr(img.image, view.image, mask);
+      m.covisible_psnr_db = masked_psnr(shown, view.image, mask);
     }
     if (planes) {
       const PlaneResidualSum r = depth_plane_residuals(*planes, cam, img.depth, img.alpha);
@@ -142,7 +151,7 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
     times.push_back(m.render_ms);
     e.views.push_back(m);
     if (images)
-      images->push_back({view.name, W, H, img.image, view.image, img.depth, img.alpha,
+      images->push_back({view.name, W, H, shown, view.image, img.depth, img.alpha,
                          covisibility.masks.empty() ? std::vector<uint8_t>{} : covisibility.masks[i]});
   }
   const double n = static_cast<double>(e.views.size());
@@ -172,9 +181,13 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
     if (scene.gt && scene.gt->map) {
       reference = &*scene.gt->map;
       e.geometry_reference = "gt/map.pcd";
+    } else if (heldout_scans) {
+      reference = &*heldout_scans;
+      e.geometry_reference = io::kHeldoutScansMap;
     } else if (scene.map) {
       reference = &*scene.map;
       e.geometry_reference = "lidar/map.pcd";
+      e.geometry_reference_trained = true;
     }
     if (reference && model.size() > 0) {
       std::vector<Eigen::Vector3d> centres(model.size());
@@ -183,7 +196,26 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
         centres[g] = {model.means[3 * g], model.means[3 * g + 1], model.means[3 * g + 2]};
         opacities[g] = 1.0 / (1.0 + std::exp(-double{model.opacity_logits[g]}));
       }
-      e.emd = gaussian_emd(centres, opacities, reference->positions, o.emd);
+      // The first surfaces of each training view come from the densest cloud at hand.
+      const io::PointCloud& surfaces =
+          scene.gt && scene.gt->map ? *scene.gt->map : scene.map ? *scene.map : *reference;
+      std::vector<kernels::SplatCamera> training_cameras;
+      for (const TrainingView& v : data.views)
+        if (!v.heldout) training_cameras.push_back(v.camera);
+      const ObservedRegion region(surfaces.positions, training_cameras, o.region);
+      std::vector<size_t> observed, inside;
+      e.region = measure_region(region, reference->positions, centres, opacities, o.region, observed, inside);
+      if (!observed.empty() && !inside.empty()) {
+        std::vector<Eigen::Vector3d> observed_points, inside_centres;
+        std::vector<double> inside_opacities;
+        for (size_t i : observed) observed_points.push_back(reference->positions[i]);
+        for (size_t g : inside) {
+          inside_centres.push_back(centres[g]);
+          inside_opacities.push_back(opacities[g]);
+        }
+        if (std::any_of(inside_opacities.begin(), inside_opacities.end(), [](double a) { return a > 0; }))
+          e.emd = gaussian_emd(inside_centres, inside_opacities, observed_points, o.emd);
+      }
     }
     if (planes) centre_plane_residuals(model, *planes, e);
   }
@@ -237,6 +269,23 @@ nlohmann::json to_json(const ModelEvaluation& e) {
       {"centre_plane_median_m", optional_number(e.centre_plane_median_m)},
       {"centre_plane_counted", e.centre_plane_counted},
   };
+  if (e.region)
+    j["observed_region"] = {
+        {"reference_points", e.region->reference_points},
+        {"reference_observed", e.region->reference_observed},
+        {"reference_observed_fraction", e.region->reference_observed_fraction()},
+        {"gaussians", e.region->gaussians},
+        {"gaussians_in_region", e.region->gaussians_in_region},
+        {"covered_fraction", e.region->covered_fraction()},
+        {"coverage_radius_m", e.region->coverage_radius_m},
+        {"coverage_min_opacity", e.region->coverage_min_opacity},
+        {"definition",
+         "reference points and Gaussian centres that some training view sees: inside its image, no more "
+         "than a margin behind the nearest surface point in their z-buffer cell; covered_fraction: the "
+         "observed reference points with a Gaussian centre (opacity >= the threshold) within the radius"}};
+  else
+    j["observed_region"] = nullptr;
+  j["geometry_reference_trained"] = e.geometry_reference_trained;
   if (e.emd)
     j["emd"] = {
         {"mean_m", e.emd->mean_m},
@@ -247,8 +296,8 @@ nlohmann::json to_json(const ModelEvaluation& e) {
         {"reference", e.geometry_reference},
         {"definition",
          "mean Euclidean distance (m) of the exact optimal one-to-one matching between N Gaussian "
-         "centres drawn in proportion to opacity and N reference points drawn uniformly; floor_m: the same "
-         "between two draws of the reference (the sampling floor)"}};
+         "centres drawn in proportion to opacity and N reference points drawn uniformly, both inside the "
+         "observed region; floor_m: the same between two draws of the reference (the sampling floor)"}};
   else
     j["emd"] = nullptr;
   return j;

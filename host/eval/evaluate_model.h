@@ -3,12 +3,16 @@
 // (EMD) and planes, and speed. Units:
 // - images: intensity in [0, 1] as training maps the frames (host/train/training_data.h: 8-bit frames value /
 //   255; 16-bit frames stretched from raw counts [stretch_low, stretch_high] to [0, 1], clamped). PSNR with
-//   peak 1 on the unclamped render, SSIM the 11-tap Gaussian-window (sigma 1.5) SSIM of 3DGS, as the
-//   trainer's evaluation. For 16-bit data also the mean absolute error in raw counts: the [0, 1] error times
-//   (stretch_high - stretch_low), against the frame as training sees it (clamped to the stretch).
+//   peak 1 and SSIM (the 11-tap Gaussian-window, sigma 1.5, SSIM of 3DGS), as the trainer's evaluation,
+//   both on the render clamped to [0, 1] as `render` writes it: an image cannot show a value outside the
+//   range. The 8- or 16-bit quantization of a written image is not applied. For 16-bit data also the mean
+//   absolute error in raw counts: the [0, 1] error times (stretch_high - stretch_low), against the frame as
+//   training sees it (clamped to the stretch).
 // - co-visibility (scenes with true depth, as synthetic ones): PSNR over the held-out pixels some training
 //   view also sees (host/eval/covisibility.h), beside the PSNR over every pixel.
-// - geometry: metres, in the scene's frame.
+// - geometry: metres, in the scene's frame, against gt/map.pcd, else the scans the LiDAR map held out
+//   (lidar/heldout.pcd), else the training map itself (circular: said in the output). EMD and the coverage
+//   are restricted to the region the training views observe (host/eval/observed_region.h).
 // LPIPS is not computed: it needs pretrained network weights that this project cannot obtain.
 #pragma once
 
@@ -20,6 +24,7 @@
 #include <vector>
 
 #include "host/eval/emd.h"
+#include "host/eval/observed_region.h"
 #include "host/train/training_data.h"
 
 namespace litgs::host {
@@ -27,6 +32,7 @@ namespace litgs::host {
 struct EvalOptions {
   TrainingDataOptions data;  // must be the training run's (downscale, holdout_every, intensity, poses)
   EmdOptions emd;
+  ObservedRegionOptions region;
   bool geometry = true;  // EMD and plane residuals (needs a reference cloud)
   void check() const;    // std::invalid_argument naming the bad field
 };
@@ -66,8 +72,10 @@ struct ModelEvaluation {
   std::string device;
   // Geometry (absent without a reference).
   std::optional<EmdResult> emd;
-  std::string geometry_reference;  // "gt/map.pcd" or "lidar/map.pcd"
-  std::string plane_reference;     // "gt/planes.txt" or "LiDAR plane fits" or ""
+  std::string geometry_reference;  // "gt/map.pcd", "lidar/heldout.pcd" or "lidar/map.pcd"
+  bool geometry_reference_trained = false;  // the reference is the map that trained the model (circular)
+  std::optional<RegionCoverage> region;     // the observed region (with a reference)
+  std::string plane_reference;     // "gt/planes.txt" or "LiDAR plane fits (...)" or ""
   double centre_plane_rms_m = -1, centre_plane_median_m = -1;
   size_t centre_plane_counted = 0;
 };

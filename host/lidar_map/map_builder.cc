@@ -65,6 +65,8 @@ void LidarMapOptions::check() const {
   if (!(min_range_m >= 0) || !(max_range_m > min_range_m))
     throw std::invalid_argument("LidarMapOptions: need 0 <= min_range_m < max_range_m");
   if (deskew_samples < 2) throw std::invalid_argument("LidarMapOptions.deskew_samples must be >= 2");
+  if (holdout_every < 0 || holdout_every == 1)
+    throw std::invalid_argument("LidarMapOptions.holdout_every must be 0 (none) or >= 2");
   planes.check();
 }
 
@@ -174,22 +176,51 @@ LidarMapReport write_scene_lidar_map(const std::filesystem::path& dir, const Lid
   if (out.empty() && scene.config.has_lidar_map && !replace)
     throw std::invalid_argument(target.string() +
                                 " already exists: pass --force to replace it, or --out to write elsewhere");
-  std::vector<double> times;
-  for (const auto& s : scene.scans) times.push_back(s.t_s);
+  const int every =
+      o.holdout_every > 0 && scene.scans.size() >= 2 * static_cast<size_t>(o.holdout_every) ? o.holdout_every
+                                                                                           : 0;
+  std::vector<size_t> kept, heldout;
+  for (size_t i = 0; i < scene.scans.size(); ++i)
+    (io::is_heldout_scan(i, every) ? heldout : kept).push_back(i);
+  auto build = [&](const std::vector<size_t>& indices, LidarMapReport& report) {
+    std::vector<double> times;
+    for (size_t i : indices) times.push_back(scene.scans[i].t_s);
+    return build_lidar_map(
+        times, [&](size_t k) { return io::read_pcd(dir / scene.scans[indices[k]].file, {true}); },
+        scene_lidar_pose(scene), o, report);
+  };
   LidarMapReport report;
-  const io::PointCloud map = build_lidar_map(
-      times, [&](size_t i) { return io::read_pcd(dir / scene.scans[i].file, {true}); },
-      scene_lidar_pose(scene), o, report);
+  const io::PointCloud map = build(kept, report);
   if (report.scans == 0)
-    throw std::invalid_argument(dir.string() + ": none of the " + std::to_string(times.size()) +
-                                " LiDAR scans lies within the trajectory of poses.txt");
+    throw std::invalid_argument(dir.string() + ": none of the " + std::to_string(kept.size()) +
+                                " LiDAR scans for the map lies within the trajectory of poses.txt");
   io::PcdWriteOptions wo;
   wo.double_positions = true;
+  const std::filesystem::path heldout_target =
+      out.empty() ? dir / io::kHeldoutScansMap
+                  : target.parent_path() / (target.stem().string() + ".heldout.pcd");
+  io::PointCloud held_map;
+  if (!heldout.empty()) {
+    LidarMapReport held;
+    held_map = build(heldout, held);
+    report.scans_heldout = held.scans;
+    report.heldout_points = held_map.size();
+  } else if (o.holdout_every > 0) {
+    report.notes.push_back("no scan held out: " + std::to_string(scene.scans.size()) +
+                           " scans are fewer than 2 x holdout_every (" + std::to_string(o.holdout_every) +
+                           "); geometry will be measured against the training map itself");
+  }
   io::write_pcd(target, map, wo);
-  if (out.empty() && !scene.config.has_lidar_map) {
+  std::error_code ignored;
+  std::filesystem::remove(heldout_target, ignored);  // a stale one would pair with the wrong map
+  if (report.scans_heldout > 0) io::write_pcd(heldout_target, held_map, wo);
+  if (out.empty()) {
     io::SceneConfig config = scene.config;
     config.has_lidar_map = true;
-    io::write_scene_yaml(dir / "scene.yaml", config);
+    config.lidar_holdout_every = report.scans_heldout > 0 ? every : 0;
+    if (config.has_lidar_map != scene.config.has_lidar_map ||
+        config.lidar_holdout_every != scene.config.lidar_holdout_every)
+      io::write_scene_yaml(dir / "scene.yaml", config);
   }
   return report;
 }

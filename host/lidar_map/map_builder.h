@@ -23,6 +23,10 @@ struct LidarMapOptions {
   bool deskew = true;        // use the scans' per-point "time" field where they have one
   int deskew_samples = 8;    // poses sampled across one scan's time span, interpolated between
   PlaneFitOptions planes;    // the per-point plane fit on the voxel centroids
+  // Scans 0, N, 2N, ... stay out of the map and go into lidar/heldout.pcd, so that geometry and the
+  // refinement's scan check meet measurements the map never held (0: every scan in the map). Scenes with
+  // fewer than 2N scans hold none out.
+  int holdout_every = io::kDefaultLidarHoldoutEvery;
   void check() const;        // throws std::invalid_argument naming the bad field
 };
 
@@ -30,6 +34,8 @@ struct LidarMapReport {
   size_t scans = 0;               // scans used
   size_t scans_without_pose = 0;  // outside the trajectory: skipped
   size_t scans_deskewed = 0;      // with a per-point time field
+  size_t scans_heldout = 0;       // left out of the map (write_scene_lidar_map): in lidar/heldout.pcd
+  size_t heldout_points = 0;      // points of the held-out map
   size_t input_points = 0;        // in range, over the scans used
   size_t map_points = 0, planar_points = 0;
   double seconds = 0;
@@ -54,7 +60,8 @@ io::PointCloud build_lidar_map(const std::vector<double>& scan_times_s,
                                LidarMapReport& report);
 
 // Reads the scene's scans and trajectory, builds the map and writes it: to `out` when given (scene.yaml
-// untouched), else to lidar/map.pcd with scene.yaml's lidar_map set to true. An existing lidar/map.pcd is
+// untouched; the held-out scans' map beside it as <out stem>.heldout.pcd), else to lidar/map.pcd and
+// lidar/heldout.pcd with scene.yaml's lidar_map and lidar_holdout_every set. An existing lidar/map.pcd is
 // kept unless `replace`. std::invalid_argument naming the problem (no scans, no scan within the trajectory,
 // a map already there); io::IoError on file errors.
 LidarMapReport write_scene_lidar_map(const std::filesystem::path& scene_dir, const LidarMapOptions& options,

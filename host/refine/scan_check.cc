@@ -1,5 +1,6 @@
 #include "host/refine/scan_check.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -30,8 +31,7 @@ void ScanCheckOptions::check() const {
 }
 
 ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>& scans,
-                           const std::vector<CameraPose>& priors, const std::vector<CameraPose>& refined,
-                           const Eigen::Matrix4d& T_cam_lidar, const ScanCheckOptions& o) {
+                           const ScanCheckOptions& o) {
   o.check();
   ScanVerdict v;
   Cloud cloud;
@@ -42,7 +42,7 @@ ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>&
       index.push_back(i);
     }
   if (cloud.pts.empty() || scans.empty()) {
-    v.summary = "scans of every Nth frame: none to compare (no planar map or no scans)";
+    v.summary = "held-out scans: none to compare (no planar map or no scans)";
     return v;
   }
   Tree tree(3, cloud);
@@ -58,17 +58,15 @@ ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>&
     const size_t m = index[nearest];
     return std::abs(map.normals[m].cast<double>().dot(x - map.centres[m].cast<double>()));
   };
-  const Eigen::Matrix3d R_cl = T_cam_lidar.topLeftCorner<3, 3>();
-  const Eigen::Vector3d t_cl = T_cam_lidar.topRightCorner<3, 1>();
   double sum_prior = 0, sum_refined = 0;
   for (const CheckedScan& s : scans) {
-    if (s.frame >= priors.size() || s.frame >= refined.size() || s.points_lidar.empty()) continue;
+    if (s.points_lidar.empty()) continue;
     ++v.scans;
     const size_t step = std::max<size_t>(1, s.points_lidar.size() / o.points_per_scan);
     for (size_t k = 0; k < s.points_lidar.size(); k += step) {
-      const Eigen::Vector3d x_cam = R_cl * s.points_lidar[k] + t_cl;
-      const double dp = distance(priors[s.frame].q * x_cam + priors[s.frame].p);
-      const double dr = distance(refined[s.frame].q * x_cam + refined[s.frame].p);
+      const Eigen::Vector4d x = s.points_lidar[k].homogeneous();
+      const double dp = distance((s.T_world_lidar_prior * x).head<3>());
+      const double dr = distance((s.T_world_lidar_refined * x).head<3>());
       if (!std::isfinite(dp) || !std::isfinite(dr) || dp > o.max_distance_m || dr > o.max_distance_m)
         continue;
       sum_prior += dp;
@@ -85,7 +83,7 @@ ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>&
   char text[320];
   std::snprintf(
       text, sizeof text,
-      "scans of every Nth frame (%zu, %zu points): mean point-to-plane %.4f m through the priors, %.4f m "
+      "held-out scans (%zu, %zu points): mean point-to-plane %.4f m through the priors, %.4f m "
       "through the refined poses%s",
       v.scans, v.points, v.prior_mean_m, v.refined_mean_m,
       !v.measured      ? ": no verdict"

@@ -1,30 +1,33 @@
 // The LiDAR side of the guard against a refinement that makes the poses worse (holdout_guard.h holds the
-// image side): the scans of every Nth frame, taken through the prior and through the refined camera poses
-// (T_world_cam * T_cam_lidar), against the local planes of the LiDAR map. Camera poses that the images
-// like but that put the LiDAR's own measurements off the map's surfaces are worse poses.
+// image side): scans the map left out (scene.yaml lidar_holdout_every), taken through the prior and
+// through the refined trajectories, against the local planes of the LiDAR map. Camera poses that the
+// images like but that put the LiDAR's own measurements off the map's surfaces are worse poses.
 #pragma once
 
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
-#include "host/refine/ba_types.h"
 #include "host/train/lidar_planes.h"
 
 namespace litgs::host::refine {
 
 struct ScanCheckOptions {
-  size_t every = 8;               // the scans of frames 0, N, 2N, ...; 0: no check
+  // Scans 0, N, 2N, ... where the scene holds none out of its map (an older scene: those scans are then
+  // in the map, a weaker check); 0: no check. A scene's own held-out scans take precedence.
+  size_t every = 8;
   size_t points_per_scan = 3000;  // evenly subsampled
   double max_distance_m = 0.3;    // points farther than this from every map plane (either way) are left out
   double tolerance = 0.02;        // refined poses pass when their mean distance <= (1 + tolerance) * priors'
   void check() const;             // std::invalid_argument naming the field
 };
 
-// One checked scan: the frame it belongs to and its points in the LiDAR frame.
+// One checked scan: its points in the LiDAR frame, and the LiDAR's pose at its stamp through each
+// trajectory.
 struct CheckedScan {
-  size_t frame = 0;
   std::vector<Eigen::Vector3d> points_lidar;
+  Eigen::Matrix4d T_world_lidar_prior = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d T_world_lidar_refined = Eigen::Matrix4d::Identity();
 };
 
 struct ScanVerdict {
@@ -36,7 +39,6 @@ struct ScanVerdict {
 };
 
 ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>& scans,
-                           const std::vector<CameraPose>& priors, const std::vector<CameraPose>& refined,
-                           const Eigen::Matrix4d& T_cam_lidar, const ScanCheckOptions& options);
+                           const ScanCheckOptions& options);
 
 }  // namespace litgs::host::refine

@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "host/lidar_map/map_builder.h"
 #include "host/refine/ate.h"
 #include "host/synth/presets.h"
 #include "io/atomic_file.h"
@@ -211,22 +212,32 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
   return j;
 }
 
-// The scans of every Nth frame (LiDAR stamps: frame time + time_offset_cam_lidar_s, within 1 ms) against the
-// map's planes through both pose sets; refined poses that fit them worse give way to the priors.
+// The scans the map left out (or, in a scene that holds none out, every Nth scan) through the prior and
+// the refined trajectories, each interpolated at the scan's stamp, against the map's planes; refined poses
+// that fit them worse give way to the priors.
 void guard_with_scans(const fs::path& dir, const io::Scene& scene, const std::vector<CameraPose>& priors,
                       const ScanCheckOptions& o, PlanarMap& planar, RefineReport& refine_report,
                       ScanVerdict& verdict, std::vector<CameraPose>& poses) {
   if (planar.points.empty()) planar = fit_planes(scene.map->positions, {});
+  const bool own_holdout = scene.config.lidar_holdout_every > 0;
+  io::Scene prior_scene = scene, refined_scene = scene;
+  prior_scene.poses = to_tum(priors, scene.config);
+  refined_scene.poses = to_tum(poses, scene.config);
+  const LidarPoseAt prior_at = scene_lidar_pose(prior_scene), refined_at = scene_lidar_pose(refined_scene);
   std::vector<CheckedScan> scans;
-  for (size_t f = 0; f < scene.frames.size(); f += o.every) {
-    const double t = scene.frames[f].t_s + scene.config.time_offset_cam_lidar_s;
-    for (const auto& s : scene.scans)
-      if (std::abs(s.t_s - t) < 1e-3) {
-        scans.push_back({f, io::read_pcd(dir / s.file).positions});
-        break;
-      }
+  for (size_t i = 0; i < scene.scans.size(); ++i) {
+    if (!io::is_heldout_scan(i, own_holdout ? scene.config.lidar_holdout_every : static_cast<int>(o.every)))
+      continue;
+    const auto prior = prior_at(scene.scans[i].t_s), refined = refined_at(scene.scans[i].t_s);
+    if (!prior || !refined) continue;  // outside the frames' time span
+    scans.push_back({io::read_pcd(dir / scene.scans[i].file).positions, *prior, *refined});
   }
-  verdict = judge_on_scans(planar, scans, priors, poses, scene.config.T_cam_lidar, o);
+  if (!own_holdout)
+    refine_report.notes.push_back(
+        "the map holds every scan (scene.yaml lidar_holdout_every: 0): the scan check uses every " +
+        std::to_string(o.every) + "th scan, which the map also holds; rebuild it with `litgs-engine map "
+        "--force` to hold scans out");
+  verdict = judge_on_scans(planar, scans, o);
   refine_report.notes.push_back(verdict.summary);
   if (!verdict.keep_refined) {
     refine_report.rejected_poses = poses;

@@ -272,6 +272,13 @@ class Runner {
                     value("psnr_db"), value("ssim"), value("emd_m"), value("emd_floor_m"),
                     value("render_ms_per_frame"), value("gaussians"));
       out_ << line;
+      if (m.value("observed_fraction", json()).is_number()) {
+        std::snprintf(line, sizeof line,
+                      "run: EMD over the region the training views see: %.1f%% of the reference, %.1f%% of "
+                      "it within reach of a Gaussian\n",
+                      100 * value("observed_fraction"), 100 * value("covered_fraction"));
+        out_ << line;
+      }
       if (m.value("covisible_psnr_db", json()).is_number()) {
         std::snprintf(line, sizeof line,
                       "run: held-out PSNR %.2f dB on the %.1f%% of pixels a training view saw\n",

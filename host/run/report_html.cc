@@ -64,7 +64,13 @@ std::string summary_table(const json& metrics, const json& eval) {
     t += row("EMD", number(emd["mean_m"], 4, " m") + " &plusmn; " + number(emd["std_m"], 4),
              "against " + escape_html(emd.value("reference", "")) + ", N = " +
                  std::to_string(emd.value("samples", 0)) + ", " + std::to_string(emd.value("rounds", 0)) +
-                 " draws; sampling floor " + number(emd["floor_m"], 4, " m"));
+                 " draws; sampling floor " + number(emd["floor_m"], 4, " m") +
+                 "; inside the region the training views see");
+  const json region = eval.value("observed_region", json());
+  if (region.is_object())
+    t += row("observed region", percent(region["reference_observed_fraction"]) + "% of the reference",
+             percent(region["covered_fraction"]) + "% of it has a Gaussian centre within " +
+                 number(region["coverage_radius_m"], 2, " m"));
   t +=
       row("depth to planes (RMSE)", number(eval["depth_plane_rmse_m"], 4, " m"),
           escape_html(eval["plane_reference"].is_string() ? eval["plane_reference"].get<std::string>() : ""));

@@ -42,6 +42,11 @@ nlohmann::json result(const StageContext& c) {
   if (e.at("emd").is_object()) {
     metrics["emd_m"] = e["emd"]["mean_m"];
     metrics["emd_floor_m"] = e["emd"]["floor_m"];
+    metrics["emd_reference"] = e["emd"]["reference"];
+  }
+  if (e.value("observed_region", nlohmann::json()).is_object()) {
+    metrics["observed_fraction"] = e["observed_region"]["reference_observed_fraction"];
+    metrics["covered_fraction"] = e["observed_region"]["covered_fraction"];
   }
   for (const char* key : {"covisible_psnr_db", "covisible_fraction"})  // null where not measured
     metrics[key] = e.value(key, nlohmann::json());

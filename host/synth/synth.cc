@@ -160,9 +160,18 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
     Rng rng(options.seed, Stream::kLidar, static_cast<uint64_t>(i));
     scans[i] = simulate_lidar_scan(p.world, T_world_lidar[i], scene.frames[i].t_s, t_traj[i], p.lidar, rng);
   });
-  LidarMaps maps = accumulate_lidar_map(scans, T_world_lidar, p.map_voxel_m);
-  scene.map = std::move(maps.noisy);
-  scene.gt->map = std::move(maps.truth);
+  // The map leaves scans 0, N, 2N, ... out, as `litgs-engine map` does, so that refine's scan check meets
+  // scans the map never held; the true map keeps every scan.
+  const int holdout_every = n >= 2 * io::kDefaultLidarHoldoutEvery ? io::kDefaultLidarHoldoutEvery : 0;
+  std::vector<LidarScan> map_scans;
+  std::vector<Eigen::Isometry3d> map_poses;
+  for (int i = 0; i < n; ++i)
+    if (!io::is_heldout_scan(static_cast<size_t>(i), holdout_every)) {
+      map_scans.push_back(scans[i]);
+      map_poses.push_back(T_world_lidar[i]);
+    }
+  scene.map = std::move(accumulate_lidar_map(map_scans, map_poses, p.map_voxel_m).noisy);
+  scene.gt->map = std::move(accumulate_lidar_map(scans, T_world_lidar, p.map_voxel_m).truth);
   scene.gt->planes = p.world.planes();
 
   std::vector<std::vector<io::Anchor>> anchors(n);
@@ -191,6 +200,7 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   c.T_imu_lidar = p.T_imu_lidar.matrix();
   c.poses_frame = io::PoseFrame::kCamera;
   c.has_lidar_map = true;
+  c.lidar_holdout_every = holdout_every;
   std::ostringstream source;
   source << "synthetic: litgs-engine synth --preset " << p.name << " --seed " << options.seed << " --frames "
          << n << " --width " << K.width << " --height " << K.height << (options.drift ? " --drift" : "")

@@ -1,5 +1,6 @@
 #include "host/train/evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "kernels/loss/loss_reference.h"
@@ -42,6 +43,12 @@ double mean_abs_diff(const std::vector<float>& a, const std::vector<float>& b) {
 }
 }  // namespace
 
+std::vector<float> shown_as_written(std::span<const float> render) {
+  std::vector<float> shown(render.begin(), render.end());
+  for (float& v : shown) v = std::clamp(v, 0.0f, 1.0f);
+  return shown;
+}
+
 EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32_t iteration,
                                std::vector<kernels::RenderImages<float>>* renders, const LevelTable* levels) {
   if (renders) renders->clear();
@@ -63,18 +70,21 @@ EvalResult Evaluator::evaluate(const kernels::DeviceGaussians& gaussians, uint32
     const double counts = data_->stretch_high - data_->stretch_low;
     if (levels) {
       const kernels::LevelGeometry g{W, H, 1, static_cast<float>(cam.cx), static_cast<float>(cam.cy)};
-      const std::vector<float> leveled = apply_level(img.image, g, levels->values(i), levels->vignetting());
+      const std::vector<float> leveled =
+          shown_as_written(apply_level(img.image, g, levels->values(i), levels->vignetting()));
+      const std::vector<float> identity = shown_as_written(img.image);
       e.view_psnr_db.emplace_back(data_->views[i].name, kernels::psnr(leveled, target));
       e.psnr_db += e.view_psnr_db.back().second;
       e.ssim += kernels::ssim_reference(leveled, target, 1, W, H);
       e.mae_counts += counts * mean_abs_diff(leveled, target);
-      e.psnr_identity_db += kernels::psnr(img.image, target);
-      e.mae_counts_identity += counts * mean_abs_diff(img.image, target);
+      e.psnr_identity_db += kernels::psnr(identity, target);
+      e.mae_counts_identity += counts * mean_abs_diff(identity, target);
     } else {
-      e.view_psnr_db.emplace_back(data_->views[i].name, kernels::psnr(img.image, target));
+      const std::vector<float> shown = shown_as_written(img.image);
+      e.view_psnr_db.emplace_back(data_->views[i].name, kernels::psnr(shown, target));
       e.psnr_db += e.view_psnr_db.back().second;
-      e.ssim += kernels::ssim_reference(img.image, target, 1, W, H);
-      e.mae_counts += counts * mean_abs_diff(img.image, target);
+      e.ssim += kernels::ssim_reference(shown, target, 1, W, H);
+      e.mae_counts += counts * mean_abs_diff(shown, target);
     }
     if (gt_planes_) {
       const PlaneResidualSum r = depth_plane_residuals(*gt_planes_, cam, img.depth, img.alpha);

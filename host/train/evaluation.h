@@ -1,5 +1,6 @@
 // Evaluation of a model on the held-out views: PSNR and SSIM against the targets, and where the scene has
-// true planes, the RMSE of the rendered depth's point-to-plane residual against them.
+// true planes, the RMSE of the rendered depth's point-to-plane residual against them. Images are scored as
+// an image shows them: the render clamped to [0, 1] (shown_as_written).
 #pragma once
 
 #include <cstdint>
@@ -23,6 +24,9 @@ struct PlaneResidualSum {
 };
 PlaneResidualSum depth_plane_residuals(const PlanarMap& truth_map, const kernels::SplatCamera& camera,
                                        std::span<const float> depth, std::span<const float> alpha);
+
+// The render as `render` writes it, before quantization: every value clamped to [0, 1].
+std::vector<float> shown_as_written(std::span<const float> render);
 
 class Evaluator {
  public:

@@ -28,6 +28,7 @@ class SceneTest : public testing::TempDirTest {
     c.T_cam_lidar << 0, -1, 0, 0.17065, 0, 0, -1, 0.65376, 1, 0, 0, -0.30456, 0, 0, 0, 1;
     c.T_imu_lidar.topRightCorner<3, 1>() = Eigen::Vector3d(-0.27255, 0.00053, -0.17954);
     c.time_offset_cam_lidar_s = -0.0123;
+    c.lidar_holdout_every = 8;
     c.poses_frame = PoseFrame::kImu;
     c.world_offset_m = {999.59453537619925, 1002.8533203485084, 101.14485388253293};
     c.source = "unit test \"full\" scene";
@@ -112,6 +113,7 @@ TEST_F(SceneTest, RoundTripKeepsEverything) {
   EXPECT_EQ(b.time_offset_cam_lidar_s, a.time_offset_cam_lidar_s);
   EXPECT_EQ(b.poses_frame, a.poses_frame);
   EXPECT_EQ(b.has_lidar_map, a.has_lidar_map);
+  EXPECT_EQ(b.lidar_holdout_every, a.lidar_holdout_every);
   EXPECT_EQ(b.world_offset_m, a.world_offset_m);
   EXPECT_EQ(b.source, a.source);
   ASSERT_EQ(r.frames.size(), 3u);

@@ -84,17 +84,19 @@ TEST(RefineScanCheck, AnEmptyScanCountsForNothingAndAShiftedPoseIsWorse) {
   for (int i = 0; i < 40; ++i)
     for (int j = 0; j < 20; ++j) wall.push_back(Eigen::Vector3d(0.1 * i, 5.0, 0.1 * j));
   const PlanarMap map = fit_planes(wall, {});
-  std::vector<CameraPose> truth(2), shifted(2);
-  shifted[1].p = Eigen::Vector3d(0, 0.05, 0);  // 5 cm towards the wall
-  std::vector<CheckedScan> scans = {{0, {}}, {1, {}}};
+  Eigen::Matrix4d shifted = Eigen::Matrix4d::Identity();
+  shifted(1, 3) = 0.05;  // 5 cm towards the wall
+  std::vector<CheckedScan> scans(2);
+  scans[0].T_world_lidar_refined = shifted;
+  scans[1].T_world_lidar_refined = shifted;
   for (int i = 5; i < 35; ++i) scans[1].points_lidar.push_back(Eigen::Vector3d(0.1 * i, 5.0, 0.95));
-  const ScanVerdict v = judge_on_scans(map, scans, truth, shifted, Eigen::Matrix4d::Identity(), {});
+  const ScanVerdict v = judge_on_scans(map, scans, {});
   EXPECT_EQ(v.scans, 1u);  // the empty one is skipped
   ASSERT_TRUE(v.measured);
   EXPECT_LT(v.prior_mean_m, 1e-6);
   EXPECT_NEAR(v.refined_mean_m, 0.05, 1e-6);
   EXPECT_FALSE(v.keep_refined);
-  const ScanVerdict none = judge_on_scans(map, {{0, {}}}, truth, shifted, Eigen::Matrix4d::Identity(), {});
+  const ScanVerdict none = judge_on_scans(map, {scans[0]}, {});
   EXPECT_FALSE(none.measured);
   EXPECT_TRUE(none.keep_refined);
 }

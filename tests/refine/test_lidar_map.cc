@@ -106,5 +106,50 @@ TEST(LidarMap, SyntheticSceneMapLiesOnTheTruePlanes) {
   std::filesystem::remove_all(dir);
 }
 
+// Scans 0, N, 2N, ... stay out of the map and form lidar/heldout.pcd; scene.yaml records N so that refine's
+// scan check and eval's geometry use the same scans. Too few scans: none held out, and the report says so.
+TEST(LidarMap, EveryEighthScanIsHeldOutOfTheMapAndRecorded) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "litgs_lidar_map_holdout";
+  std::filesystem::remove_all(dir);
+  synth::SynthOptions so;
+  so.frames = 17;
+  so.width = 64;
+  so.height = 48;
+  so.out = dir;
+  synth::generate_synthetic_scene(so);
+  EXPECT_EQ(io::read_scene(dir, {false, false}).config.lidar_holdout_every, 8);  // synth holds out too
+  const LidarMapReport r = write_scene_lidar_map(dir, {}, {}, true);
+  EXPECT_EQ(r.scans, 14u);  // 17 less scans 0, 8, 16
+  EXPECT_EQ(r.scans_heldout, 3u);
+  const io::Scene scene = io::read_scene(dir, {false, true});
+  EXPECT_EQ(scene.config.lidar_holdout_every, 8);
+  ASSERT_TRUE(std::filesystem::exists(dir / io::kHeldoutScansMap));
+  EXPECT_EQ(io::read_pcd(dir / io::kHeldoutScansMap).size(), r.heldout_points);
+  EXPECT_GT(r.heldout_points, 100u);
+
+  LidarMapOptions all;
+  all.holdout_every = 0;
+  const LidarMapReport whole = write_scene_lidar_map(dir, all, {}, true);
+  EXPECT_EQ(whole.scans, 17u);
+  EXPECT_EQ(io::read_scene(dir, {false, false}).config.lidar_holdout_every, 0);
+  EXPECT_FALSE(std::filesystem::exists(dir / io::kHeldoutScansMap));  // a stale one would mislead eval
+
+  LidarMapOptions wide;
+  wide.holdout_every = 9;  // 17 scans < 2 x 9: none held out
+  const LidarMapReport none = write_scene_lidar_map(dir, wide, {}, true);
+  EXPECT_EQ(none.scans, 17u);
+  EXPECT_EQ(none.scans_heldout, 0u);
+  ASSERT_FALSE(none.notes.empty());
+  EXPECT_NE(none.notes.back().find("no scan held out"), std::string::npos);
+  EXPECT_THROW(
+      [] {
+        LidarMapOptions bad;
+        bad.holdout_every = 1;
+        bad.check();
+      }(),
+      std::invalid_argument);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace litgs::host
