@@ -43,6 +43,13 @@ struct BaWeights {
   // while the SE(3)-aligned ATE hid it (docs/experiments.md, 2026-11-27 night). 0: off.
   double odometry_sigma_r_rad = 0.002;
   double odometry_sigma_r_per_m = 0.0005;
+  // Position likewise: the LiDAR map is in the odometry's frame, so a camera pose may move from its prior
+  // by the drift but not slide freely. Without it a direction that the planes in view do not constrain
+  // (up along a facade with little ground in the tracks) is held only by the first frame, and the refined
+  // trajectory slid 2 cm off the map while the SE(3)-aligned ATE improved (docs/experiments.md,
+  // 2026-11-28). 0: off.
+  double odometry_sigma_t_m = 0.02;
+  double odometry_sigma_t_per_m = 0.02;
   double gauge_sigma_t_m = 0.01;     // the first frame's pose prior: the odometry's per-frame accuracy
   double gauge_sigma_r_rad = 0.003;  // (translation as rel_sigma_t_m)
   // Priors that are absolute (a georeferenced photogrammetric solution such as Metashape's, not an
