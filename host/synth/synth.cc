@@ -161,7 +161,7 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
     scans[i] = simulate_lidar_scan(p.world, T_world_lidar[i], scene.frames[i].t_s, t_traj[i], p.lidar, rng);
   });
   // The map leaves scans 0, N, 2N, ... out, as `litgs-engine map` does, so that refine's scan check meets
-  // scans the map never held; the true map keeps every scan.
+  // scans the map never held; the true map is the same returns without noise.
   const int holdout_every = n >= 2 * io::kDefaultLidarHoldoutEvery ? io::kDefaultLidarHoldoutEvery : 0;
   std::vector<LidarScan> map_scans;
   std::vector<Eigen::Isometry3d> map_poses;
@@ -170,8 +170,9 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
       map_scans.push_back(scans[i]);
       map_poses.push_back(T_world_lidar[i]);
     }
-  scene.map = std::move(accumulate_lidar_map(map_scans, map_poses, p.map_voxel_m).noisy);
-  scene.gt->map = std::move(accumulate_lidar_map(scans, T_world_lidar, p.map_voxel_m).truth);
+  LidarMaps maps = accumulate_lidar_map(map_scans, map_poses, p.map_voxel_m);
+  scene.map = std::move(maps.noisy);
+  scene.gt->map = std::move(maps.truth);
   scene.gt->planes = p.world.planes();
 
   std::vector<std::vector<io::Anchor>> anchors(n);
