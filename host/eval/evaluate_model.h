@@ -87,7 +87,7 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
 
 nlohmann::json to_json(const ModelEvaluation& e);
 
-// The statement the output and the README make about LPIPS.
+// The statement the output and the docs make about LPIPS.
 inline constexpr const char* kLpipsNote =
     "not available: LPIPS needs pretrained network weights that this project cannot obtain";
 

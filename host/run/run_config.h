@@ -55,7 +55,7 @@ struct RunConfig {
     uint32_t iterations = 2000;
     double downscale = 1.0;
     std::string strategy = "mcmc";
-    // Grown on validation views (README, "The Gaussian budget"; docs/budget.md); ablate fixes it instead.
+    // Grown on validation views (docs/budget.md); ablate fixes it instead.
     std::string max_gaussians = "search";
     double mcmc_growth = 0.3;
     double lambda_geo = 0.6;
@@ -125,18 +125,13 @@ void for_each_field(Config& c, F&& f) {
   f("train", "iterations", c.train.iterations, "training iterations");
   f("train", "downscale", c.train.downscale, "divide image size and intrinsics by this");
   f("train", "strategy", c.train.strategy,
-    "mcmc (fixed budget; through run at 40k over three seeds 0.49 dB above capped adc on DUNR at 320x256, "
-    "within -0.16..+0.05 dB of it on the synthetic presets) | adc (3DGS's densification, capped by "
-    "max_gaussians: faster on the presets, where it stops below the cap; README)");
+    "mcmc (a fixed budget; the default, ahead of capped adc on the real DUNR facade: docs/results.md) | adc "
+    "(3DGS's densification, capped by max_gaussians)");
   f("train", "max_gaussians", c.train.max_gaussians,
     "MCMC budget (adc: cap): search (the default: doubled while the validation PSNR of trainings on the "
-    "training views less a validation eighth still rises, two trainings per budget tried; through run on "
-    "lavapipe it keeps the best fixed budget, or one within 0.2 dB of it with fewer Gaussians, on DUNR, the "
-    "facade and the corridor, and one 0.23 dB below the best on the street; 3-14x one training's time on an "
-    "H100 with an earlier rule that tried fewer budgets, 20-95x on lavapipe; a cut-short search continues on "
-    "rerun), a count (40000 for a quick run: "
-    "the best fixed budget on DUNR, 0.66-1.0 dB below the best on the synthetic presets) or auto (from the "
-    "surface the training views see; README)");
+    "training views less a validation eighth still rises, two trainings per budget; a cut-short search "
+    "continues on rerun; docs/budget.md), a count (40000 for a quick run) or auto (from the surface the "
+    "training views see)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
   f("train", "init", c.train.init,
