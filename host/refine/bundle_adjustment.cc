@@ -7,82 +7,9 @@
 #include <cmath>
 #include <limits>
 
+#include "host/refine/cost_functions.h"
+
 namespace litgs::host::refine {
-namespace {
-
-// Pixel residual of a world point seen by a camera with T_world_cam = (q, p).
-struct Reprojection {
-  Eigen::Vector2d uv;
-  PinholeCamera c;
-  template <class T>
-  bool operator()(const T* q_, const T* p_, const T* X_, T* r) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q(q_);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_), X(X_);
-    const Eigen::Matrix<T, 3, 1> x = q.conjugate() * (X - p);
-    // A point behind the camera gives a large finite residual, not a division by ~0.
-    const T z = x.z() > T(1e-3) ? x.z() : T(1e-3);
-    r[0] = T(c.fx) * x.x() / z + T(c.cx) - T(uv.x());
-    r[1] = T(c.fy) * x.y() / z + T(c.cy) - T(uv.y());
-    return true;
-  }
-};
-
-struct PointToPlane {
-  PlaneRef plane;
-  double inv_sigma;
-  template <class T>
-  bool operator()(const T* X_, T* r) const {
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> X(X_);
-    r[0] = T(inv_sigma) * plane.n.cast<T>().dot(X - plane.l.cast<T>());
-    return true;
-  }
-};
-
-// Relative motion T_i^-1 T_j against the measured one, whitened; rotation as 2 * vec(dq) (radians, small).
-struct RelativePose {
-  Eigen::Quaterniond dq;
-  Eigen::Vector3d dp;
-  double inv_sigma_t, inv_sigma_r;
-  template <class T>
-  bool operator()(const T* qi_, const T* pi_, const T* qj_, const T* pj_, T* r) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> qi(qi_), qj(qj_);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pi(pi_), pj(pj_);
-    const Eigen::Matrix<T, 3, 1> t = qi.conjugate() * (pj - pi);
-    const Eigen::Quaternion<T> e = dq.cast<T>().conjugate() * (qi.conjugate() * qj);
-    for (int k = 0; k < 3; ++k) r[k] = T(inv_sigma_t) * (t[k] - T(dp[k]));
-    for (int k = 0; k < 3; ++k) r[3 + k] = T(2 * inv_sigma_r) * e.vec()[k] * (e.w() < T(0) ? T(-1) : T(1));
-    return true;
-  }
-};
-
-struct AbsolutePose {
-  Eigen::Quaterniond q0;
-  Eigen::Vector3d p0;
-  double inv_sigma_t, inv_sigma_r;
-  template <class T>
-  bool operator()(const T* q_, const T* p_, T* r) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q(q_);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_);
-    const Eigen::Quaternion<T> e = q0.cast<T>().conjugate() * q;
-    for (int k = 0; k < 3; ++k) r[k] = T(inv_sigma_t) * (p[k] - T(p0[k]));
-    for (int k = 0; k < 3; ++k) r[3 + k] = T(2 * inv_sigma_r) * e.vec()[k] * (e.w() < T(0) ? T(-1) : T(1));
-    return true;
-  }
-};
-
-struct AnchorPrior {
-  Eigen::Vector3d a;
-  Eigen::Matrix3d sqrt_info;
-  template <class T>
-  bool operator()(const T* X_, T* r) const {
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> X(X_);
-    const Eigen::Matrix<T, 3, 1> e = sqrt_info.cast<T>() * (X - a.cast<T>());
-    for (int k = 0; k < 3; ++k) r[k] = e[k];
-    return true;
-  }
-};
-
-}  // namespace
 
 double reprojection_error_px(const CameraPose& pose, const PinholeCamera& c, const Eigen::Vector3d& X,
                              const Eigen::Vector2d& uv) {
