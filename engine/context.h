@@ -103,16 +103,16 @@ class Context {
   void end_one_off(VkCommandBuffer cmd);  // submits, waits and gives the command buffer back
 
   // Waits for a submitted fence. On a GPU it polls for up to 20 ms first: a blocking wait returns only when
-  // the driver's interrupt wakes the thread, and polling took 11% off a training iteration on an H200 in a
-  // VM (3.63 -> 3.2 ms, three submits each). A CPU device (lavapipe) needs every core for the work itself,
-  // so there the thread blocks at once.
+  // the driver's interrupt wakes the thread, which in a VM took a noticeable share of a training iteration
+  // (three submits each; docs/experiments.md, "the first runs on a real GPU", issue 18). A CPU device
+  // (lavapipe) needs every core for the work itself, so there the thread blocks at once.
   void wait_for_fence(VkFence fence);
 
   // Runs `use` with the context's kept host-visible staging buffer of at least `bytes` (bytes at most
   // kKeptStagingBytes), under a lock: up- and downloads of renders and small arrays reuse it instead of
   // allocating host-visible memory each time. On an H200, `serve`'s time per render grew with the bytes it
-  // downloaded (40 ms at 320x256, 190 ms at 640x512, for renders of about 1 ms), which points at those
-  // allocations; the change could not be measured there afterwards.
+  // downloaded, far beyond the render's own time, which points at those allocations (docs/results.md, "On a
+  // GPU: NVIDIA H200"); the change could not be measured there afterwards.
   static constexpr uint64_t kKeptStagingBytes = 8ull << 20;
   uint64_t kept_staging_bytes();  // its size now (0 before the first staged transfer)
   template <class Use>

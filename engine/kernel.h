@@ -22,7 +22,8 @@ struct SpecConstant {
 // A binding the kernel reads as a uniform texel buffer (GLSL `samplerBuffer` / `usamplerBuffer` with
 // texelFetch) instead of a storage buffer. Why: on CPU drivers (lavapipe) a storage-buffer load at an index
 // that differs per invocation is a loop over the SIMD lanes, while a texel fetch is one vector gather, and a
-// four-component texel fetches 16 bytes per lane at once (docs/experiments.md, 2026-11-26).
+// four-component texel fetches 16 bytes per lane at once (`bench gather` measures it: docs/performance.md,
+// docs/experiments.md "the rasterizer's per-entry reads as texel fetches", issue 18).
 struct TexelBinding {
   uint32_t index = 0;                     // binding index, < KernelDesc::binding_count
   VkFormat format = VK_FORMAT_UNDEFINED;  // element format: R32_UINT, R32_SFLOAT or R32G32B32A32_SFLOAT

@@ -1,8 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Gathers four-float records from a storage buffer (kernels/bench/gather_shared.h): as one vec4 load per
-// record, or (VEC4_LOADS = 0) as four float loads, the way the rasterizer read its attributes before
-// 2026-11-26.
+// record, or (VEC4_LOADS = 0) as four float loads, the way the rasterizer read its attributes before they
+// became texel fetches (docs/experiments.md, issue 18).
 #include "bench/gather_shared.h"
 
 layout(local_size_x = GATHER_BENCH_GROUP_SIZE) in;

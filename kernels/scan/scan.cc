@@ -30,8 +30,8 @@ ExclusiveScan::ExclusiveScan(engine::Context& context, ScanOptions options)
   options.check(width);
   // A block is walked serially by one subgroup. A CPU device runs each workgroup on one thread, so long
   // blocks (few dispatches) suit it; a GPU waits on each batch's load in turn, so it takes shorter blocks
-  // and many more workgroups (on an H200, 32 batches instead of 256 took the scans of a 100k-Gaussian
-  // render from 0.92 to 0.21 ms).
+  // and many more workgroups (on an H200, 32 batches instead of 256 made the scans several times faster:
+  // docs/experiments.md, "the first runs on a real GPU", issue 18).
   const uint32_t batches = context.info().type == "cpu" ? 256u : 32u;
   block_size_ = options.block_size != 0 ? options.block_size : width * batches;
   reduce_ = make_subgroup_kernel(context, "scan/scan_reduce", SCAN_REDUCE_BINDING_COUNT, sizeof(ScanParams));

@@ -34,8 +34,9 @@ layout(std430, binding = FWD_BINDING_COUNTERS) buffer Counters { uint counters[]
 // footprint reaches the subgroup's pixels, and every lane then reads those entries from lane k by shuffle,
 // in list order, and blends each into its eight pixels. No shared memory, no barriers; on CPU drivers a
 // shuffle is a register permute. Eight pixels per invocation (footprint.glsl block_origin): an eighth of the
-// subgroups reads the tile's list, and each entry taken by shuffle serves eight pixels (lavapipe, 100k
-// Gaussians at 640x512: 82 ms with one pixel, 48 with four, 45 with eight; docs/experiments.md 2026-11-26).
+// subgroups reads the tile's list, and each entry taken by shuffle serves eight pixels: on a CPU device that
+// roughly halves the forward's time against one pixel per invocation (docs/experiments.md, "four pixels per
+// invocation" and "eight pixels per invocation", issue 18).
 
 // One pixel's blend state. Up to eight per invocation, as separate variables (CPU drivers spill arrays);
 // with one pixel per invocation s1..s7 lie outside the image and are never blended.

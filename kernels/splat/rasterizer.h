@@ -38,8 +38,9 @@ struct RasterizerOptions {
   bool parameter_gradients = true;
   // Pixels each rasterize invocation blends: 8 (a 2x4 block, 8x4 invocations per tile) or 1 (16x16
   // invocations); 0: 8 on a CPU device, where every subgroup reads its tile's whole list and eight pixels
-  // share each read (lavapipe: about 2x faster), 1 on a GPU, whose many lanes want the 256 invocations (an
-  // H200: about 2x faster). Tests set it to run both layouts on one device.
+  // share each read (the block roughly halves the rasterize time on lavapipe), 1 on a GPU, whose many lanes
+  // want the 256 invocations (there the block roughly doubles it; figures: docs/performance.md, issue 18).
+  // Tests set it to run both layouts on one device.
   uint32_t pixels_per_invocation = 0;
 };
 
