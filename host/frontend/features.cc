@@ -119,7 +119,7 @@ ImageFeatures detect_features(const Gray8& image, const FeatureOptions& o) {
   // OpenCV's SIFT doubles the image first (bilinear, pixel centres mapped as (x + 0.5) / 2 - 0.5) but halves
   // the coordinates found there as x / 2: every keypoint lands a quarter pixel right of and below its
   // feature. Uncorrected, that bias moved the refined poses against the LiDAR map (docs/experiments.md,
-  // 2026-11-27 night; FrontendFeatures.SiftKeypointsSitOnTheFeature).
+  // "the refinement on the engine's own tracks", issue 44; FrontendFeatures.SiftKeypointsSitOnTheFeature).
   const float bias = o.type == FeatureType::kSift ? 0.25f : 0.0f;
   for (const auto& k : kept) f.keypoints.push_back({k.pt.x - bias, k.pt.y - bias, k.size, k.angle});
   return f;

@@ -27,9 +27,9 @@ struct BudgetSearchOptions {
   uint32_t start = 5000;  // the first budget (raised to the initialization's size where larger)
   double factor = 2.0;    // each budget is this times the last
   // A larger budget counts as a gain only if its score rises above the best so far by at least this much;
-  // 0 (any rise): "grow while held-out error still falls". At 0.1 dB five of the fourteen recorded searches
-  // stopped a doubling before their validation stopped rising, below their scene's best fixed budget, and
-  // none went past it (docs/budget.md, 2026-11-27).
+  // 0 (any rise): "grow while held-out error still falls". A margin (0.1 dB, the default until issue 15
+  // dropped it) stopped some of the recorded searches a doubling before their validation stopped rising,
+  // below their scene's best fixed budget, and none went past it (docs/budget.md has the replay).
   double min_gain_db = 0.0;
   // Budgets tried past one that did not gain before the search stops: 1 looks one doubling past a plateau
   // (a budget that gains nothing can precede one that does: the facade at 20k).
@@ -37,18 +37,19 @@ struct BudgetSearchOptions {
   uint32_t max_budget = 4000000;  // the MCMC strategy's row limit
   uint32_t validation_every = 8;  // every k-th training view validates (at least one)
   // Trainings per budget, each validating on its own every-k-th of the views (validation_split's fold) with
-  // its own seed; their mean validation PSNR scores the budget. One fold of 4-5 views misranked budgets by
-  // up to 1 dB against the test views (docs/experiments.md); more folds cost one training each.
+  // its own seed; their mean validation PSNR scores the budget. One fold of a few views is a noisy score:
+  // it ranked budgets otherwise than the test views did (docs/budget.md); more folds cost one training each.
   uint32_t folds = 2;
   // Standard errors of shortfall a smaller budget may have against the last one that gained and still be
   // chosen (1: the one-standard-error rule); 0 keeps the last budget that gained. 0 by default: at 1 the
-  // facade's search chose 160k, 0.31 dB below its 320k on the test views over four seeds, and DUNR's and the
-  // street's choices did not change (docs/experiments.md).
+  // facade's search chose 160k, which scored below its 320k on the test views, and DUNR's and the street's
+  // choices did not change (docs/budget.md).
   double parsimony_se = 0.0;
   // Trials train with bit-identical gradients, so that one command keeps one budget: with float atomics the
-  // same trial moved by 0.2-0.35 dB between runs and DUNR's search kept 40k in one run and 80k in another.
-  // Costs about 10% per trial (DUNR at 40k on lavapipe: 36.8 -> 39.6-41.2 ms per iteration;
-  // docs/experiments.md). The final training follows `train --deterministic` as any other.
+  // same trial's score moved between runs by as much as two neighbouring budgets differ, and DUNR's search
+  // kept 40k in one run and 80k in another (docs/budget.md). Ordered sums make each trial somewhat slower
+  // (docs/experiments.md, "deterministic trials", issue 18). The final training follows
+  // `train --deterministic` as any other.
   bool deterministic_trials = true;
   void check() const;  // throws std::invalid_argument naming the bad field
 };
@@ -82,8 +83,8 @@ struct BudgetSearchResult {
 // first trial sets the baseline; the next ones run until patience + 1 budgets in a row fail to gain
 // min_gain_db over the best before them (a budget its initialization filled is not counted: its score
 // measures how densely the seeding points were subsampled, not whether the images ask for more Gaussians;
-// the facade through `run`, seeded from 20k+ LiDAR points, stopped on a plateau of such budgets at 5k), or
-// until a trial ends with fewer Gaussians than its budget (a larger
+// the facade through `run`, seeded from more LiDAR points than its first budgets hold, stopped on a plateau
+// of such budgets: docs/budget.md), or until a trial ends with fewer Gaussians than its budget (a larger
 // budget would train the same model: MCMC's growth in the given iterations, not the budget, limited it). A
 // budget the device cannot hold (train_at throws std::length_error, as buffers over the device's memory or
 // limits do) ends the search at the budget before it, recorded as a failed trial; at the first budget it

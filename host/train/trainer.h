@@ -10,8 +10,9 @@
 // - With `deterministic`, a run interrupted after a checkpoint and resumed with the same options writes the
 //   same bits (point_cloud.ply, and metrics.json but for timings) as the run that was never interrupted.
 // - With float atomics (the default) the gradient sums' order varies run to run, so a resumed run is another
-//   sample of the same training, not the same bits: held-out PSNR within 0.5 dB of an uninterrupted run on
-//   the test scene (tests/gpu/test_train_resume.cc), the spread of two uninterrupted runs.
+//   sample of the same training, not the same bits: its held-out PSNR is as close to an uninterrupted run's
+//   as two uninterrupted runs are to each other (tests/gpu/test_train_resume.cc bounds it; the figures:
+//   docs/training-outputs.md, "Resume").
 // - metrics.json of a resumed run carries the evaluations, counters and resumes of the checkpoint's run.
 #pragma once
 
