@@ -18,8 +18,8 @@ namespace litgs::host::refine {
 
 struct AnchorAssociationOptions {
   // Search radius: radius_px * shrink^round, at least min_radius_px. A wider first radius (16 px) reaches
-  // anchors under larger drift but associated wrong tracks on the synthetic street and facade (worse ATE,
-  // plane RMS 5 -> 24 mm on facade): the default stays small.
+  // anchors under larger drift but associated wrong tracks on the synthetic street and facade (worse ATE
+  // and plane RMS; docs/refinement.md, "Associations"): the default stays small.
   double radius_px = 3;
   double shrink = 0.5;
   double min_radius_px = 3;
@@ -27,8 +27,8 @@ struct AnchorAssociationOptions {
   double occlusion_margin_m = 0.3;  // an anchor farther than the map's surface by more than this is hidden
   // A track agrees with an anchor only if its point, triangulated again from its own observations with
   // the current poses, lies within the anchor's covariance: (X - a)^T Sigma^-1 (X - a) <= gate_chi2, the
-  // 99% quantile of chi^2 with 3 degrees of freedom. Pixel agreement alone takes neighbouring tracks (11%
-  // of the synthetic street's pairs even with the true poses).
+  // 99% quantile of chi^2 with 3 degrees of freedom. Pixel agreement alone takes neighbouring tracks, even
+  // through the true poses (the synthetic street: docs/refinement.md, "Why the anchors hurt").
   double gate_chi2 = 11.34;
   // An anchor that two or more tracks pass the gate for is ambiguous and takes none: on a textured wall an
   // estimator's map point (a patch at a high gradient) and a detector's keypoint need not be the same

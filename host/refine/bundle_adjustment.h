@@ -5,7 +5,8 @@
 // - the signed point-to-plane distance n . (X - l) / plane_sigma_m of a point associated with a LiDAR
 //   plane (a signed residual, differentiable at zero), scaled by the point's weight; Cauchy at 1 sigma:
 //   round 1 associates through the drifting priors, and a point held to the wrong plane must lose its
-//   pull rather than keep the Huber's constant one (street seed 2: 48 -> 10 mm);
+//   pull rather than keep the Huber's constant one (that mended a synthetic street seed the Huber had left
+//   far off: docs/refinement.md, "Why the anchors hurt");
 // - relative-pose priors between consecutive frames from the odometry (the priors' relative motion; sigma
 //   grows with the distance travelled), which keep metric scale, and a prior on the first frame's
 //   pose at the odometry's own per-frame accuracy (the map and the odometry share their first frame), which
@@ -32,22 +33,23 @@ struct BaWeights {
   double rel_sigma_t_per_m = 0.02;  // ... plus this per metre travelled between the frames
   // Rotation sigma between consecutive frames: an odometry's relative rotation comes from its gyro over
   // one frame interval and is far better than any frame's absolute orientation (gauge_sigma_r_rad); at
-  // 3 mrad a sideways shift of the camera traded against a small rotation cost almost nothing
-  // (docs/experiments.md, 2026-11-26: synthetic facade ATE 33% -> 27% of the input).
+  // 3 mrad a sideways shift of the camera traded against a small rotation cost almost nothing, and the
+  // tighter prior lowered the synthetic facade's ATE (docs/refinement.md, "Why the anchors hurt"; issue 14).
   double rel_sigma_r_rad = 0.001;
   double rel_sigma_r_per_m = 0.002;  // ... plus this per metre travelled
   // An odometry's orientation is absolute up to a slow drift (gravity fixes roll and pitch; yaw drifts with
   // distance): every frame gets an orientation prior of this sigma plus the per-metre term times the
   // distance from the first frame. Without it the images and planes leave a rotation of the whole
   // trajectory nearly free, and the refined orientations drifted further from the truth than the priors'
-  // while the SE(3)-aligned ATE hid it (docs/experiments.md, 2026-11-27 night). 0: off.
+  // while the SE(3)-aligned ATE hid it (docs/experiments.md, "the refinement on the engine's own tracks",
+  // issue 44). 0: off.
   double odometry_sigma_r_rad = 0.002;
   double odometry_sigma_r_per_m = 0.0005;
   // Position likewise: the LiDAR map is in the odometry's frame, so a camera pose may move from its prior
   // by the drift but not slide freely. Without it a direction that the planes in view do not constrain
   // (up along a facade with little ground in the tracks) is held only by the first frame, and the refined
-  // trajectory slid 2 cm off the map while the SE(3)-aligned ATE improved (docs/experiments.md,
-  // 2026-11-28). 0: off.
+  // trajectory slid off the map while the SE(3)-aligned ATE improved (docs/experiments.md, "Figures moved
+  // out of code comments"). 0: off.
   double odometry_sigma_t_m = 0.02;
   double odometry_sigma_t_per_m = 0.02;
   double gauge_sigma_t_m = 0.01;     // the first frame's pose prior: the odometry's per-frame accuracy

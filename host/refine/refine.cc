@@ -214,7 +214,8 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
     const auto round_start = std::chrono::steady_clock::now();
     RoundReport rr;
     // Anchors live in the map's frame; projected through drifting priors they land on neighbouring
-    // tracks (76% of the street's pairs in round 1): they join once a solve has brought the poses there.
+    // tracks (most of the street's pairs in round 1: docs/refinement.md, "Why the anchors hurt"): they
+    // join once a solve has brought the poses there.
     // Both associations follow the poses as they improve.
     const bool anchors_now = anchors && r >= o.anchors_from_round;
     if (!anchors_now)

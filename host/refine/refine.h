@@ -16,8 +16,8 @@ namespace litgs::host::refine {
 
 struct RefineOptions {
   // Rounds of association, solve and rejection. 8: on the front end's own tracks (more wrong matches than
-  // the oracle's) the rejection between rounds keeps paying after round 5 (docs/experiments.md,
-  // 2026-11-27 night); with oracle tracks 5 were enough.
+  // the oracle's) the rejection between rounds keeps paying after round 5 (docs/experiments.md, "the
+  // refinement on the engine's own tracks", issue 44); with oracle tracks 5 were enough.
   size_t rounds = 8;
   bool use_anchors = true, use_planes = true;
   size_t window = 20;             // frames per local window (step: half of it); 0: no local pass
