@@ -12,8 +12,8 @@
 namespace litgs::host::run {
 namespace {
 
-// A word-at-a-time multiply-xorshift hash: FNV-1a's byte loop runs at ~1 GB/s, this at several, which
-// matters for multi-gigabyte bags hashed on every rerun.
+// A word-at-a-time multiply-xorshift hash: several times the speed of FNV-1a's byte loop, which matters for
+// multi-gigabyte bags hashed on every rerun (docs/experiments.md, "Figures moved out of code comments").
 class Hasher {
  public:
   void add(const void* data, size_t size) {
