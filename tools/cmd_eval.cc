@@ -102,7 +102,7 @@ void run_eval(const EvalCliOptions& cli) {
   // The trajectories where the scene has ground truth; a trajectory ATE cannot use is said, not fatal.
   std::string why_not;
   try {
-    const auto trajectories = host::evaluate_trajectories(cli.scene, &why_not);
+    const auto trajectories = host::evaluate_trajectories(cli.scene, &why_not, o.data.true_poses);
     if (trajectories) j["trajectory"] = host::to_json(*trajectories);
   } catch (const std::invalid_argument& error) {
     why_not = error.what();

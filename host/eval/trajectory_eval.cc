@@ -47,7 +47,8 @@ std::vector<Eigen::Vector2d> top_view(const std::vector<io::TumPose>& poses, con
 
 }  // namespace
 
-std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, std::string* why_not) {
+std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, std::string* why_not,
+                                                          bool trained_on_truth) {
   io::SceneReadOptions ro;
   ro.check_images = false;
   ro.load_map = false;
@@ -61,7 +62,8 @@ std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, s
   const std::vector<io::TumPose> truth = at_times(scene.gt->poses, times);
   constexpr double kSameTime = 1e-9;  // all three are sampled at the same frame times
   TrajectoryEvaluation r;
-  const std::vector<io::TumPose> estimate = at_times(scene.poses, times);
+  r.trained_on_truth = trained_on_truth;
+  const std::vector<io::TumPose> estimate = at_times(trained_on_truth ? scene.gt->poses : scene.poses, times);
   r.estimate = refine::absolute_trajectory_error(estimate, truth, refine::AteAlignment::kSE3, kSameTime);
   std::vector<io::TumPose> prior;
   if (fs::exists(dir / "poses_prior.txt")) {
@@ -93,6 +95,7 @@ nlohmann::json to_json(const TrajectoryEvaluation& t) {
   return {{"ate_m", t.estimate.rmse_m},
           {"ate_prior_m", t.prior ? nlohmann::json(t.prior->rmse_m) : nlohmann::json(nullptr)},
           {"pairs", t.estimate.pairs},
+          {"poses", t.trained_on_truth ? "gt/poses.txt (the model was trained on the truth)" : "poses.txt"},
           {"alignment", "SE(3) Umeyama, positions at the frame times"},
           {"top_view",
            {{"truth", points(t.truth_top)},
