@@ -14,7 +14,7 @@
 #include "host/train/level_plan.h"
 #include "host/train/metrics_json.h"
 #include "host/train/output_frame.h"
-#include "host/train/refinement.h"
+#include "host/train/density_control.h"
 #include "host/train/run_options.h"
 #include "host/train/training_step.h"
 #include "host/train/view_sampler.h"
@@ -226,7 +226,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   const uint32_t start = run.iteration;
   std::unique_ptr<kernels::McmcStrategy> mcmc;
   if (o.strategy == "mcmc") mcmc = std::make_unique<kernels::McmcStrategy>(ctx);
-  Refinement refinement(ctx, o, planes, static_cast<float>(data.scene_extent_m));
+  DensityControl density_control(ctx, o, planes, static_cast<float>(data.scene_extent_m));
   // The level model: one row per view (held-out rows stay at identity: their level is interpolated).
   const LevelModelKind level_kind = parse_level_model(o.level_model);
   const LevelPlan level_plan(data);
@@ -268,7 +268,7 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     training_step.run(model, mcmc.get(), level.get(),
                       level ? level_plan.step(view, it, o) : kernels::LevelStep{}, it, view, kernel_ms,
                       record.counters);
-    refinement.after_step(model, mcmc.get(), step, record.counters);
+    density_control.after_step(model, mcmc.get(), step, record.counters);
     const bool last = step == o.iterations;
     if (last) wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     // At the last step the final evaluation, so that a checkpoint there holds it.

@@ -17,12 +17,12 @@
 
 namespace litgs::host {
 
-class Refinement {
+class DensityControl {
  public:
   // `planes` (optional) drives the plane prune when options.lambda_geo > 0 and options.plane_prune_k > 0.
-  Refinement(engine::Context& context, const TrainOptions& options, const PlanarMap* planes,
+  DensityControl(engine::Context& context, const TrainOptions& options, const PlanarMap* planes,
              float scene_extent_m);
-  ~Refinement();
+  ~DensityControl();
 
   // After the step `step` (1-based): refines if `step` is a refinement step, resets opacities (ADC) if it is
   // a reset step. `mcmc` is the MCMC strategy (null: ADC). May replace model.gaussians(). Adds what it

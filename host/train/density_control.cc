@@ -1,4 +1,4 @@
-#include "host/train/refinement.h"
+#include "host/train/density_control.h"
 
 #include <algorithm>
 #include <vector>
@@ -8,7 +8,7 @@
 
 namespace litgs::host {
 
-Refinement::Refinement(engine::Context& ctx, const TrainOptions& o, const PlanarMap* planes,
+DensityControl::DensityControl(engine::Context& ctx, const TrainOptions& o, const PlanarMap* planes,
                        float scene_extent_m)
     : context_(&ctx), options_(&o), extent_(scene_extent_m), mcmc_(o.mcmc_options()) {
   densify_.grad_threshold = o.densify_grad_threshold;
@@ -19,9 +19,9 @@ Refinement::Refinement(engine::Context& ctx, const TrainOptions& o, const Planar
     plane_index_ = std::make_unique<PlaneDistance>(*planes);
 }
 
-Refinement::~Refinement() = default;
+DensityControl::~DensityControl() = default;
 
-void Refinement::after_step(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc, uint32_t step,
+void DensityControl::after_step(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc, uint32_t step,
                             TrainingCounters& counters) {
   const TrainOptions& o = *options_;
   const uint32_t until = o.refine_until();
