@@ -326,6 +326,9 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
     in.map = &planar;
   }
   std::vector<CameraPose> poses = in.priors;
+  // The points as they came (through the priors), written instead of the solve's when the priors are kept:
+  // points adjusted to turned-down poses would not fit the poses written beside them.
+  const std::vector<TrackPoint> points_through_priors = in.points;
   report.refine = refine(in, poses, refine_options);
   if (report.refine.outcome == "refined" && o.scan_check.every > 0 && scene.map && !scene.scans.empty())
     guard_with_scans(dir, scene, in.priors, o.scan_check, planar, report.refine, report.scans, poses);
@@ -362,7 +365,8 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   if (!kept) io::write_tum(prior_path, scene.poses);
   io::PointCloud cloud;
   io::ScalarField anchor{"anchor", {}}, on_plane{"on_plane", {}}, observations{"observations", {}};
-  for (const auto& p : in.points) {
+  const bool refined = report.refine.outcome == "refined";
+  for (const auto& p : refined ? in.points : points_through_priors) {
     if (!p.active) continue;
     cloud.positions.push_back(p.X);
     anchor.values.push_back(p.anchor);
