@@ -66,6 +66,10 @@ void add_refine_command(CLI::App& app) {
        "Odometry priors: orientation prior on every frame, radians (plus 0.0005 per metre travelled; 0: "
        "off)")
       ->capture_default_str();
+  c->add_option("--relative-rotation-sigma", o->refine.ba.rel_sigma_r_rad,
+                "Odometry priors: rotation sigma between consecutive frames, radians (plus 0.002 per metre "
+                "between them)")
+      ->capture_default_str();
   c->add_option("--odometry-position-sigma", o->refine.ba.odometry_sigma_t_m,
                 "Odometry priors: position prior on every frame, metres (plus 0.02 per metre travelled: the "
                 "map shares the odometry's frame; 0: off)")
