@@ -35,7 +35,11 @@ struct BaWeights {
   // one frame interval and is far better than any frame's absolute orientation (gauge_sigma_r_rad); at
   // 3 mrad a sideways shift of the camera traded against a small rotation cost almost nothing, and the
   // tighter prior lowered the synthetic facade's ATE (docs/refinement.md, "Why the anchors hurt"; issue 14).
-  double rel_sigma_r_rad = 0.001;
+  // With the front end's own tracks the poses jittered by a pitch traded against a height, which a camera
+  // facing a flat wall cannot tell apart; 0.3 mrad, the per-frame orientation noise of the estimator that
+  // synth models, steadied them on every preset and on DUNR's control points (docs/experiments.md, "Issue
+  // 44 on the engine's own tracks, continued").
+  double rel_sigma_r_rad = 0.0003;
   double rel_sigma_r_per_m = 0.002;  // ... plus this per metre travelled
   // An odometry's orientation is absolute up to a slow drift (gravity fixes roll and pitch; yaw drifts with
   // distance): every frame gets an orientation prior of this sigma plus the per-metre term times the

@@ -249,8 +249,11 @@ class Runner {
     out_ << "run: summary (" << (record_path_).string() << ")\n";
     for (const json& s : record_["stages"]) {
       char line[256];
-      std::snprintf(line, sizeof line, "  %-8s %-24s", s["name"].get<std::string>().c_str(),
-                    s["status"].get<std::string>().c_str());
+      std::string status = s["status"].get<std::string>();
+      // refine says what it did, as the report's stage table does: refined, kept the priors or stopped.
+      if (const json m = s.value("metrics", json::object()); m.is_object() && m.contains("outcome"))
+        status += ": " + m["outcome"].get<std::string>();
+      std::snprintf(line, sizeof line, "  %-8s %-24s", s["name"].get<std::string>().c_str(), status.c_str());
       out_ << line;
       if (s.contains("seconds")) {
         std::snprintf(line, sizeof line, " %8.1f s, peak host memory %s", s["seconds"].get<double>(),
