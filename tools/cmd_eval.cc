@@ -72,8 +72,8 @@ void print_text(const host::ModelEvaluation& e, const nlohmann::json& trajectory
               << e.region->reference_points << " points) is seen by a training view, "
               << e.region->gaussians_in_region << " of " << e.region->gaussians
               << " Gaussians lie in it; coverage " << percent(e.region->covered_fraction())
-              << " % of the seen points have a Gaussian centre within " << fixed(e.region->coverage_radius_m, 2)
-              << " m\n";
+              << " % of the seen points have a Gaussian centre within "
+              << fixed(e.region->coverage_radius_m, 2) << " m\n";
   if (e.geometry_reference_trained)
     std::cout << "eval: note: the geometry reference is the map that trained the model (circular): rebuild "
                  "it with `litgs-engine map --force` to hold scans out\n";

@@ -33,8 +33,9 @@ void add_map_command(CLI::App& app) {
   c->add_option("--out", *out, "Write the map here instead of lidar/map.pcd (scene.yaml untouched)");
   c->add_flag("--force", *force, "Replace an existing lidar/map.pcd");
   c->add_flag("!--no-deskew", o->deskew, "Ignore the scans' per-point time field");
-  c->add_option("--holdout-every", o->holdout_every,
-                "Leave scans 0, N, 2N, ... out of the map, for eval's geometry and refine's scan check (0: none)")
+  c->add_option(
+       "--holdout-every", o->holdout_every,
+       "Leave scans 0, N, 2N, ... out of the map, for eval's geometry and refine's scan check (0: none)")
       ->capture_default_str();
   c->callback([scene, out, force, o] {
     const host::LidarMapReport r = host::write_scene_lidar_map(*scene, *o, *out, *force);

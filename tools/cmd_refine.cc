@@ -74,9 +74,10 @@ void add_refine_command(CLI::App& app) {
                 "Odometry priors: position prior on every frame, metres (plus 0.02 per metre travelled: the "
                 "map shares the odometry's frame; 0: off)")
       ->capture_default_str();
-  c->add_option("--scan-check-every", o->scan_check.every,
-                "After the solve, check the scans the map held out (a scene without any: every Nth scan) "
-                "against its planes; refined poses that fit them worse than the priors are not kept (0: no check)")
+  c->add_option(
+       "--scan-check-every", o->scan_check.every,
+       "After the solve, check the scans the map held out (a scene without any: every Nth scan) "
+       "against its planes; refined poses that fit them worse than the priors are not kept (0: no check)")
       ->capture_default_str();
   c->add_flag("--absolute-priors", *absolute, "The same as --priors absolute");
   c->add_option("--control-points", o->control_points_csv,

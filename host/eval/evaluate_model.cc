@@ -197,8 +197,9 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
         opacities[g] = 1.0 / (1.0 + std::exp(-double{model.opacity_logits[g]}));
       }
       // The first surfaces of each training view come from the densest cloud at hand.
-      const io::PointCloud& surfaces =
-          scene.gt && scene.gt->map ? *scene.gt->map : scene.map ? *scene.map : *reference;
+      const io::PointCloud& surfaces = scene.gt && scene.gt->map ? *scene.gt->map
+                                       : scene.map               ? *scene.map
+                                                                 : *reference;
       std::vector<kernels::SplatCamera> training_cameras;
       for (const TrainingView& v : data.views)
         if (!v.heldout) training_cameras.push_back(v.camera);

@@ -72,10 +72,10 @@ struct ModelEvaluation {
   std::string device;
   // Geometry (absent without a reference).
   std::optional<EmdResult> emd;
-  std::string geometry_reference;  // "gt/map.pcd", "lidar/heldout.pcd" or "lidar/map.pcd"
+  std::string geometry_reference;           // "gt/map.pcd", "lidar/heldout.pcd" or "lidar/map.pcd"
   bool geometry_reference_trained = false;  // the reference is the map that trained the model (circular)
   std::optional<RegionCoverage> region;     // the observed region (with a reference)
-  std::string plane_reference;     // "gt/planes.txt" or "LiDAR plane fits (...)" or ""
+  std::string plane_reference;              // "gt/planes.txt" or "LiDAR plane fits (...)" or ""
   double centre_plane_rms_m = -1, centre_plane_median_m = -1;
   size_t centre_plane_counted = 0;
 };

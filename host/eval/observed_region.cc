@@ -96,8 +96,9 @@ double RegionCoverage::covered_fraction() const {
 }
 
 RegionCoverage measure_region(const ObservedRegion& region, const std::vector<Eigen::Vector3d>& reference,
-                              const std::vector<Eigen::Vector3d>& centres, const std::vector<double>& opacities,
-                              const ObservedRegionOptions& o, std::vector<size_t>& observed_reference,
+                              const std::vector<Eigen::Vector3d>& centres,
+                              const std::vector<double>& opacities, const ObservedRegionOptions& o,
+                              std::vector<size_t>& observed_reference,
                               std::vector<size_t>& centres_in_region) {
   o.check();
   if (opacities.size() != centres.size())

@@ -18,19 +18,19 @@
 namespace litgs::host {
 
 struct ObservedRegionOptions {
-  uint32_t cell_px = 8;                // z-buffer cell edge, pixels of the training resolution
-  double depth_margin_m = 0.10;        // how far behind a cell's first surface still counts as seen
-  double depth_margin_fraction = 0.02; // plus this share of the depth (noise grows with range)
-  double coverage_radius_m = 0.10;     // a reference point is covered by a Gaussian centre this near
-  double coverage_min_opacity = 0.1;   // Gaussians fainter than this do not cover
-  void check() const;                  // std::invalid_argument naming the bad field
+  uint32_t cell_px = 8;                 // z-buffer cell edge, pixels of the training resolution
+  double depth_margin_m = 0.10;         // how far behind a cell's first surface still counts as seen
+  double depth_margin_fraction = 0.02;  // plus this share of the depth (noise grows with range)
+  double coverage_radius_m = 0.10;      // a reference point is covered by a Gaussian centre this near
+  double coverage_min_opacity = 0.1;    // Gaussians fainter than this do not cover
+  void check() const;                   // std::invalid_argument naming the bad field
 };
 
 class ObservedRegion {
  public:
   // `reference`: the cloud whose first surfaces bound each view (world frame, as the cameras).
-  ObservedRegion(const std::vector<Eigen::Vector3d>& reference, const std::vector<kernels::SplatCamera>& views,
-                 const ObservedRegionOptions& options);
+  ObservedRegion(const std::vector<Eigen::Vector3d>& reference,
+                 const std::vector<kernels::SplatCamera>& views, const ObservedRegionOptions& options);
   bool contains(const Eigen::Vector3d& x) const;
 
  private:
@@ -57,8 +57,9 @@ struct RegionCoverage {
 // Splits the reference and the Gaussian centres by the region and counts the coverage. `observed_reference`
 // and `centres_in_region` receive the points inside (indices into the inputs).
 RegionCoverage measure_region(const ObservedRegion& region, const std::vector<Eigen::Vector3d>& reference,
-                              const std::vector<Eigen::Vector3d>& centres, const std::vector<double>& opacities,
-                              const ObservedRegionOptions& options, std::vector<size_t>& observed_reference,
+                              const std::vector<Eigen::Vector3d>& centres,
+                              const std::vector<double>& opacities, const ObservedRegionOptions& options,
+                              std::vector<size_t>& observed_reference,
                               std::vector<size_t>& centres_in_region);
 
 }  // namespace litgs::host

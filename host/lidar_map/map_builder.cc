@@ -176,9 +176,9 @@ LidarMapReport write_scene_lidar_map(const std::filesystem::path& dir, const Lid
   if (out.empty() && scene.config.has_lidar_map && !replace)
     throw std::invalid_argument(target.string() +
                                 " already exists: pass --force to replace it, or --out to write elsewhere");
-  const int every =
-      o.holdout_every > 0 && scene.scans.size() >= 2 * static_cast<size_t>(o.holdout_every) ? o.holdout_every
-                                                                                           : 0;
+  const int every = o.holdout_every > 0 && scene.scans.size() >= 2 * static_cast<size_t>(o.holdout_every)
+                        ? o.holdout_every
+                        : 0;
   std::vector<size_t> kept, heldout;
   for (size_t i = 0; i < scene.scans.size(); ++i)
     (io::is_heldout_scan(i, every) ? heldout : kept).push_back(i);

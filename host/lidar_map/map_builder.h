@@ -27,7 +27,7 @@ struct LidarMapOptions {
   // refinement's scan check meet measurements the map never held (0: every scan in the map). Scenes with
   // fewer than 2N scans hold none out.
   int holdout_every = io::kDefaultLidarHoldoutEvery;
-  void check() const;        // throws std::invalid_argument naming the bad field
+  void check() const;  // throws std::invalid_argument naming the bad field
 };
 
 struct LidarMapReport {

@@ -111,12 +111,10 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
       if (f > 0) travelled += (priors[f].p - priors[f - 1].p).norm();
       if (!variable(f)) continue;
       add_pose(f);
-      auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(
-          new AbsolutePose{priors[f].q, priors[f].p,
-                           w.odometry_sigma_t_m > 0
-                               ? 1 / (w.odometry_sigma_t_m + w.odometry_sigma_t_per_m * travelled)
-                               : 0.0,
-                           1 / (w.odometry_sigma_r_rad + w.odometry_sigma_r_per_m * travelled)});
+      auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(new AbsolutePose{
+          priors[f].q, priors[f].p,
+          w.odometry_sigma_t_m > 0 ? 1 / (w.odometry_sigma_t_m + w.odometry_sigma_t_per_m * travelled) : 0.0,
+          1 / (w.odometry_sigma_r_rad + w.odometry_sigma_r_per_m * travelled)});
       problem.AddResidualBlock(cost, new ceres::CauchyLoss(1.0), poses[f].q.coeffs().data(),
                                poses[f].p.data());
       ++s.prior_residuals;

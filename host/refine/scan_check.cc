@@ -81,14 +81,13 @@ ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>&
     v.keep_refined = v.refined_mean_m <= (1 + o.tolerance) * v.prior_mean_m;
   }
   char text[320];
-  std::snprintf(
-      text, sizeof text,
-      "held-out scans (%zu, %zu points): mean point-to-plane %.4f m through the priors, %.4f m "
-      "through the refined poses%s",
-      v.scans, v.points, v.prior_mean_m, v.refined_mean_m,
-      !v.measured      ? ": no verdict"
-      : v.keep_refined ? ""
-                       : ": worse");
+  std::snprintf(text, sizeof text,
+                "held-out scans (%zu, %zu points): mean point-to-plane %.4f m through the priors, %.4f m "
+                "through the refined poses%s",
+                v.scans, v.points, v.prior_mean_m, v.refined_mean_m,
+                !v.measured      ? ": no verdict"
+                : v.keep_refined ? ""
+                                 : ": worse");
   v.summary = text;
   return v;
 }

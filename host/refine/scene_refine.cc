@@ -235,7 +235,8 @@ void guard_with_scans(const fs::path& dir, const io::Scene& scene, const std::ve
   if (!own_holdout)
     refine_report.notes.push_back(
         "the map holds every scan (scene.yaml lidar_holdout_every: 0): the scan check uses every " +
-        std::to_string(o.every) + "th scan, which the map also holds; rebuild it with `litgs-engine map "
+        std::to_string(o.every) +
+        "th scan, which the map also holds; rebuild it with `litgs-engine map "
         "--force` to hold scans out");
   verdict = judge_on_scans(planar, scans, o);
   refine_report.notes.push_back(verdict.summary);

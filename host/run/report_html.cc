@@ -62,10 +62,10 @@ std::string summary_table(const json& metrics, const json& eval) {
   t += row("LPIPS", "not available", escape_html(eval.value("lpips", "")));
   if (emd.is_object())
     t += row("EMD", number(emd["mean_m"], 4, " m") + " &plusmn; " + number(emd["std_m"], 4),
-             "against " + escape_html(emd.value("reference", "")) + ", N = " +
-                 std::to_string(emd.value("samples", 0)) + ", " + std::to_string(emd.value("rounds", 0)) +
-                 " draws; sampling floor " + number(emd["floor_m"], 4, " m") +
-                 "; inside the region the training views see");
+             "against " + escape_html(emd.value("reference", "")) +
+                 ", N = " + std::to_string(emd.value("samples", 0)) + ", " +
+                 std::to_string(emd.value("rounds", 0)) + " draws; sampling floor " +
+                 number(emd["floor_m"], 4, " m") + "; inside the region the training views see");
   const json region = eval.value("observed_region", json());
   if (region.is_object())
     t += row("observed region", percent(region["reference_observed_fraction"]) + "% of the reference",

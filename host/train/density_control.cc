@@ -9,7 +9,7 @@
 namespace litgs::host {
 
 DensityControl::DensityControl(engine::Context& ctx, const TrainOptions& o, const PlanarMap* planes,
-                       float scene_extent_m)
+                               float scene_extent_m)
     : context_(&ctx), options_(&o), extent_(scene_extent_m), mcmc_(o.mcmc_options()) {
   densify_.grad_threshold = o.densify_grad_threshold;
   densify_.max_gaussians = o.max_gaussians;
@@ -21,8 +21,8 @@ DensityControl::DensityControl(engine::Context& ctx, const TrainOptions& o, cons
 
 DensityControl::~DensityControl() = default;
 
-void DensityControl::after_step(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc, uint32_t step,
-                            TrainingCounters& counters) {
+void DensityControl::after_step(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc,
+                                uint32_t step, TrainingCounters& counters) {
   const TrainOptions& o = *options_;
   const uint32_t until = o.refine_until();
   if (step > o.densify_from && step < until && step % o.densify_every == 0) {

@@ -21,7 +21,7 @@ class DensityControl {
  public:
   // `planes` (optional) drives the plane prune when options.lambda_geo > 0 and options.plane_prune_k > 0.
   DensityControl(engine::Context& context, const TrainOptions& options, const PlanarMap* planes,
-             float scene_extent_m);
+                 float scene_extent_m);
   ~DensityControl();
 
   // After the step `step` (1-based): refines if `step` is a refinement step, resets opacities (ADC) if it is

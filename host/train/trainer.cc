@@ -10,11 +10,11 @@
 
 #include "engine/buffer.h"
 #include "host/train/checkpoint.h"
+#include "host/train/density_control.h"
 #include "host/train/evaluation.h"
 #include "host/train/level_plan.h"
 #include "host/train/metrics_json.h"
 #include "host/train/output_frame.h"
-#include "host/train/density_control.h"
 #include "host/train/run_options.h"
 #include "host/train/training_step.h"
 #include "host/train/view_sampler.h"

@@ -76,7 +76,8 @@ TEST(EvalObservedRegion, CoverageCountsTheSeenReferenceWithAGaussianNearby) {
   size_t covered = 0;
   for (size_t i : observed)
     for (size_t g = 0; g < centres.size(); ++g)
-      if (opacities[g] >= o.coverage_min_opacity && (centres[g] - reference[i]).norm() <= o.coverage_radius_m) {
+      if (opacities[g] >= o.coverage_min_opacity &&
+          (centres[g] - reference[i]).norm() <= o.coverage_radius_m) {
         ++covered;
         break;
       }
@@ -95,7 +96,8 @@ TEST(EvalObservedRegion, BadOptionsAreNamed) {
   o.cell_px = 0;
   EXPECT_THROW(ObservedRegion({}, {}, o), std::invalid_argument);
   std::vector<size_t> a, b;
-  EXPECT_THROW(measure_region(ObservedRegion({}, {}, {}), {}, {{0, 0, 1}}, {}, {}, a, b), std::invalid_argument);
+  EXPECT_THROW(measure_region(ObservedRegion({}, {}, {}), {}, {{0, 0, 1}}, {}, {}, a, b),
+               std::invalid_argument);
 }
 
 }  // namespace

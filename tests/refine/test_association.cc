@@ -113,7 +113,7 @@ TEST(RefinePlaneAssociator, TheRadiusShrinksOverTheRounds) {
   const WallScene s;
   const PlaneAssociator associator(s.map, s.camera);
   std::vector<TrackPoint> points = {s.track({0.3, 0.2, 5.2})};  // 20 cm off the wall
-  const PlaneAssociationOptions o;                                // 0.5 m, halved per round, 5 cm at least
+  const PlaneAssociationOptions o;                              // 0.5 m, halved per round, 5 cm at least
   EXPECT_EQ(associator.associate(points, s.poses, 0, o).unassociated, 0u);
   EXPECT_TRUE(points[0].has_plane);
   const PlaneAssociationReport third = associator.associate(points, s.poses, 2, o);  // 12.5 cm
