@@ -36,6 +36,10 @@ void add_synth_command(CLI::App& app) {
                    "textured (weathered surfaces, blur, column noise: calibrated against real frames) | flat "
                    "(the smooth blocks of earlier versions)")
       ->capture_default_str();
+  synth
+      ->add_option("--lidar-holdout-every", o->lidar_holdout_every,
+                   "Leave scans 0, N, 2N, ... out of lidar/map.pcd, as map does (0: every scan in the map)")
+      ->capture_default_str();
   synth->add_flag("--force", o->force, "Replace the scene files in a non-empty --out");
   synth->add_flag("--drift", o->drift,
                   "A known sensor level drift (slow gain and offset warm-up, an offset jump at the first NUC "

@@ -86,6 +86,8 @@ std::string SynthOptions::check() const {
   if (frame_rate_hz && !(*frame_rate_hz >= 1 && *frame_rate_hz <= 200))
     return "frame_rate_hz: must be in [1, 200], got " + std::to_string(*frame_rate_hz);
   if (width.has_value() != height.has_value()) return "width/height: give both or neither";
+  if (lidar_holdout_every < 0 || lidar_holdout_every == 1)
+    return "lidar_holdout_every: must be 0 (none) or >= 2, got " + std::to_string(lidar_holdout_every);
   if (width && (*width < 16 || *width > 8192))
     return "width: must be in [16, 8192], got " + std::to_string(*width);
   if (height && (*height < 16 || *height > 8192))
@@ -162,7 +164,9 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   });
   // The map leaves scans 0, N, 2N, ... out, as `litgs-engine map` does, so that refine's scan check meets
   // scans the map never held; the true map is the same returns without noise.
-  const int holdout_every = n >= 2 * io::kDefaultLidarHoldoutEvery ? io::kDefaultLidarHoldoutEvery : 0;
+  const int holdout_every = options.lidar_holdout_every > 0 && n >= 2 * options.lidar_holdout_every
+                                ? options.lidar_holdout_every
+                                : 0;
   std::vector<LidarScan> map_scans;
   std::vector<Eigen::Isometry3d> map_poses;
   for (int i = 0; i < n; ++i)

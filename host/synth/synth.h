@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "io/scene_types.h"
+
 namespace litgs::host::synth {
 
 struct SynthOptions {
@@ -26,6 +28,9 @@ struct SynthOptions {
   // "textured" (the default: weathered surfaces calibrated against real frames) | "flat" (the smooth
   // blocks of earlier versions); presets.h, Appearance.
   std::string appearance = "textured";
+  // Scans 0, N, 2N, ... left out of lidar/map.pcd, as `litgs-engine map` does (scene.yaml
+  // lidar_holdout_every); 0: every scan in the map. Sequences under 2N frames hold none out.
+  int lidar_holdout_every = io::kDefaultLidarHoldoutEvery;
 
   // Empty if valid, else the first bad field and why (std::invalid_argument from generate_* carries it).
   std::string check() const;

@@ -49,6 +49,7 @@ class FacadeTargets : public ::testing::Test {
     s.out = dir_;
     s.seed = 1;
     s.frames = 24;
+    s.lidar_holdout_every = 0;  // the map of every scan, as when the figures below were measured
     synth::generate_synthetic_scene(s);
     TrainingDataOptions t;
     t.true_poses = true;
