@@ -89,7 +89,7 @@ ModelEvaluation evaluate_model(const std::filesystem::path& model_ply, const std
   std::unique_ptr<PlanarMap> planes = true_planar_map(scene);
   if (planes) {
     e.plane_reference = "gt/planes.txt";
-  } else if (heldout_scans && o.geometry) {
+  } else if (heldout_scans) {
     planes = std::make_unique<PlanarMap>(fit_planes(heldout_scans->positions, PlaneFitOptions{}));
     e.plane_reference = std::string("LiDAR plane fits of the held-out scans (") + io::kHeldoutScansMap + ")";
   } else if (scene.map && o.geometry) {

@@ -71,13 +71,15 @@ void LidarMapOptions::check() const {
 }
 
 LidarPoseAt scene_lidar_pose(const io::Scene& scene) {
-  const Eigen::Matrix4d T_body_lidar = scene.config.poses_frame == io::PoseFrame::kCamera
-                                           ? scene.config.T_cam_lidar
-                                           : scene.config.T_imu_lidar;
+  return scene_lidar_pose(scene.config, scene.poses);
+}
+
+LidarPoseAt scene_lidar_pose(const io::SceneConfig& config, const std::vector<io::TumPose>& trajectory) {
+  const Eigen::Matrix4d T_body_lidar =
+      config.poses_frame == io::PoseFrame::kCamera ? config.T_cam_lidar : config.T_imu_lidar;
   // Camera poses run on the camera clock, IMU poses on the LiDAR's (the convention of export_scene).
-  const double offset =
-      scene.config.poses_frame == io::PoseFrame::kCamera ? scene.config.time_offset_cam_lidar_s : 0.0;
-  const std::vector<io::TumPose>* poses = &scene.poses;
+  const double offset = config.poses_frame == io::PoseFrame::kCamera ? config.time_offset_cam_lidar_s : 0.0;
+  const std::vector<io::TumPose>* poses = &trajectory;
   return [poses, T_body_lidar, offset](double t_lidar) -> std::optional<Eigen::Matrix4d> {
     const auto T = io::tum_pose_at(*poses, t_lidar - offset, 1e-6);
     if (!T) return std::nullopt;

@@ -49,6 +49,9 @@ using LidarPoseAt = std::function<std::optional<Eigen::Matrix4d>(double t_lidar_
 // The scene's LiDAR pose: poses.txt interpolated (camera poses at t_lidar - time_offset_cam_lidar_s, IMU
 // poses, on the LiDAR clock, at t_lidar), times T_cam_lidar or T_imu_lidar.
 LidarPoseAt scene_lidar_pose(const io::Scene& scene);
+// The same through another trajectory in the frame and on the clock scene.yaml gives poses.txt (refine's
+// prior and refined poses); `poses` must outlive the returned function.
+LidarPoseAt scene_lidar_pose(const io::SceneConfig& config, const std::vector<io::TumPose>& poses);
 
 // The map from scans given one at a time (sensor frame; an extra field "time" holds each point's seconds
 // after the scan's stamp). Output: world positions, mean intensity where every scan has one, unit normals

@@ -43,6 +43,13 @@ struct PointToPlane {
   }
 };
 
+// A small rotation error e as the whitened angle-axis 2 vec(e) / sigma (radians), the same for e and -e.
+template <class T>
+void rotation_residual(const Eigen::Quaternion<T>& e, double inv_sigma_r, T* r) {
+  const T sign = e.w() < T(0) ? T(-1) : T(1);
+  for (int k = 0; k < 3; ++k) r[k] = T(2 * inv_sigma_r) * e.vec()[k] * sign;
+}
+
 // Relative motion T_i^-1 T_j against the measured one, whitened; rotation as 2 * vec(dq) (radians, small).
 struct RelativePose {
   Eigen::Quaterniond dq;
@@ -55,7 +62,7 @@ struct RelativePose {
     const Eigen::Matrix<T, 3, 1> t = qi.conjugate() * (pj - pi);
     const Eigen::Quaternion<T> e = dq.cast<T>().conjugate() * (qi.conjugate() * qj);
     for (int k = 0; k < 3; ++k) r[k] = T(inv_sigma_t) * (t[k] - T(dp[k]));
-    for (int k = 0; k < 3; ++k) r[3 + k] = T(2 * inv_sigma_r) * e.vec()[k] * (e.w() < T(0) ? T(-1) : T(1));
+    rotation_residual(e, inv_sigma_r, r + 3);
     return true;
   }
 };
@@ -72,7 +79,7 @@ struct AbsolutePose {
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_);
     const Eigen::Quaternion<T> e = q0.cast<T>().conjugate() * q;
     for (int k = 0; k < 3; ++k) r[k] = T(inv_sigma_t) * (p[k] - T(p0[k]));
-    for (int k = 0; k < 3; ++k) r[3 + k] = T(2 * inv_sigma_r) * e.vec()[k] * (e.w() < T(0) ? T(-1) : T(1));
+    rotation_residual(e, inv_sigma_r, r + 3);
     return true;
   }
 };

@@ -220,10 +220,10 @@ void guard_with_scans(const fs::path& dir, const io::Scene& scene, const std::ve
                       ScanVerdict& verdict, std::vector<CameraPose>& poses) {
   if (planar.points.empty()) planar = fit_planes(scene.map->positions, {});
   const bool own_holdout = scene.config.lidar_holdout_every > 0;
-  io::Scene prior_scene = scene, refined_scene = scene;
-  prior_scene.poses = to_tum(priors, scene.config);
-  refined_scene.poses = to_tum(poses, scene.config);
-  const LidarPoseAt prior_at = scene_lidar_pose(prior_scene), refined_at = scene_lidar_pose(refined_scene);
+  const std::vector<io::TumPose> prior_trajectory = to_tum(priors, scene.config),
+                                 refined_trajectory = to_tum(poses, scene.config);
+  const LidarPoseAt prior_at = scene_lidar_pose(scene.config, prior_trajectory),
+                    refined_at = scene_lidar_pose(scene.config, refined_trajectory);
   std::vector<CheckedScan> scans;
   for (size_t i = 0; i < scene.scans.size(); ++i) {
     if (!io::is_heldout_scan(i, own_holdout ? scene.config.lidar_holdout_every : static_cast<int>(o.every)))

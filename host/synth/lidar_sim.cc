@@ -67,7 +67,8 @@ LidarScan simulate_lidar_scan(const World& world, const Eigen::Isometry3d& T_wor
 }
 
 LidarMaps accumulate_lidar_map(const std::vector<LidarScan>& scans,
-                               const std::vector<Eigen::Isometry3d>& T_world_lidar, double voxel_m) {
+                               const std::vector<Eigen::Isometry3d>& T_world_lidar, double voxel_m,
+                               int holdout_every) {
   if (scans.size() != T_world_lidar.size())
     throw std::invalid_argument("accumulate_lidar_map: one pose per scan is needed");
   if (!(voxel_m > 0)) throw std::invalid_argument("accumulate_lidar_map: voxel_m must be > 0");
@@ -85,6 +86,7 @@ LidarMaps accumulate_lidar_map(const std::vector<LidarScan>& scans,
   LidarMaps maps;
   io::ScalarField plane{"plane_id", {}};
   for (size_t s = 0; s < scans.size(); ++s) {
+    if (io::is_heldout_scan(s, holdout_every)) continue;
     for (size_t i = 0; i < scans[s].points_lidar.size(); ++i) {
       const Eigen::Vector3d p = T_world_lidar[s] * scans[s].points_lidar[i];
       // Voxel of the noisy point; the first point in insertion order wins, so the result is deterministic.

@@ -11,6 +11,7 @@
 #include "host/synth/geometry.h"
 #include "host/synth/rng.h"
 #include "io/point_cloud.h"
+#include "io/scene_types.h"
 
 namespace litgs::host::synth {
 
@@ -55,7 +56,9 @@ struct LidarMaps {
   io::PointCloud noisy;
   io::PointCloud truth;
 };
+// Scans the map holds out (io::is_heldout_scan with `holdout_every`) are in neither map.
 LidarMaps accumulate_lidar_map(const std::vector<LidarScan>& scans,
-                               const std::vector<Eigen::Isometry3d>& T_world_lidar, double voxel_m);
+                               const std::vector<Eigen::Isometry3d>& T_world_lidar, double voxel_m,
+                               int holdout_every = 0);
 
 }  // namespace litgs::host::synth

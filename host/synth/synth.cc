@@ -167,14 +167,7 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   const int holdout_every = options.lidar_holdout_every > 0 && n >= 2 * options.lidar_holdout_every
                                 ? options.lidar_holdout_every
                                 : 0;
-  std::vector<LidarScan> map_scans;
-  std::vector<Eigen::Isometry3d> map_poses;
-  for (int i = 0; i < n; ++i)
-    if (!io::is_heldout_scan(static_cast<size_t>(i), holdout_every)) {
-      map_scans.push_back(scans[i]);
-      map_poses.push_back(T_world_lidar[i]);
-    }
-  LidarMaps maps = accumulate_lidar_map(map_scans, map_poses, p.map_voxel_m);
+  LidarMaps maps = accumulate_lidar_map(scans, T_world_lidar, p.map_voxel_m, holdout_every);
   scene.map = std::move(maps.noisy);
   scene.gt->map = std::move(maps.truth);
   scene.gt->planes = p.world.planes();
