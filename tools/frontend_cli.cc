@@ -45,6 +45,11 @@ void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli
                  "Reject matches this far from the prior poses' epipolar lines (pixels)")
       ->capture_default_str();
   cmd.add_flag("--no-prior-epipolar", cli->no_prior_epipolar, "Do not use the prior poses' epipolar bound");
+  cmd.add_flag("!--no-lidar-check", o.lidar_check.enabled,
+               "Keep the matches the LiDAR map contradicts (default: reject them where the scene has a map)");
+  cmd.add_option("--lidar-transfer-px", o.lidar_check.max_transfer_px,
+                 "LiDAR check: a keypoint lifted to the map's depth must land this near its match (pixels)")
+      ->capture_default_str();
   cmd.add_option("--min-inliers", o.verify.min_inliers, "Verified matches a pair needs")
       ->capture_default_str();
   cmd.add_option("--max-error-px", o.triangulation.max_error_px,
@@ -93,11 +98,16 @@ void print_summary(std::ostream& out, const std::string& title, const host::fron
       << "  keypoints/image " << m.keypoints_per_image << "\n"
       << "  pairs           " << m.pairs_tried << " tried, " << m.pairs_verified << " verified\n"
       << std::setprecision(3) << "  inlier ratio    " << m.inlier_ratio << " (" << m.verified_matches
-      << " verified / " << m.mutual_matches << " mutual matches)\n"
-      << "  tracks          " << m.tracks << " (" << m.track_conflicts << " of " << m.track_matches
-      << " verified matches lost to conflicts; " << m.conflicting_components << " conflicting tracks split, "
-      << m.conflict_keypoints_kept << " of their keypoints kept, " << m.conflict_keypoints_dropped
-      << " dropped)\n"
+      << " verified / " << m.mutual_matches << " mutual matches)\n";
+  if (m.lidar_checked_images)
+    out << "  LiDAR check     " << m.rejected_by_lidar
+        << " essential-matrix inliers contradicted by the map, "
+        << "rejected (" << m.lidar_checked_images << " images with map depth, " << std::setprecision(1)
+        << o.lidar_check.max_transfer_px << " px)\n";
+  out << std::setprecision(3) << "  tracks          " << m.tracks << " (" << m.track_conflicts << " of "
+      << m.track_matches << " verified matches lost to conflicts; " << m.conflicting_components
+      << " conflicting tracks split, " << m.conflict_keypoints_kept << " of their keypoints kept, "
+      << m.conflict_keypoints_dropped << " dropped)\n"
       << "  points          " << m.points << "\n"
       << std::setprecision(2) << "  track length    " << m.mean_track_length << " (mean)\n"
       << std::setprecision(3) << "  reprojection    " << m.mean_error_px << " px (mean)\n";

@@ -69,7 +69,11 @@ SceneAppearance measure_appearance(const std::filesystem::path& dir, const Front
   out.gradients = gradient_histogram(frames);
   out.width = scene.config.camera.width;
   out.height = scene.config.camera.height;
-  out.frontend = run_frontend(dir, options).summary;
+  // The frames' matchability, not the map's: a scene without a map (DUNR's) would otherwise be compared
+  // against one whose repeated texture the map filters out.
+  FrontendOptions frames_only = options;
+  frames_only.lidar_check.enabled = false;
+  out.frontend = run_frontend(dir, frames_only).summary;
   return out;
 }
 

@@ -34,7 +34,8 @@ struct Context {
   PinholeK K;
   std::vector<std::optional<Pose>> poses;
   std::vector<ImageFeatures> features;
-  std::vector<std::vector<Eigen::Vector2d>> undistorted;  // pixels of the ideal pinhole
+  std::vector<std::vector<Eigen::Vector2d>> undistorted;    // pixels of the ideal pinhole
+  std::vector<std::optional<LidarDepthImage>> lidar_depth;  // per image; empty without the LiDAR check
   const FrontendProgress& progress;
 };
 
@@ -48,6 +49,32 @@ std::optional<RelativePose> relative_prior(const Context& c, uint32_t a, uint32_
   r.R_ba = c.poses[b]->R_cam_world * c.poses[a]->R_cam_world.transpose();
   r.t_ba = c.poses[b]->t_cam_world - r.R_ba * c.poses[a]->t_cam_world;
   return r;
+}
+
+// Clears the inliers of `v` that the LiDAR map contradicts; the pair fails when fewer than min_inliers
+// remain. Returns the inliers cleared.
+size_t reject_by_lidar(const Context& c, uint32_t a, uint32_t b,
+                       const std::vector<std::array<uint32_t, 2>>& mutual, Verification& v) {
+  if (c.lidar_depth.empty() || !c.lidar_depth[a] || !c.lidar_depth[b] || !v.verified) return 0;
+  size_t rejected = 0;
+  for (size_t k = 0; k < mutual.size(); ++k) {
+    if (!v.inlier[k]) continue;
+    const DepthView va{c.poses[a]->R_cam_world, c.poses[a]->t_cam_world, c.undistorted[a][mutual[k][0]],
+                       *c.lidar_depth[a]};
+    const DepthView vb{c.poses[b]->R_cam_world, c.poses[b]->t_cam_world, c.undistorted[b][mutual[k][1]],
+                       *c.lidar_depth[b]};
+    if (contradicted_by_lidar(va, vb, c.K, c.o.lidar_check.max_transfer_px)) {
+      v.inlier[k] = 0;
+      ++rejected;
+    }
+  }
+  v.inliers -= rejected;
+  if (v.inliers < c.o.verify.min_inliers) {
+    std::fill(v.inlier.begin(), v.inlier.end(), 0);
+    v.inliers = 0;
+    v.verified = false;
+  }
+  return rejected;
 }
 
 // Matches and verifies `pairs` on the pool; results in the pairs' order.
@@ -68,13 +95,14 @@ void match_pairs(const Context& c, const std::vector<ImagePair>& pairs, std::vec
                                                                     *prior, c.o.verify.prior_epipolar_px),
                                                    c.o.match)
                               : match_mutual(c.features[a], c.features[b], c.o.match);
-    const Verification v = verify_pair(c.undistorted[a], c.undistorted[b], mutual, c.K, prior, c.o.verify);
+    Verification v = verify_pair(c.undistorted[a], c.undistorted[b], mutual, c.K, prior, c.o.verify);
+    const size_t rejected_by_lidar = reject_by_lidar(c, a, b, mutual, v);
     io::SfmPairMatches& m = out[first + p];
     m.image_a = a;
     m.image_b = b;
     for (size_t k = 0; k < mutual.size(); ++k)
       m.matches.push_back({mutual[k][0], mutual[k][1], v.inlier[k] != 0});
-    stats[first + p] = {a, b, mutual.size(), v.inliers, v.rejected_by_prior, v.verified};
+    stats[first + p] = {a, b, mutual.size(), v.inliers, v.rejected_by_prior, rejected_by_lidar, v.verified};
     std::lock_guard<std::mutex> lock(progress_mutex);
     ++done;
     if (std::this_thread::get_id() == caller) report(c, "matching", done, pairs.size());
@@ -175,6 +203,7 @@ void summarize(FrontendResult& r, const Structure& s) {
     m.mutual_matches += p.mutual;
     m.verified_matches += p.verified;
     m.rejected_by_prior += p.rejected_by_prior;
+    m.rejected_by_lidar += p.rejected_by_lidar;
   }
   m.inlier_ratio = m.mutual_matches
                        ? static_cast<double>(m.verified_matches) / static_cast<double>(m.mutual_matches)
@@ -211,6 +240,7 @@ void FrontendOptions::check() const {
   pairs.check();
   triangulation.check();
   conflicts.check();
+  lidar_check.check();
   if (threads < 0) throw std::invalid_argument("threads must be >= 0");
 }
 
@@ -221,7 +251,8 @@ FrontendResult run_frontend(const std::filesystem::path& dir, const FrontendOpti
   FrontendResult r;
   r.options = o;
   FrontendSummary& m = r.summary;
-  io::Scene scene = io::read_scene(dir, {.check_images = true, .load_map = false});
+  const bool lidar_check = o.lidar_check.enabled && !o.true_poses;
+  io::Scene scene = io::read_scene(dir, {.check_images = true, .load_map = lidar_check});
   if (o.true_poses) {
     if (!scene.gt || scene.gt->poses.empty())
       throw std::invalid_argument(dir.string() + ": true poses asked for, but the scene has no gt/poses.txt");
@@ -236,7 +267,7 @@ FrontendResult run_frontend(const std::filesystem::path& dir, const FrontendOpti
   m.seconds.preprocess = since(t0);
   m.images = frames.size();
 
-  Context c{o, cam, {cam.fx, cam.fy, cam.cx, cam.cy}, {}, {}, {}, progress};
+  Context c{o, cam, {cam.fx, cam.fy, cam.cx, cam.cy}, {}, {}, {}, {}, progress};
   const auto poses = io::camera_poses_at_frames(scene);
   for (const auto& T : poses) {
     if (!T) {
@@ -281,6 +312,20 @@ FrontendResult run_frontend(const std::filesystem::path& dir, const FrontendOpti
     if (std::this_thread::get_id() == caller) report(c, "features", features_done, kept.size());
   });
   report(c, "features", kept.size(), kept.size());
+  if (lidar_check && scene.map && scene.map->size()) {
+    c.lidar_depth.resize(frames.size());
+    parallel_for(kept.size(), o.threads, [&](size_t k) {
+      const uint32_t i = kept[k];
+      if (c.poses[i])
+        c.lidar_depth[i].emplace(scene.map->positions, c.poses[i]->R_cam_world, c.poses[i]->t_cam_world, c.K,
+                                 cam.width, cam.height, o.lidar_check);
+    });
+    for (const auto& d : c.lidar_depth) m.lidar_checked_images += d.has_value();
+  } else if (o.lidar_check.enabled) {
+    m.notes.push_back(o.true_poses
+                          ? "LiDAR check off: the map is in the odometry's frame, not the true poses'"
+                          : "LiDAR check off: the scene has no LiDAR map");
+  }
   for (uint32_t i : kept) {
     r.data.images[i].keypoints = c.features[i].keypoints;
     m.keypoints += c.features[i].keypoints.size();
@@ -364,74 +409,79 @@ std::string frontend_json(const FrontendResult& r) {
          {"mutual", p.mutual},
          {"verified", p.verified},
          {"rejected_by_prior", p.rejected_by_prior},
+         {"rejected_by_lidar", p.rejected_by_lidar},
          {"accepted", p.accepted},
          {"inlier_ratio", p.mutual ? static_cast<double>(p.verified) / static_cast<double>(p.mutual) : 0.0}});
-  json j = {{"format", "litgs-frontend 1"},
-            {"options",
-             {{"features", feature_name(o.features.type)},
-              {"max_keypoints", o.features.max_keypoints},
-              {"grid", {o.features.grid_cols, o.features.grid_rows}},
-              {"clahe", o.preprocess.clahe},
-              {"clahe_clip_limit", o.preprocess.clahe_clip_limit},
-              {"clahe_tiles", o.preprocess.clahe_tiles},
-              {"stretch_percentiles", {o.preprocess.low_percentile, o.preprocess.high_percentile}},
-              {"stretch_window", o.preprocess.stretch_window},
-              {"frozen_threshold", o.preprocess.frozen_threshold},
-              {"pairs", pairs_name(o.pairs)},
-              {"ratio", o.match.ratio},
-              {"magsac_threshold_px", o.verify.max_error_px},
-              {"prior_epipolar_px", o.prior_epipolar ? json(o.verify.prior_epipolar_px) : json(nullptr)},
-              {"min_inliers", o.verify.min_inliers},
-              {"triangulation_max_error_px", o.triangulation.max_error_px},
-              {"min_angle_deg", o.triangulation.min_angle_deg},
-              {"min_views", o.triangulation.min_views},
-              {"split_conflicts", o.split_conflicts},
-              {"conflict_max_error_px", o.conflicts.max_error_px},
-              {"threads", resolve_threads(o.threads)},
-              {"poses", o.true_poses ? "gt/poses.txt" : "poses.txt"}}},
-            {"summary",
-             {{"images", m.images},
-              {"frozen", m.frozen},
-              {"uniform", m.uniform},
-              {"without_pose", m.without_pose},
-              {"keypoints", m.keypoints},
-              {"keypoints_per_image", m.keypoints_per_image},
-              {"pairs_tried", m.pairs_tried},
-              {"pairs_verified", m.pairs_verified},
-              {"mutual_matches", m.mutual_matches},
-              {"verified_matches", m.verified_matches},
-              {"rejected_by_prior", m.rejected_by_prior},
-              {"inlier_ratio", m.inlier_ratio},
-              {"tracks", m.tracks},
-              {"track_conflicts", m.track_conflicts},
-              {"track_matches", m.track_matches},
-              {"conflicts",
-               {{"split", o.split_conflicts},
-                {"components", m.conflicting_components},
-                {"keypoints_kept", m.conflict_keypoints_kept},
-                {"keypoints_dropped", m.conflict_keypoints_dropped},
-                {"lost_match_share", m.track_matches ? static_cast<double>(m.track_conflicts) /
-                                                           static_cast<double>(m.track_matches)
-                                                     : 0.0}}},
-              {"points", m.points},
-              {"mean_track_length", m.mean_track_length},
-              {"mean_reprojection_error_px", m.mean_error_px},
-              {"true_plane_distance_m", {{"median", m.true_plane_median_m}, {"mean", m.true_plane_mean_m}}},
-              {"rejected_tracks",
-               {{"no_angle", m.rejected_no_angle},
-                {"depth", m.rejected_depth},
-                {"reprojection_error", m.rejected_error},
-                {"too_few_views", m.rejected_few_views}}},
-              {"seconds",
-               {{"preprocess", m.seconds.preprocess},
-                {"features", m.seconds.features},
-                {"pair_selection", m.seconds.pair_selection},
-                {"matching", m.seconds.matching},
-                {"triangulation", m.seconds.triangulation},
-                {"total", m.seconds.total}}},
-              {"notes", m.notes}}},
-            {"frozen_frames", r.frozen_frames},
-            {"pairs", pairs}};
+  json j = {
+      {"format", "litgs-frontend 1"},
+      {"options",
+       {{"features", feature_name(o.features.type)},
+        {"max_keypoints", o.features.max_keypoints},
+        {"grid", {o.features.grid_cols, o.features.grid_rows}},
+        {"clahe", o.preprocess.clahe},
+        {"clahe_clip_limit", o.preprocess.clahe_clip_limit},
+        {"clahe_tiles", o.preprocess.clahe_tiles},
+        {"stretch_percentiles", {o.preprocess.low_percentile, o.preprocess.high_percentile}},
+        {"stretch_window", o.preprocess.stretch_window},
+        {"frozen_threshold", o.preprocess.frozen_threshold},
+        {"pairs", pairs_name(o.pairs)},
+        {"ratio", o.match.ratio},
+        {"magsac_threshold_px", o.verify.max_error_px},
+        {"prior_epipolar_px", o.prior_epipolar ? json(o.verify.prior_epipolar_px) : json(nullptr)},
+        {"min_inliers", o.verify.min_inliers},
+        {"lidar_transfer_px", o.lidar_check.enabled ? json(o.lidar_check.max_transfer_px) : json(nullptr)},
+        {"triangulation_max_error_px", o.triangulation.max_error_px},
+        {"min_angle_deg", o.triangulation.min_angle_deg},
+        {"min_views", o.triangulation.min_views},
+        {"split_conflicts", o.split_conflicts},
+        {"conflict_max_error_px", o.conflicts.max_error_px},
+        {"threads", resolve_threads(o.threads)},
+        {"poses", o.true_poses ? "gt/poses.txt" : "poses.txt"}}},
+      {"summary",
+       {{"images", m.images},
+        {"frozen", m.frozen},
+        {"uniform", m.uniform},
+        {"without_pose", m.without_pose},
+        {"keypoints", m.keypoints},
+        {"keypoints_per_image", m.keypoints_per_image},
+        {"pairs_tried", m.pairs_tried},
+        {"pairs_verified", m.pairs_verified},
+        {"mutual_matches", m.mutual_matches},
+        {"verified_matches", m.verified_matches},
+        {"rejected_by_prior", m.rejected_by_prior},
+        {"rejected_by_lidar", m.rejected_by_lidar},
+        {"lidar_checked_images", m.lidar_checked_images},
+        {"inlier_ratio", m.inlier_ratio},
+        {"tracks", m.tracks},
+        {"track_conflicts", m.track_conflicts},
+        {"track_matches", m.track_matches},
+        {"conflicts",
+         {{"split", o.split_conflicts},
+          {"components", m.conflicting_components},
+          {"keypoints_kept", m.conflict_keypoints_kept},
+          {"keypoints_dropped", m.conflict_keypoints_dropped},
+          {"lost_match_share",
+           m.track_matches ? static_cast<double>(m.track_conflicts) / static_cast<double>(m.track_matches)
+                           : 0.0}}},
+        {"points", m.points},
+        {"mean_track_length", m.mean_track_length},
+        {"mean_reprojection_error_px", m.mean_error_px},
+        {"true_plane_distance_m", {{"median", m.true_plane_median_m}, {"mean", m.true_plane_mean_m}}},
+        {"rejected_tracks",
+         {{"no_angle", m.rejected_no_angle},
+          {"depth", m.rejected_depth},
+          {"reprojection_error", m.rejected_error},
+          {"too_few_views", m.rejected_few_views}}},
+        {"seconds",
+         {{"preprocess", m.seconds.preprocess},
+          {"features", m.seconds.features},
+          {"pair_selection", m.seconds.pair_selection},
+          {"matching", m.seconds.matching},
+          {"triangulation", m.seconds.triangulation},
+          {"total", m.seconds.total}}},
+        {"notes", m.notes}}},
+      {"frozen_frames", r.frozen_frames},
+      {"pairs", pairs}};
   return j.dump(1);
 }
 

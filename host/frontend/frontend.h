@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "host/frontend/features.h"
+#include "host/frontend/lidar_depth_check.h"
 #include "host/frontend/matching.h"
 #include "host/frontend/pair_selection.h"
 #include "host/frontend/preprocess.h"
@@ -24,6 +25,9 @@ struct FrontendOptions {
   MatchOptions match;
   VerifyOptions verify;
   bool prior_epipolar = true;  // reject matches far from the prior poses' epipolar lines
+  // Reject verified matches the LiDAR map contradicts (lidar_depth_check.h); not with true_poses, whose
+  // frame the map (built through the odometry) is not in.
+  LidarCheckOptions lidar_check;
   PairOptions pairs;
   TriangulationOptions triangulation;
   // Tracks that would hold two keypoints of one image are split by the prior poses (track_conflicts.h);
@@ -40,7 +44,8 @@ struct FrontendOptions {
 struct PairStats {
   uint32_t image_a = 0, image_b = 0;
   size_t mutual = 0, verified = 0, rejected_by_prior = 0;
-  bool accepted = false;  // at least min_inliers verified
+  size_t rejected_by_lidar = 0;  // essential-matrix inliers the LiDAR map contradicts (not in `verified`)
+  bool accepted = false;         // at least min_inliers verified
 };
 
 struct StageSeconds {
@@ -54,8 +59,9 @@ struct FrontendSummary {
   size_t keypoints = 0;
   double keypoints_per_image = 0;  // over the images matched (not frozen)
   size_t pairs_tried = 0, pairs_verified = 0;
-  size_t mutual_matches = 0, verified_matches = 0, rejected_by_prior = 0;
-  double inlier_ratio = 0;  // verified / mutual over all pairs tried (the sequence's)
+  size_t mutual_matches = 0, verified_matches = 0, rejected_by_prior = 0, rejected_by_lidar = 0;
+  size_t lidar_checked_images = 0;  // images with a LiDAR depth image (0: the check did not run)
+  double inlier_ratio = 0;          // verified / mutual over all pairs tried (the sequence's)
   size_t tracks = 0, points = 0;
   // Verified matches lost to conflicts (their keypoints ended in different tracks, or in none), out of
   // track_matches; the components split and their keypoints kept in a track or dropped.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 namespace litgs::host::frontend {
@@ -48,10 +49,64 @@ Support support_of(const Eigen::Vector3d& X, const std::vector<size_t>& remainin
   return s;
 }
 
+// Tracks of one point that the priors' drift split in time: two groups without a shared image, joined by
+// verified matches, whose union still reprojects within merge_factor times the bound. Pairs with more
+// matches between them merge first. Empties the groups merged away.
+void merge_disjoint_groups(std::vector<std::vector<size_t>>& groups,
+                           const std::vector<std::array<size_t, 2>>& edges, const io::SfmTrack& component,
+                           const std::vector<std::optional<TriangulationView>>& views, double fx, double fy,
+                           const ConflictOptions& o) {
+  if (!(o.merge_factor > 0) || groups.size() < 2) return;
+  std::vector<size_t> group_of(component.observations.size(), SIZE_MAX);
+  for (size_t g = 0; g < groups.size(); ++g)
+    for (size_t m : groups[g]) group_of[m] = g;
+  std::map<std::pair<size_t, size_t>, size_t> links;
+  for (const auto& e : edges) {
+    if (e[0] >= group_of.size() || e[1] >= group_of.size()) continue;
+    const size_t a = group_of[e[0]], b = group_of[e[1]];
+    if (a != SIZE_MAX && b != SIZE_MAX && a != b) ++links[{std::min(a, b), std::max(a, b)}];
+  }
+  std::vector<std::pair<size_t, std::pair<size_t, size_t>>> order;
+  for (const auto& [pair, count] : links) order.push_back({count, pair});
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& x, const auto& y) { return x.first > y.first; });
+  std::vector<size_t> root(groups.size());
+  for (size_t g = 0; g < root.size(); ++g) root[g] = g;
+  auto find = [&root](size_t g) {
+    while (root[g] != g) g = root[g] = root[root[g]];
+    return g;
+  };
+  const double bound = o.merge_factor * o.max_error_px;
+  for (const auto& [count, pair] : order) {
+    const size_t a = find(pair.first), b = find(pair.second);
+    if (a == b) continue;
+    std::vector<size_t> joined = groups[a];
+    joined.insert(joined.end(), groups[b].begin(), groups[b].end());
+    std::vector<uint32_t> images;
+    for (size_t m : joined) images.push_back(component.observations[m].image);
+    std::sort(images.begin(), images.end());
+    if (std::adjacent_find(images.begin(), images.end()) != images.end()) continue;
+    std::vector<TriangulationView> member_views;
+    for (size_t m : joined) member_views.push_back(*views[m]);
+    std::vector<size_t> all(member_views.size());
+    for (size_t k = 0; k < all.size(); ++k) all[k] = k;
+    const Eigen::Vector3d X = triangulate_linear(member_views, all);
+    if (!X.allFinite()) continue;
+    const bool consistent = std::all_of(member_views.begin(), member_views.end(), [&](const auto& v) {
+      return error2_px(v, X, fx, fy) <= bound * bound;
+    });
+    if (!consistent) continue;
+    groups[a] = std::move(joined);
+    groups[b].clear();
+    root[b] = a;
+  }
+}
+
 }  // namespace
 
 void ConflictOptions::check() const {
   if (!(max_error_px > 0)) throw std::invalid_argument("conflicts.max_error_px must be > 0");
+  if (!(merge_factor >= 0)) throw std::invalid_argument("conflicts.merge_factor must be >= 0");
   if (max_hypotheses < 1) throw std::invalid_argument("conflicts.max_hypotheses must be >= 1");
 }
 
@@ -66,6 +121,7 @@ ConflictSplit split_conflicting_component(const io::SfmTrack& component,
   std::vector<char> used(n, 0);
   std::vector<std::array<size_t, 2>> open = edges;
   ConflictSplit out;
+  std::vector<std::vector<size_t>> groups;  // the tracks as observation indices
   const double bound2 = o.max_error_px * o.max_error_px;
   while (true) {
     std::vector<size_t> remaining;
@@ -90,11 +146,30 @@ ConflictSplit split_conflicting_component(const io::SfmTrack& component,
         best = std::move(s);
     }
     if (best.members.size() < 2) break;
-    io::SfmTrack t;
-    for (size_t m : best.members) {
-      used[m] = 1;
-      t.observations.push_back(component.observations[m]);
+    // A two-view point from a short baseline is poorly placed in depth, so distant views of the same point
+    // fall outside the bound and would become a second track. Re-triangulating from every member and
+    // collecting again (local optimisation, as in LO-RANSAC) keeps them in one.
+    for (int round = 0; round < 3; ++round) {
+      std::vector<TriangulationView> member_views;
+      for (size_t m : best.members) member_views.push_back(*views[m]);
+      std::vector<size_t> all(member_views.size());
+      for (size_t k = 0; k < all.size(); ++k) all[k] = k;
+      const Eigen::Vector3d X = triangulate_linear(member_views, all);
+      if (!X.allFinite()) break;
+      Support grown = support_of(X, remaining, component, views, fx, fy, bound2);
+      if (grown.members.size() <= best.members.size()) break;
+      best = std::move(grown);
     }
+    for (size_t m : best.members) used[m] = 1;
+    groups.push_back(std::move(best.members));
+  }
+  merge_disjoint_groups(groups, edges, component, views, fx, fy, o);
+  for (const auto& g : groups) {
+    if (g.empty()) continue;
+    io::SfmTrack t;
+    for (size_t m : g) t.observations.push_back(component.observations[m]);
+    std::sort(t.observations.begin(), t.observations.end(),
+              [](const auto& a, const auto& b) { return a.image < b.image; });
     out.tracks.push_back(std::move(t));
   }
   for (size_t i = 0; i < n; ++i) out.dropped += !used[i];

@@ -67,6 +67,37 @@ TEST(FrontendTrackConflicts, UnposedImagesAreNeverSplitIntoATrack) {
   EXPECT_EQ(split.dropped, 3u);
 }
 
+TEST(FrontendTrackConflicts, ATrackTheDriftSplitInTimeIsMergedBack) {
+  // One brick seen by images 0..5, but the priors of images 3..5 drifted 0.15 m down: through them the brick
+  // projects 9 px off the others' point. Each half is exact on its own, the union leaves about 4.5 px, and
+  // a wrong match in image 2 makes the component conflicting.
+  const Eigen::Vector3d brick(0.8, 0.1, 5), drifted(0.8, 0.25, 5), neighbour(1.05, 0.1, 5);
+  io::SfmTrack component;
+  component.observations = {{0, 0}, {1, 0}, {2, 0}, {2, 1}, {3, 0}, {4, 0}, {5, 0}};
+  const std::vector<Eigen::Vector3d> seen = {brick, brick, brick, neighbour, drifted, drifted, drifted};
+  const std::vector<std::array<size_t, 2>> edges = {{0, 1}, {1, 2}, {1, 3}, {2, 4}, {4, 5}, {5, 6}};
+  const ObservationView view = view_of(component, seen);
+
+  ConflictOptions no_merge;
+  no_merge.merge_factor = 0;
+  const ConflictSplit split = split_conflicting_component(component, edges, view, kF, kF, no_merge);
+  ASSERT_EQ(split.tracks.size(), 2u);  // the two halves
+  EXPECT_EQ(split.tracks[0].observations.size() + split.tracks[1].observations.size(), 6u);
+
+  const ConflictSplit merged = split_conflicting_component(component, edges, view, kF, kF, {});
+  ASSERT_EQ(merged.tracks.size(), 1u);
+  EXPECT_EQ(merged.tracks[0].observations,
+            (std::vector<io::SfmObservation>{{0, 0}, {1, 0}, {2, 0}, {3, 0}, {4, 0}, {5, 0}}));
+  EXPECT_EQ(merged.dropped, 1u);  // the neighbour
+
+  // Beyond the merge bound (twice the 3 px split bound): a drift of 0.4 m leaves about 12 px each way.
+  std::vector<Eigen::Vector3d> far_seen = seen;
+  for (size_t k = 4; k < 7; ++k) far_seen[k] = Eigen::Vector3d(0.8, 0.5, 5);
+  const ConflictSplit apart =
+      split_conflicting_component(component, edges, view_of(component, far_seen), kF, kF, {});
+  EXPECT_EQ(apart.tracks.size(), 2u);
+}
+
 TEST(FrontendTracks, WithASplitterConflictsAreSplitAndTheLostMatchesCounted) {
   // A chain 0:0 - 1:0 - 2:0 and a match 0:0 - 2:1: with a splitter the component {0:0, 1:0, 2:0, 2:1}
   // reaches it whole (this splitter keeps image 2's keypoint 0); 1:1 - 2:2 is a track of its own.
