@@ -20,8 +20,9 @@ namespace litgs::host::frontend {
 struct LidarCheckOptions {
   bool enabled = true;  // used where the scene has lidar/map.pcd and both images a prior pose
   // A match is kept when the map's depth carries one keypoint to within this of the other (undistorted
-  // pixels). Like prior_epipolar_px it must cover the priors' error between the two frames.
-  double max_transfer_px = 8;
+  // pixels). Like prior_epipolar_px it must cover the priors' error between the two frames, which grows
+  // with the focal length in pixels: the default suits synth's odometry at 320x256 (docs/results.md).
+  double max_transfer_px = 5;
   uint32_t cell_px = 4;  // z-buffer cell edge (pixels)
   uint32_t window = 1;   // cells on each side whose first surfaces are also candidates
   double min_depth_m = 0.1;

@@ -20,6 +20,7 @@ double error2_px(const TriangulationView& v, const Eigen::Vector3d& X, double fx
 struct Support {
   std::vector<size_t> members;  // one observation index per agreeing image
   double error2_sum = 0;
+  Eigen::Vector3d X = Eigen::Vector3d::Constant(NAN);  // the point they agree with
 };
 
 // Per image, the remaining observation nearest X if within the bound.
@@ -27,6 +28,7 @@ Support support_of(const Eigen::Vector3d& X, const std::vector<size_t>& remainin
                    const io::SfmTrack& component, const std::vector<std::optional<TriangulationView>>& views,
                    double fx, double fy, double bound2) {
   Support s;
+  s.X = X;
   size_t k = 0;
   while (k < remaining.size()) {
     const uint32_t image = component.observations[remaining[k]].image;
@@ -102,6 +104,82 @@ void merge_disjoint_groups(std::vector<std::vector<size_t>>& groups,
   }
 }
 
+// Observations no hypothesis took, because the priors' drift put them just beyond the bound: each joins a
+// track it has verified matches with, that has no observation in its image, and whose point it sees within
+// merge_factor times the bound.
+void attach_dropped(std::vector<std::vector<size_t>>& groups, std::vector<char>& used,
+                    const std::vector<std::array<size_t, 2>>& edges, const io::SfmTrack& component,
+                    const std::vector<std::optional<TriangulationView>>& views, double fx, double fy,
+                    const ConflictOptions& o) {
+  if (!(o.merge_factor > 0) || groups.empty()) return;
+  const size_t n = component.observations.size();
+  std::vector<size_t> group_of(n, SIZE_MAX);
+  for (size_t g = 0; g < groups.size(); ++g)
+    for (size_t m : groups[g]) group_of[m] = g;
+  std::vector<std::map<size_t, size_t>> links(n);  // per dropped observation: group -> matches
+  for (const auto& e : edges) {
+    if (e[0] >= n || e[1] >= n) continue;
+    if (!used[e[0]] && group_of[e[1]] != SIZE_MAX) ++links[e[0]][group_of[e[1]]];
+    if (!used[e[1]] && group_of[e[0]] != SIZE_MAX) ++links[e[1]][group_of[e[0]]];
+  }
+  std::vector<std::optional<Eigen::Vector3d>> point(groups.size());
+  const double bound2 = o.merge_factor * o.max_error_px * o.merge_factor * o.max_error_px;
+  for (size_t i = 0; i < n; ++i) {
+    if (used[i] || !views[i] || links[i].empty()) continue;
+    std::vector<std::pair<size_t, size_t>> order(links[i].begin(), links[i].end());
+    std::stable_sort(order.begin(), order.end(),
+                     [](const auto& x, const auto& y) { return x.second > y.second; });
+    for (const auto& [g, count] : order) {
+      const uint32_t image = component.observations[i].image;
+      if (std::any_of(groups[g].begin(), groups[g].end(),
+                      [&](size_t m) { return component.observations[m].image == image; }))
+        continue;
+      if (!point[g]) {
+        std::vector<TriangulationView> member_views;
+        for (size_t m : groups[g]) member_views.push_back(*views[m]);
+        std::vector<size_t> all(member_views.size());
+        for (size_t k = 0; k < all.size(); ++k) all[k] = k;
+        point[g] = triangulate_linear(member_views, all);
+      }
+      if (!point[g]->allFinite() || !(error2_px(*views[i], *point[g], fx, fy) <= bound2)) continue;
+      groups[g].push_back(i);
+      used[i] = 1;
+      break;
+    }
+  }
+}
+
+// Where an image has several observations within the bound (a repeated feature close by, and priors that
+// drifted), the nearest through the priors may be the wrong one; the one with the most verified matches
+// to the members in the other images is the track's. Ties keep the nearest.
+void prefer_matched(Support& s, const std::vector<size_t>& remaining, const io::SfmTrack& component,
+                    const std::vector<std::optional<TriangulationView>>& views,
+                    const std::vector<std::vector<size_t>>& adjacent, double fx, double fy, double bound2) {
+  std::vector<char> member(component.observations.size(), 0);
+  for (size_t m : s.members) member[m] = 1;
+  for (size_t& chosen : s.members) {
+    const uint32_t image = component.observations[chosen].image;
+    auto matched = [&](size_t i) {
+      size_t count = 0;
+      for (size_t j : adjacent[i]) count += member[j] && component.observations[j].image != image;
+      return count;
+    };
+    size_t best = chosen, best_count = matched(chosen);
+    for (size_t i : remaining) {
+      if (i == chosen || component.observations[i].image != image || !views[i]) continue;
+      if (!(error2_px(*views[i], s.X, fx, fy) <= bound2)) continue;
+      const size_t count = matched(i);
+      if (count > best_count) {
+        best = i;
+        best_count = count;
+      }
+    }
+    member[chosen] = 0;
+    member[best] = 1;
+    chosen = best;
+  }
+}
+
 }  // namespace
 
 void ConflictOptions::check() const {
@@ -119,6 +197,12 @@ ConflictSplit split_conflicting_component(const io::SfmTrack& component,
   std::vector<std::optional<TriangulationView>> views(n);
   for (size_t i = 0; i < n; ++i) views[i] = view(component.observations[i]);
   std::vector<char> used(n, 0);
+  std::vector<std::vector<size_t>> adjacent(n);
+  for (const auto& e : edges)
+    if (e[0] < n && e[1] < n) {
+      adjacent[e[0]].push_back(e[1]);
+      adjacent[e[1]].push_back(e[0]);
+    }
   std::vector<std::array<size_t, 2>> open = edges;
   ConflictSplit out;
   std::vector<std::vector<size_t>> groups;  // the tracks as observation indices
@@ -160,10 +244,12 @@ ConflictSplit split_conflicting_component(const io::SfmTrack& component,
       if (grown.members.size() <= best.members.size()) break;
       best = std::move(grown);
     }
+    prefer_matched(best, remaining, component, views, adjacent, fx, fy, bound2);
     for (size_t m : best.members) used[m] = 1;
     groups.push_back(std::move(best.members));
   }
   merge_disjoint_groups(groups, edges, component, views, fx, fy, o);
+  attach_dropped(groups, used, edges, component, views, fx, fy, o);
   for (const auto& g : groups) {
     if (g.empty()) continue;
     io::SfmTrack t;

@@ -20,8 +20,8 @@ struct ConflictOptions {
   // below this (pixels). Wider than triangulation's 2 px: the priors drift between distant frames.
   double max_error_px = 3.0;
   // Two split tracks of one point (the priors drift along a long track) are merged when they share no
-  // image, verified matches join them, and their union reprojects within this many times max_error_px
-  // (0: never merged).
+  // image, verified matches join them, and their union reprojects within this many times max_error_px;
+  // a dropped observation joins a track it is matched to within the same bound (0: neither).
   double merge_factor = 2.0;
   size_t max_hypotheses = 200;  // matches tried as two-view hypotheses per split (evenly sampled)
   void check() const;           // std::invalid_argument naming the field
@@ -38,9 +38,10 @@ struct ConflictSplit {
 
 // Splits `component` (observations sorted by image; several may share an image) using `edges`, its
 // verified matches as pairs of indices into component.observations: repeatedly takes the match whose two-
-// view point the most images agree with, keeps per image the observation nearest that point, and removes
-// them; then merges tracks of one point that the priors' drift split (ConflictOptions::merge_factor).
-// Deterministic.
+// view point the most images agree with, re-triangulates it from them, keeps per image the agreeing
+// observation with the most matches to the others (the nearest on a tie), and removes them. Then, within
+// merge_factor times the bound (the priors' drift), merges tracks of one point that share no image and
+// gives dropped observations to the track they are matched to. Deterministic.
 ConflictSplit split_conflicting_component(const io::SfmTrack& component,
                                           const std::vector<std::array<size_t, 2>>& edges,
                                           const ObservationView& view, double fx, double fy,

@@ -98,6 +98,50 @@ TEST(FrontendTrackConflicts, ATrackTheDriftSplitInTimeIsMergedBack) {
   EXPECT_EQ(apart.tracks.size(), 2u);
 }
 
+TEST(FrontendTrackConflicts, TheObservationMatchedToTheTrackBeatsANearerNeighbour) {
+  // Image 2's prior drifted: through it the brick lands 2 px off, while a different feature lands 1 px
+  // off. The nearest would be the wrong one; the brick's keypoint has verified matches to images 1 and 3,
+  // the other feature only to image 1.
+  constexpr double kPx = 5.0 / kF;  // metres per pixel on the wall
+  const Eigen::Vector3d brick(0.5, 0.1, 5);
+  io::SfmTrack component;
+  component.observations = {{0, 0}, {1, 0}, {2, 0}, {2, 1}, {3, 0}};
+  const std::vector<Eigen::Vector3d> seen = {brick, brick, brick + Eigen::Vector3d(0, 2 * kPx, 0),
+                                             brick + Eigen::Vector3d(kPx, 0, 0), brick};
+  const std::vector<std::array<size_t, 2>> edges = {{0, 1}, {1, 2}, {2, 4}, {1, 3}};
+  const ConflictSplit split =
+      split_conflicting_component(component, edges, view_of(component, seen), kF, kF, {});
+  ASSERT_EQ(split.tracks.size(), 1u);
+  EXPECT_EQ(split.tracks[0].observations, (std::vector<io::SfmObservation>{{0, 0}, {1, 0}, {2, 0}, {3, 0}}));
+  EXPECT_EQ(split.dropped, 1u);
+}
+
+TEST(FrontendTrackConflicts, AnObservationJustBeyondTheBoundJoinsTheTrackItIsMatchedTo) {
+  // Image 4 sees the brick 4.5 px off along the baseline (its prior drifted): beyond the 3 px bound, within
+  // twice it (the two-view point of images 3 and 4 moves in depth and loses the others). Image 3 also holds
+  // a wrong keypoint, so the component is split.
+  constexpr double kPx = 5.0 / kF;
+  const Eigen::Vector3d brick(0.5, 0.1, 5), neighbour(0.75, 0.1, 5);
+  io::SfmTrack component;
+  component.observations = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {3, 1}, {4, 0}};
+  const std::vector<Eigen::Vector3d> seen = {brick, brick,     brick,
+                                             brick, neighbour, brick + Eigen::Vector3d(4.5 * kPx, 0, 0)};
+  const std::vector<std::array<size_t, 2>> edges = {{0, 1}, {1, 2}, {2, 3}, {2, 4}, {3, 5}};
+  const ConflictSplit attached =
+      split_conflicting_component(component, edges, view_of(component, seen), kF, kF, {});
+  ASSERT_EQ(attached.tracks.size(), 1u);
+  EXPECT_EQ(attached.tracks[0].observations,
+            (std::vector<io::SfmObservation>{{0, 0}, {1, 0}, {2, 0}, {3, 0}, {4, 0}}));
+  EXPECT_EQ(attached.dropped, 1u);  // the neighbour
+  ConflictOptions strict;
+  strict.merge_factor = 0;
+  const ConflictSplit dropped =
+      split_conflicting_component(component, edges, view_of(component, seen), kF, kF, strict);
+  ASSERT_EQ(dropped.tracks.size(), 1u);
+  EXPECT_EQ(dropped.tracks[0].observations.size(), 4u);
+  EXPECT_EQ(dropped.dropped, 2u);
+}
+
 TEST(FrontendTracks, WithASplitterConflictsAreSplitAndTheLostMatchesCounted) {
   // A chain 0:0 - 1:0 - 2:0 and a match 0:0 - 2:1: with a splitter the component {0:0, 1:0, 2:0, 2:1}
   // reaches it whole (this splitter keeps image 2's keypoint 0); 1:1 - 2:2 is a track of its own.
