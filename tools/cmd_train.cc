@@ -11,19 +11,17 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "engine/context.h"
-#include "host/train/init_gaussians.h"
+#include "host/train/initial_model.h"
 #include "host/train/lidar_planes.h"
 #include "host/train/scene_budget.h"
 #include "host/train/trainer.h"
 #include "host/train/training_data.h"
 #include "host/train/true_planes.h"
 #include "io/scene.h"
-#include "io/sfm_files.h"
 #include "tools/commands.h"
 #include "tools/data_flags.h"
 #include "tools/train_budget.h"
@@ -33,15 +31,9 @@ namespace {
 
 struct TrainCliOptions {
   std::string scene, out;
-  std::string init = "auto";         // auto | random | a .ply/.pcd file (in the scene's original world frame)
-  bool init_in_scene_frame = false;  // --init-frame scene: the file is in the recentred scene frame
-  uint32_t random_count = 20000;     // Gaussians of --init random
-  uint32_t max_init_points = 200000;  // LiDAR-map initialization keeps at most this many points
-  // LiDAR-map initialization: a point on a LiDAR plane becomes a disc this thin relative to its radius
-  // (host::surfel_covariances); 1: spheres, as 3DGS.
-  double init_flatness = 0.1;
-  DataFlags data_flags;  // --intensity, --poses
-  std::string trace;     // JSON lines appended at every progress report (the report's curves)
+  host::InitialModelOptions initial;  // --init and its options (seed and SH degree from `train`)
+  DataFlags data_flags;               // --intensity, --poses
+  std::string trace;                  // JSON lines appended at every progress report (the report's curves)
   std::string max_gaussians = "2000000";  // a count, auto or search (tools/train_budget.h)
   host::BudgetSearchOptions budget_search;
   std::vector<std::string> search_options_given;  // the --budget-* options on the command line
@@ -116,7 +108,10 @@ void run_train(TrainCliOptions o) {
   read.check_images = false;
   const io::Scene scene = io::read_scene(o.scene, read);
   if (scene.map) map_points = scene.map->positions;
-  const bool init_from_map = !o.train.resume && o.init == "auto" && !map_points.empty();
+  o.initial.seed = o.train.seed;
+  o.initial.sh_degree = o.train.sh_degree;
+  const host::InitialModel initial(o.initial, o.scene, map_points, o.train.resume);
+  const bool init_from_map = initial.from_map();
   std::unique_ptr<host::PlanarMap> planes;
   if ((o.train.lambda_geo > 0 || init_from_map) && !map_points.empty())
     planes = std::make_unique<host::PlanarMap>(host::fit_planes(map_points, host::PlaneFitOptions{}));
@@ -128,15 +123,6 @@ void run_train(TrainCliOptions o) {
   // Ground truth planes (synthetic scenes): evaluation's depth residual.
   const std::unique_ptr<host::PlanarMap> gt_planes = host::true_planar_map(scene);
 
-  // --init auto: the LiDAR map, else the front end's points (SCENE/sfm/, from `match`), else random.
-  const std::filesystem::path sfm_dir = std::filesystem::path(o.scene) / "sfm";
-  std::vector<Eigen::Vector3d> sfm_points;
-  if (!o.train.resume && (o.init == "sfm" || (o.init == "auto" && map_points.empty())) &&
-      io::has_sfm(sfm_dir))
-    for (const io::SfmPoint& p : io::read_sfm(sfm_dir).points) sfm_points.push_back(p.xyz);
-  std::string init_kind = o.init;
-  if (o.init == "auto") init_kind = !map_points.empty() ? "map" : !sfm_points.empty() ? "sfm" : "random";
-
   // The budget: `auto` measures the LiDAR map when there is one (then it is known before the map
   // initialization, which it caps), else the initialization's points.
   BudgetInputs budget;
@@ -146,61 +132,9 @@ void run_train(TrainCliOptions o) {
   const bool budget_from_map = !map_points.empty();
   if (budget_from_map) o.train.max_gaussians = resolve_max_gaussians(o.max_gaussians, budget, o.out);
 
-  host::InitOptions init;
-  init.sh_degree = o.train.sh_degree;
-  // The initial model for a budget: the LiDAR-map initialization is capped at it (the search initializes
-  // each budget it tries the same way).
   const auto initialize = [&](uint32_t cap_gaussians, std::string& init_what) {
-    kernels::GaussianModel model;
-    if (o.train.resume) {
-      // The model comes from the checkpoint: --init and its options do not apply.
-      init_what = "the newest checkpoint in " + o.out;
-    } else if (init_kind == "random") {
-      model = host::init_random(data, o.random_count, o.train.seed, init);
-      init_what = std::to_string(o.random_count) + " random points";
-    } else if (init_from_map) {
-      // Planar map points become discs on their plane (the plane fit's normal), the rest spheres. Only the
-      // points a training view sees (a Gaussian none sees is never trained), and never more than the budget
-      // or --max-init-points: a seeded random subset.
-      const std::vector<uint8_t> seen = host::inside_any_view(map_points, host::training_cameras(data));
-      std::vector<size_t> keep;
-      for (size_t i = 0; i < map_points.size(); ++i)
-        if (seen[i]) keep.push_back(i);
-      if (keep.empty())  // no view sees the map (bad poses?): seed from all of it rather than nothing
-        for (size_t i = 0; i < map_points.size(); ++i) keep.push_back(i);
-      const size_t cap = std::min<size_t>(o.max_init_points, cap_gaussians);
-      if (keep.size() > cap) {
-        std::mt19937 rng(o.train.seed);
-        std::shuffle(keep.begin(), keep.end(), rng);
-        keep.resize(cap);
-      }
-      std::vector<Eigen::Vector3d> pts;
-      std::vector<Eigen::Vector3f> normals;
-      std::vector<uint8_t> planar;
-      for (size_t i : keep) {
-        pts.push_back(map_points[i]);
-        normals.push_back(planes->normals[i]);
-        planar.push_back(planes->planar[i]);
-      }
-      const auto covariances = host::surfel_covariances(
-          host::neighbour_scales(pts, init, data.scene_extent_m * 0.01), normals, planar, o.init_flatness);
-      model = host::init_from_points(pts, data, init, covariances);
-      init_what = std::to_string(pts.size()) + " LiDAR map points";
-    } else if (init_kind == "sfm") {
-      // The front end's triangulated points (`match`), already in the scene's recentred frame.
-      if (sfm_points.empty())
-        throw std::invalid_argument("--init sfm: " + sfm_dir.string() +
-                                    (io::has_sfm(sfm_dir)
-                                         ? " holds no triangulated point"
-                                         : " holds no front-end results (run `litgs-engine match` first)"));
-      model = host::init_from_points(sfm_points, data, init, {});
-      init_what = std::to_string(sfm_points.size()) + " front-end points (" + sfm_dir.string() + ")";
-    } else {
-      const host::InitPoints file =
-          host::load_points(o.init, o.init_in_scene_frame ? Eigen::Vector3d::Zero() : data.world_offset_m);
-      model = host::init_from_points(file.positions, data, init, file.covariances);
-      init_what = o.init + (file.covariances.empty() ? "" : " (with covariances)");
-    }
+    kernels::GaussianModel model = initial.make(data, planes.get(), cap_gaussians, init_what);
+    if (initial.source() == host::InitialSource::kCheckpoint) init_what += " in " + o.out;
     return model;
   };
   // A searched budget caps a LiDAR-map seeding only once it is known: that one is made after the search.
@@ -211,7 +145,7 @@ void run_train(TrainCliOptions o) {
 
   if (!budget_from_map) {
     budget.initial = &model;
-    budget.initial_is_random = init_kind == "random";
+    budget.initial_is_random = initial.source() == host::InitialSource::kRandom;
     o.train.max_gaussians = resolve_max_gaussians(o.max_gaussians, budget, o.out);
   }
   o.train.check();
@@ -310,23 +244,24 @@ void add_train_command(CLI::App& app) {
   cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")
       ->capture_default_str();
   cmd->add_option(
-         "--init", o->init,
+         "--init", o->initial.init,
          "auto (the LiDAR map, else the front end's points in SCENE/sfm/, else random), random, sfm (the "
          "front end's points), or a "
          ".ply/.pcd point file")
       ->capture_default_str();
   cmd->add_option_function<std::string>(
-         "--init-frame", [o](const std::string& frame) { o->init_in_scene_frame = frame == "scene"; },
+         "--init-frame", [o](const std::string& frame) { o->initial.init_in_scene_frame = frame == "scene"; },
          "--init FILE's frame: world (the original, scene + world_offset_m) or scene (recentred, as the "
          "front end's and refine's points)")
       ->check(CLI::IsMember({"world", "scene"}));
-  cmd->add_option("--init-flatness", o->init_flatness,
+  cmd->add_option("--init-flatness", o->initial.init_flatness,
                   "LiDAR-map init: thickness / radius of the discs on LiDAR planes (1: spheres)")
       ->check(CLI::Range(1e-3, 1.0))
       ->capture_default_str();
-  cmd->add_option("--random-count", o->random_count, "Gaussians of --init random")->capture_default_str();
+  cmd->add_option("--random-count", o->initial.random_count, "Gaussians of --init random")
+      ->capture_default_str();
   cmd->add_option(
-         "--max-init-points", o->max_init_points,
+         "--max-init-points", o->initial.max_init_points,
          "LiDAR-map initialization: at most this many of the map points the training views see (a seeded "
          "random subset; never more than --max-gaussians)")
       ->check(CLI::PositiveNumber)
