@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "engine/context.h"
+#include "host/train/budget_flag.h"
 #include "host/train/initial_model.h"
 #include "host/train/lidar_planes.h"
 #include "host/train/scene_budget.h"
@@ -24,7 +25,6 @@
 #include "io/scene.h"
 #include "tools/commands.h"
 #include "tools/data_flags.h"
-#include "tools/train_budget.h"
 
 namespace litgs::tools {
 namespace {
@@ -34,7 +34,7 @@ struct TrainCliOptions {
   host::InitialModelOptions initial;  // --init and its options (seed and SH degree from `train`)
   DataFlags data_flags;               // --intensity, --poses
   std::string trace;                  // JSON lines appended at every progress report (the report's curves)
-  std::string max_gaussians = "2000000";  // a count, auto or search (tools/train_budget.h)
+  std::string max_gaussians = "2000000";  // a count, auto or search (host/train/budget_flag.h)
   host::BudgetSearchOptions budget_search;
   std::vector<std::string> search_options_given;  // the --budget-* options on the command line
   host::TrainingDataOptions data;
@@ -89,7 +89,7 @@ void run_train(TrainCliOptions o) {
     throw std::invalid_argument(o.search_options_given.front() +
                                 " applies to --max-gaussians search only, not '" + o.max_gaussians + "'");
   const bool asked_to_resume = o.train.resume;
-  const bool reuse_finished_trials = restart_cut_short_search(o.max_gaussians, o.train.resume, o.out);
+  const bool reuse_finished_trials = host::restart_cut_short_search(o.max_gaussians, o.train.resume, o.out);
   if (reuse_finished_trials)
     std::cout
         << "train: --resume: the budget search had not finished; it continues, reusing the trainings it "
@@ -125,12 +125,12 @@ void run_train(TrainCliOptions o) {
 
   // The budget: `auto` measures the LiDAR map when there is one (then it is known before the map
   // initialization, which it caps), else the initialization's points.
-  BudgetInputs budget;
+  host::BudgetInputs budget;
   budget.data = &data;
   budget.map_points = &map_points;
   budget.resume = o.train.resume;
   const bool budget_from_map = !map_points.empty();
-  if (budget_from_map) o.train.max_gaussians = resolve_max_gaussians(o.max_gaussians, budget, o.out);
+  if (budget_from_map) o.train.max_gaussians = host::resolve_max_gaussians(o.max_gaussians, budget, o.out);
 
   const auto initialize = [&](uint32_t cap_gaussians, std::string& init_what) {
     kernels::GaussianModel model = initial.make(data, planes.get(), cap_gaussians, init_what);
@@ -146,7 +146,7 @@ void run_train(TrainCliOptions o) {
   if (!budget_from_map) {
     budget.initial = &model;
     budget.initial_is_random = initial.source() == host::InitialSource::kRandom;
-    o.train.max_gaussians = resolve_max_gaussians(o.max_gaussians, budget, o.out);
+    o.train.max_gaussians = host::resolve_max_gaussians(o.max_gaussians, budget, o.out);
   }
   o.train.check();
 
@@ -160,7 +160,7 @@ void run_train(TrainCliOptions o) {
                 << o.budget_search.folds << " " << progress_text(p)
                 << (tty && p.iteration < p.total ? "" : "\n") << std::flush;
     };
-    o.train.max_gaussians = search_max_gaussians(
+    o.train.max_gaussians = host::search_max_gaussians(
         context, data,
         [&](uint32_t trial_budget) {
           std::string what;

@@ -10,7 +10,7 @@
 #include <optional>
 #include <vector>
 
-namespace litgs::tools {
+namespace litgs::host {
 
 struct FinishedTrial {
   double psnr_db = 0;  // on the fold's validation views
@@ -28,4 +28,4 @@ void write_finished_trial(const std::filesystem::path& dir, const nlohmann::json
 // another key (then the training runs again and overwrites it).
 std::optional<FinishedTrial> read_finished_trial(const std::filesystem::path& dir, const nlohmann::json& key);
 
-}  // namespace litgs::tools
+}  // namespace litgs::host

@@ -1,4 +1,4 @@
-#include "tools/train_budget.h"
+#include "host/train/budget_flag.h"
 
 #include <algorithm>
 #include <cctype>
@@ -10,14 +10,14 @@
 #include <stdexcept>
 
 #include "host/train/budget_search.h"
+#include "host/train/budget_trial_record.h"
 #include "host/train/checkpoint.h"
 #include "host/train/run_options.h"
 #include "host/train/scene_budget.h"
 #include "host/train/trainer.h"
 #include "io/atomic_file.h"
-#include "tools/budget_trial_record.h"
 
-namespace litgs::tools {
+namespace litgs::host {
 namespace {
 
 uint32_t parse_count(const std::string& flag) {
@@ -45,7 +45,7 @@ uint32_t budget_of_earlier_run(const std::filesystem::path& file) {
 }  // namespace
 
 bool restart_cut_short_search(std::string& flag, bool& resume, const std::filesystem::path& out) {
-  if (!resume || flag != "search" || !host::newest_checkpoint(out).empty()) return false;
+  if (!resume || flag != "search" || !newest_checkpoint(out).empty()) return false;
   resume = false;
   const std::filesystem::path record = out / "budget.json";
   if (!std::filesystem::exists(record)) return true;
@@ -56,8 +56,7 @@ bool restart_cut_short_search(std::string& flag, bool& resume, const std::filesy
 uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
                                const std::filesystem::path& out) {
   const std::filesystem::path record = out / "budget.json";
-  if (flag == "search")
-    return in.resume ? budget_of_earlier_run(record) : host::BudgetSearchOptions{}.max_budget;
+  if (flag == "search") return in.resume ? budget_of_earlier_run(record) : BudgetSearchOptions{}.max_budget;
   if (flag != "auto") return parse_count(flag);
   if (in.resume) return budget_of_earlier_run(record);
 
@@ -75,10 +74,10 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
         "--max-gaussians auto measures the surface from points on it: the scene has no LiDAR map and the "
         "initialization is random; give --init sfm or a point file, or a number");
   }
-  const std::vector<kernels::SplatCamera> cameras = host::training_cameras(*in.data);
+  const std::vector<kernels::SplatCamera> cameras = training_cameras(*in.data);
 
-  const host::SceneBudgetOptions options;
-  const host::SceneBudget b = host::derive_scene_budget(points, cameras, options);
+  const SceneBudgetOptions options;
+  const SceneBudget b = derive_scene_budget(points, cameras, options);
   std::filesystem::create_directories(out);
   io::write_file_atomic(record, [&](std::ostream& os) {
     os << nlohmann::json{{"gaussians", b.gaussians},
@@ -101,19 +100,19 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
 }
 
 uint32_t search_max_gaussians(
-    engine::Context& context, const host::TrainingData& data,
-    const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for, const host::PlanarMap* planes,
-    const host::TrainOptions& options, const host::BudgetSearchOptions& search,
-    const std::filesystem::path& out, bool reuse_finished_trials,
-    const std::function<void(uint32_t, uint32_t, const host::TrainProgress&)>& trial_progress) {
+    engine::Context& context, const TrainingData& data,
+    const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for, const PlanarMap* planes,
+    const TrainOptions& options, const BudgetSearchOptions& search, const std::filesystem::path& out,
+    bool reuse_finished_trials,
+    const std::function<void(uint32_t, uint32_t, const TrainProgress&)>& trial_progress) {
   search.check();
-  std::vector<host::TrainingData> splits;
+  std::vector<TrainingData> splits;
   for (uint32_t fold = 0; fold < search.folds; ++fold)
-    splits.push_back(host::validation_split(data, search.validation_every, fold, search.folds));
+    splits.push_back(validation_split(data, search.validation_every, fold, search.folds));
   std::vector<size_t> validation_views;  // per fold
-  for (const host::TrainingData& split : splits)
+  for (const TrainingData& split : splits)
     validation_views.push_back(std::count_if(split.views.begin(), split.views.end(),
-                                             [](const host::TrainingView& v) { return v.heldout; }));
+                                             [](const TrainingView& v) { return v.heldout; }));
   const size_t views = splits.front().views.size();
   const bool deterministic = options.deterministic || search.deterministic_trials;
   std::cout << "train: budget search on " << views << " views, " << search.folds
@@ -133,12 +132,12 @@ uint32_t search_max_gaussians(
     return cached;
   };
   const auto train_at = [&](uint32_t budget) {
-    host::BudgetTrial trial;
+    BudgetTrial trial;
     trial.initial_gaussians = static_cast<uint32_t>(initial_at(budget).size());
     uint32_t reused = 0;  // folds whose finished training an earlier, interrupted search left
-    const std::string start = host::start_fingerprint(initial_at(budget), planes);  // every fold's
+    const std::string start = start_fingerprint(initial_at(budget), planes);  // every fold's
     for (uint32_t fold = 0; fold < search.folds; ++fold) {
-      host::TrainOptions t = options;
+      TrainOptions t = options;
       t.max_gaussians = budget;
       t.seed = options.seed + fold;
       t.deterministic = deterministic;
@@ -147,16 +146,16 @@ uint32_t search_max_gaussians(
       t.eval_every = 0;  // the final evaluation only
       const std::filesystem::path dir =
           out / "budget-search" / std::to_string(budget) / ("fold-" + std::to_string(fold));
-      const nlohmann::json key = {{"options", host::run_options_json(t, splits[fold])}, {"start", start}};
+      const nlohmann::json key = {{"options", run_options_json(t, splits[fold])}, {"start", start}};
       std::optional<FinishedTrial> finished;
       if (reuse_finished_trials) finished = read_finished_trial(dir, key);
       if (finished) {
         ++reused;
       } else {
-        std::function<void(const host::TrainProgress&)> progress;
-        if (trial_progress) progress = [&](const host::TrainProgress& p) { trial_progress(budget, fold, p); };
-        const host::TrainReport r = host::train(context, splits[fold], initial_at(budget), planes, t, dir,
-                                                progress, nullptr, [](const std::string&) {});
+        std::function<void(const TrainProgress&)> progress;
+        if (trial_progress) progress = [&](const TrainProgress& p) { trial_progress(budget, fold, p); };
+        const TrainReport r = train(context, splits[fold], initial_at(budget), planes, t, dir, progress,
+                                    nullptr, [](const std::string&) {});
         finished = FinishedTrial{
             r.final_eval.psnr_db, r.final_eval.ssim, {}, static_cast<uint32_t>(r.gaussians), r.wall_s};
         for (const auto& view : r.final_eval.view_psnr_db) finished->view_psnr_db.push_back(view.second);
@@ -181,9 +180,9 @@ uint32_t search_max_gaussians(
   };
   // A budget below the initialization's size (one not capped by the budget) cannot hold it: start there.
   const uint32_t smallest = static_cast<uint32_t>(initial_at(search.start).size());
-  const host::BudgetSearchResult result = host::search_budget(train_at, smallest, search);
+  const BudgetSearchResult result = search_budget(train_at, smallest, search);
   nlohmann::json trials = nlohmann::json::array();
-  for (const host::BudgetTrial& t : result.trials) {
+  for (const BudgetTrial& t : result.trials) {
     if (!t.failure.empty()) {
       trials.push_back({{"budget", t.budget}, {"failure", t.failure}});
       std::cout << "train: budget " << t.budget << " does not fit the device (" << t.failure
@@ -231,4 +230,4 @@ uint32_t search_max_gaussians(
   return result.chosen;
 }
 
-}  // namespace litgs::tools
+}  // namespace litgs::host

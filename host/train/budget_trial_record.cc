@@ -1,10 +1,10 @@
-#include "tools/budget_trial_record.h"
+#include "host/train/budget_trial_record.h"
 
 #include <fstream>
 
 #include "io/atomic_file.h"
 
-namespace litgs::tools {
+namespace litgs::host {
 namespace {
 
 const char* const kRecord = "trial.json";
@@ -45,4 +45,4 @@ std::optional<FinishedTrial> read_finished_trial(const std::filesystem::path& di
   }
 }
 
-}  // namespace litgs::tools
+}  // namespace litgs::host

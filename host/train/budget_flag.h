@@ -18,10 +18,10 @@
 #include "host/train/training_data.h"
 #include "kernels/splat/splat_types.h"
 
-namespace litgs::tools {
+namespace litgs::host {
 
 struct BudgetInputs {
-  const host::TrainingData* data = nullptr;
+  const TrainingData* data = nullptr;
   const std::vector<Eigen::Vector3d>* map_points = nullptr;  // the LiDAR map (may be empty)
   const kernels::GaussianModel* initial = nullptr;           // its means stand for the surface without a map
   bool initial_is_random = false;                            // random means say nothing about the surface
@@ -36,17 +36,16 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
 
 // `--max-gaussians search`: trainings with `options` at growing budgets on the validation split of the
 // training views, each from initial_for(budget) and in OUT/budget-search/<budget>/fold-<f>/ (with its
-// trial.json once finished: tools/budget_trial_record.h); writes OUT/budget.json and returns the budget found
-// by `search`'s rule. With reuse_finished_trials, a training whose trial.json matches is not run again.
+// trial.json once finished: host/train/budget_trial_record.h); writes OUT/budget.json and returns the budget
+// found by `search`'s rule. With reuse_finished_trials, a training whose trial.json matches is not run again.
 // Prints one line per budget tried; `trial_progress` (optional) gets each training's progress reports, with
 // its budget and fold (0-based), at options.progress_every.
-uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData& data,
-                              const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for,
-                              const host::PlanarMap* planes, const host::TrainOptions& options,
-                              const host::BudgetSearchOptions& search, const std::filesystem::path& out,
-                              bool reuse_finished_trials,
-                              const std::function<void(uint32_t budget, uint32_t fold,
-                                                       const host::TrainProgress&)>& trial_progress = {});
+uint32_t search_max_gaussians(
+    engine::Context& context, const TrainingData& data,
+    const std::function<kernels::GaussianModel(uint32_t budget)>& initial_for, const PlanarMap* planes,
+    const TrainOptions& options, const BudgetSearchOptions& search, const std::filesystem::path& out,
+    bool reuse_finished_trials,
+    const std::function<void(uint32_t budget, uint32_t fold, const TrainProgress&)>& trial_progress = {});
 
 // `train --resume --max-gaussians search` where OUT holds no checkpoint of the final training: the run was
 // cut short in the search, or after it before the final training's first checkpoint, and there is nothing
@@ -55,4 +54,4 @@ uint32_t search_max_gaussians(engine::Context& context, const host::TrainingData
 // search had finished (returns true). In any other case changes nothing and returns false.
 bool restart_cut_short_search(std::string& flag, bool& resume, const std::filesystem::path& out);
 
-}  // namespace litgs::tools
+}  // namespace litgs::host
