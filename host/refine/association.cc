@@ -15,8 +15,8 @@ namespace {
 // The pose as the rasterizer's camera (pixel centres at +0.5) for the map's depth image.
 kernels::SplatCamera splat_camera(const CameraPose& pose, const PinholeCamera& c) {
   kernels::SplatCamera s;
-  const Eigen::Matrix3d R = pose.q.toRotationMatrix().transpose();
-  const Eigen::Vector3d t = -R * pose.p;
+  const Eigen::Matrix3d R = pose.q_world_cam.toRotationMatrix().transpose();
+  const Eigen::Vector3d t = -R * pose.p_world_cam;
   for (int r = 0; r < 3; ++r)
     for (int k = 0; k < 3; ++k) s.R_cam_world[k][r] = R(r, k);  // glm is column-major
   s.t_cam_world = glm::dvec3(t.x(), t.y(), t.z());
@@ -32,7 +32,7 @@ kernels::SplatCamera splat_camera(const CameraPose& pose, const PinholeCamera& c
 // Where x lands in the image, or false when behind the camera or outside.
 bool project(const CameraPose& pose, const PinholeCamera& c, const Eigen::Vector3d& x, Eigen::Vector2d& uv,
              double& depth) {
-  const Eigen::Vector3d q = pose.q.conjugate() * (x - pose.p);
+  const Eigen::Vector3d q = pose.q_world_cam.conjugate() * (x - pose.p_world_cam);
   depth = q.z();
   if (q.z() <= 0.05) return false;
   uv = {c.fx * q.x() / q.z() + c.cx, c.fy * q.y() / q.z() + c.cy};
@@ -81,7 +81,7 @@ AnchorAssociationReport associate_anchors(std::vector<TrackPoint>& points,
     for (size_t a = 0; a < anchors.size(); ++a) {
       Eigen::Vector2d uv;
       double z = 0;
-      if (!project(poses[f], camera, anchors[a].p, uv, z)) continue;
+      if (!project(poses[f], camera, anchors[a].p_world, uv, z)) continue;
       if (map) {
         if (!depth) depth = project_planes(*map, splat_camera(poses[f], camera));
         const size_t px = static_cast<size_t>(std::floor(uv.x() + 0.5)),
@@ -121,7 +121,7 @@ AnchorAssociationReport associate_anchors(std::vector<TrackPoint>& points,
       if (n < o.min_agreeing || 2 * n < shared) continue;
       const auto X = triangulate(points[track].obs, poses, camera);
       if (!X) continue;
-      const Eigen::Vector3d e = *X - anchors[a].p;
+      const Eigen::Vector3d e = *X - anchors[a].p_world;
       if (e.dot(anchors[a].cov.ldlt().solve(e)) <= o.gate_chi2)  // NaN fails too
         pairs.emplace_back(n, -dist[a][track] / static_cast<double>(n), a, track);
     }
@@ -195,8 +195,8 @@ PlaneAssociationReport PlaneAssociator::associate(std::vector<TrackPoint>& point
           const Eigen::Vector3d q(it->second.points[i], it->second.points[i + 1], it->second.points[i + 2]);
           const Eigen::Vector3d n(it->second.normals[i], it->second.normals[i + 1],
                                   it->second.normals[i + 2]);
-          plane.n = (pose.q * n).normalized();
-          plane.l = pose.q * q + pose.p;
+          plane.n = (pose.q_world_cam * n).normalized();
+          plane.l = pose.q_world_cam * q + pose.p_world_cam;
           found = true;
           ++report.by_depth_image;
         }

@@ -65,8 +65,8 @@ std::vector<io::TumPose> as_tum_poses(const std::vector<CameraPose>& poses) {
   for (const auto& c : poses) {
     io::TumPose p;
     p.t_s = c.t_s;
-    p.p_world = c.p;
-    p.q_world_body = c.q;
+    p.p_world = c.p_world_cam;
+    p.q_world_body = c.q_world_cam;
     out.push_back(p);
   }
   return out;

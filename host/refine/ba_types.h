@@ -16,11 +16,11 @@ struct PinholeCamera {
   int width = 0, height = 0;
 };
 
-// A camera pose T_world_cam: p_world = q * p_cam + p.
+// A camera pose T_world_cam: x_world = q_world_cam * x_cam + p_world_cam (p_world_cam: the camera centre).
 struct CameraPose {
   double t_s = 0;
-  Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_world_cam = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d p_world_cam = Eigen::Vector3d::Zero();
 };
 
 struct Observation {
@@ -49,7 +49,7 @@ struct TrackPoint {
 
 // A visual map point of the upstream estimator with its covariance (anchors.txt).
 struct AnchorPoint {
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p_world = Eigen::Vector3d::Zero();
   Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();  // m^2
 };
 

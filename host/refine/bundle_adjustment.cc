@@ -13,7 +13,7 @@ namespace litgs::host::refine {
 
 double reprojection_error_px(const CameraPose& pose, const PinholeCamera& c, const Eigen::Vector3d& X,
                              const Eigen::Vector2d& uv) {
-  const Eigen::Vector3d x = pose.q.conjugate() * (X - pose.p);
+  const Eigen::Vector3d x = pose.q_world_cam.conjugate() * (X - pose.p_world_cam);
   if (!(x.z() > 1e-3)) return std::numeric_limits<double>::infinity();
   return (Eigen::Vector2d(c.fx * x.x() / x.z() + c.cx, c.fy * x.y() / x.z() + c.cy) - uv).norm();
 }
@@ -32,11 +32,11 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
   auto add_pose = [&](size_t f) {
     if (in_problem[f]) return;
     in_problem[f] = true;
-    problem.AddParameterBlock(poses[f].q.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
-    problem.AddParameterBlock(poses[f].p.data(), 3);
+    problem.AddParameterBlock(poses[f].q_world_cam.coeffs().data(), 4, new ceres::EigenQuaternionManifold);
+    problem.AddParameterBlock(poses[f].p_world_cam.data(), 3);
     if (!variable(f)) {
-      problem.SetParameterBlockConstant(poses[f].q.coeffs().data());
-      problem.SetParameterBlockConstant(poses[f].p.data());
+      problem.SetParameterBlockConstant(poses[f].q_world_cam.coeffs().data());
+      problem.SetParameterBlockConstant(poses[f].p_world_cam.data());
     } else {
       ++s.variable_frames;
     }
@@ -58,7 +58,7 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
       problem.AddResidualBlock(
           cost,
           new ceres::ScaledLoss(new ceres::CauchyLoss(w.pixel_loss_px), ob.weight, ceres::TAKE_OWNERSHIP),
-          poses[ob.frame].q.coeffs().data(), poses[ob.frame].p.data(), p.X.data());
+          poses[ob.frame].q_world_cam.coeffs().data(), poses[ob.frame].p_world_cam.data(), p.X.data());
       ++s.reprojection_residuals;
       weight_sum += ob.weight;
       ++count;
@@ -76,7 +76,7 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
     if (b.use_anchor_priors && b.anchors && p.anchor >= 0) {
       const size_t a = static_cast<size_t>(p.anchor);
       auto* cost = new ceres::AutoDiffCostFunction<AnchorPrior, 3, 3>(
-          new AnchorPrior{(*b.anchors)[a].p, b.anchor_sqrt_information[a]});
+          new AnchorPrior{(*b.anchors)[a].p_world, b.anchor_sqrt_information[a]});
       problem.AddResidualBlock(cost, new ceres::CauchyLoss(w.anchor_loss), p.X.data());
       ++s.anchor_residuals;
     }
@@ -86,37 +86,38 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
     if (!variable(f) && !variable(f + 1)) continue;
     add_pose(f);
     add_pose(f + 1);
-    const Eigen::Quaterniond dq = priors[f].q.conjugate() * priors[f + 1].q;
-    const Eigen::Vector3d dp = priors[f].q.conjugate() * (priors[f + 1].p - priors[f].p);
+    const Eigen::Quaterniond dq = priors[f].q_world_cam.conjugate() * priors[f + 1].q_world_cam;
+    const Eigen::Vector3d dp =
+        priors[f].q_world_cam.conjugate() * (priors[f + 1].p_world_cam - priors[f].p_world_cam);
     const double dist = dp.norm();
     auto* cost = new ceres::AutoDiffCostFunction<RelativePose, 6, 4, 3, 4, 3>(
         new RelativePose{dq, dp, 1 / (w.rel_sigma_t_m + w.rel_sigma_t_per_m * dist),
                          1 / (w.rel_sigma_r_rad + w.rel_sigma_r_per_m * dist)});
-    problem.AddResidualBlock(cost, nullptr, poses[f].q.coeffs().data(), poses[f].p.data(),
-                             poses[f + 1].q.coeffs().data(), poses[f + 1].p.data());
+    problem.AddResidualBlock(cost, nullptr, poses[f].q_world_cam.coeffs().data(), poses[f].p_world_cam.data(),
+                             poses[f + 1].q_world_cam.coeffs().data(), poses[f + 1].p_world_cam.data());
     ++s.prior_residuals;
   }
   for (size_t f = 0; f < (w.absolute_priors ? n : std::min<size_t>(n, 1)); ++f) {
     if (!variable(f)) continue;
     add_pose(f);
-    auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(
-        new AbsolutePose{priors[f].q, priors[f].p, 1 / w.gauge_sigma_t_m, 1 / w.gauge_sigma_r_rad});
+    auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(new AbsolutePose{
+        priors[f].q_world_cam, priors[f].p_world_cam, 1 / w.gauge_sigma_t_m, 1 / w.gauge_sigma_r_rad});
     problem.AddResidualBlock(cost, w.absolute_priors ? nullptr : new ceres::CauchyLoss(1.0),
-                             poses[f].q.coeffs().data(), poses[f].p.data());
+                             poses[f].q_world_cam.coeffs().data(), poses[f].p_world_cam.data());
     ++s.prior_residuals;
   }
   if (!w.absolute_priors && w.odometry_sigma_r_rad > 0) {
     double travelled = 0;
     for (size_t f = 0; f < n; ++f) {
-      if (f > 0) travelled += (priors[f].p - priors[f - 1].p).norm();
+      if (f > 0) travelled += (priors[f].p_world_cam - priors[f - 1].p_world_cam).norm();
       if (!variable(f)) continue;
       add_pose(f);
       auto* cost = new ceres::AutoDiffCostFunction<AbsolutePose, 6, 4, 3>(new AbsolutePose{
-          priors[f].q, priors[f].p,
+          priors[f].q_world_cam, priors[f].p_world_cam,
           w.odometry_sigma_t_m > 0 ? 1 / (w.odometry_sigma_t_m + w.odometry_sigma_t_per_m * travelled) : 0.0,
           1 / (w.odometry_sigma_r_rad + w.odometry_sigma_r_per_m * travelled)});
-      problem.AddResidualBlock(cost, new ceres::CauchyLoss(1.0), poses[f].q.coeffs().data(),
-                               poses[f].p.data());
+      problem.AddResidualBlock(cost, new ceres::CauchyLoss(1.0), poses[f].q_world_cam.coeffs().data(),
+                               poses[f].p_world_cam.data());
       ++s.prior_residuals;
     }
   }
@@ -143,7 +144,7 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
   s.termination = ceres::TerminationTypeToString(summary.termination_type);
   s.brief = summary.BriefReport();
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (auto& pose : poses) pose.q.normalize();
+  for (auto& pose : poses) pose.q_world_cam.normalize();
   return s;
 }
 

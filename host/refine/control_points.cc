@@ -29,7 +29,7 @@ ControlPointErrors control_point_errors(const io::MetashapeDocument& doc,
       const Eigen::Vector3d c = doc.T_world_cam(*cam).topRightCorner<3, 1>() - world_offset_m;
       size_t frame = priors.size();
       for (size_t f = 0; f < priors.size(); ++f)
-        if ((priors[f].p - c).norm() < 1e-3) frame = f;
+        if ((priors[f].p_world_cam - c).norm() < 1e-3) frame = f;
       if (frame == priors.size()) {
         ++r.unmatched_cameras;
         continue;

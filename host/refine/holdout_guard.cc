@@ -22,14 +22,14 @@ std::optional<Eigen::Vector3d> fit_point(const std::vector<Observation>& obs,
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
     for (const auto& o : obs) {
       const CameraPose& c = poses[o.frame];
-      const Eigen::Vector3d pc = c.q.conjugate() * (X - c.p);
+      const Eigen::Vector3d pc = c.q_world_cam.conjugate() * (X - c.p_world_cam);
       if (!(pc.z() > 1e-6)) continue;
       const Eigen::Vector2d r(camera.fx * pc.x() / pc.z() + camera.cx - o.uv.x(),
                               camera.fy * pc.y() / pc.z() + camera.cy - o.uv.y());
       Eigen::Matrix<double, 2, 3> J_pc;
       J_pc << camera.fx / pc.z(), 0, -camera.fx * pc.x() / (pc.z() * pc.z()), 0, camera.fy / pc.z(),
           -camera.fy * pc.y() / (pc.z() * pc.z());
-      const Eigen::Matrix<double, 2, 3> J = J_pc * c.q.conjugate().toRotationMatrix();
+      const Eigen::Matrix<double, 2, 3> J = J_pc * c.q_world_cam.conjugate().toRotationMatrix();
       H += J.transpose() * J;
       g += J.transpose() * r;
     }

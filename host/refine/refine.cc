@@ -63,7 +63,7 @@ std::vector<size_t> frame_observations(const std::vector<TrackPoint>& points, si
 
 bool all_finite(const std::vector<CameraPose>& poses, const std::vector<TrackPoint>& points) {
   for (const auto& c : poses)
-    if (!c.p.allFinite() || !c.q.coeffs().allFinite()) return false;
+    if (!c.p_world_cam.allFinite() || !c.q_world_cam.coeffs().allFinite()) return false;
   for (const auto& p : points)
     if (p.active && !p.X.allFinite()) return false;
   return true;
@@ -164,7 +164,7 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
     for (const auto& a : in.anchors) {
       const Eigen::Matrix3d c = guarded_covariance(a.cov, o.weights.min_sigma_m * o.weights.min_sigma_m);
       sqrt_info.push_back(Eigen::Matrix3d(c.llt().matrixL()).inverse());
-      guarded_anchors.push_back({a.p, c});
+      guarded_anchors.push_back({a.p_world, c});
     }
   } else {
     for (auto& p : in.points) p.anchor = -1;

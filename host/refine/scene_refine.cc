@@ -20,16 +20,16 @@ namespace {
 
 Eigen::Matrix4d to_matrix(const CameraPose& c) {
   Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
-  T.topLeftCorner<3, 3>() = c.q.toRotationMatrix();
-  T.topRightCorner<3, 1>() = c.p;
+  T.topLeftCorner<3, 3>() = c.q_world_cam.toRotationMatrix();
+  T.topRightCorner<3, 1>() = c.p_world_cam;
   return T;
 }
 
 CameraPose from_matrix(double t, const Eigen::Matrix4d& T) {
   CameraPose c;
   c.t_s = t;
-  c.q = Eigen::Quaterniond(Eigen::Matrix3d(T.topLeftCorner<3, 3>())).normalized();
-  c.p = T.topRightCorner<3, 1>();
+  c.q_world_cam = Eigen::Quaterniond(Eigen::Matrix3d(T.topLeftCorner<3, 3>())).normalized();
+  c.p_world_cam = T.topRightCorner<3, 1>();
   return c;
 }
 

@@ -12,12 +12,12 @@ namespace {
 std::optional<Eigen::Vector2d> visible_at(const synth::World& world, const CameraPose& pose,
                                           const PinholeCamera& c, const Eigen::Vector3d& x,
                                           double max_range_m) {
-  const Eigen::Vector3d q = pose.q.conjugate() * (x - pose.p);
+  const Eigen::Vector3d q = pose.q_world_cam.conjugate() * (x - pose.p_world_cam);
   if (q.z() <= 0.3 || q.norm() > max_range_m) return std::nullopt;
   const Eigen::Vector2d uv(c.fx * q.x() / q.z() + c.cx, c.fy * q.y() / q.z() + c.cy);
   if (uv.x() < 0 || uv.y() < 0 || uv.x() > c.width - 1 || uv.y() > c.height - 1) return std::nullopt;
-  const double range = (x - pose.p).norm();
-  synth::Ray ray{pose.p, (x - pose.p) / range};
+  const double range = (x - pose.p_world_cam).norm();
+  synth::Ray ray{pose.p_world_cam, (x - pose.p_world_cam) / range};
   const auto hit = world.cast(ray, 1e-3, range + 0.05);
   if (!hit || std::abs(hit->range_m - range) > 1e-3 + 1e-4 * range) return std::nullopt;
   return uv;
@@ -79,7 +79,8 @@ std::vector<TrackPoint> synthetic_tracks(const synth::World& world, const std::v
     for (int k = 0; k < o.tracks_per_frame; ++k) {
       const Eigen::Vector3d d((rng.uniform(0, c.width) - c.cx) / c.fx,
                               (rng.uniform(0, c.height) - c.cy) / c.fy, 1);
-      const auto hit = world.cast({truth[f].p, (truth[f].q * d).normalized()}, 0.3, o.max_range_m);
+      const auto hit =
+          world.cast({truth[f].p_world_cam, (truth[f].q_world_cam * d).normalized()}, 0.3, o.max_range_m);
       const size_t length = static_cast<size_t>(rng.uniform_int(2, std::max(2, o.max_track_length)));
       if (hit) features.push_back({hit->point, f, std::min(n, f + length)});
     }

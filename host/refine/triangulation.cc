@@ -10,7 +10,8 @@ namespace litgs::host::refine {
 namespace {
 
 Eigen::Vector3d ray(const Observation& ob, const CameraPose& pose, const PinholeCamera& c) {
-  return (pose.q * Eigen::Vector3d((ob.uv.x() - c.cx) / c.fx, (ob.uv.y() - c.cy) / c.fy, 1.0)).normalized();
+  return (pose.q_world_cam * Eigen::Vector3d((ob.uv.x() - c.cx) / c.fx, (ob.uv.y() - c.cy) / c.fy, 1.0))
+      .normalized();
 }
 
 // Least-squares point nearest to every ray: sum (I - d d^T)(X - c) = 0.
@@ -22,7 +23,7 @@ std::optional<Eigen::Vector3d> midpoint(const std::vector<const Observation*>& o
     const Eigen::Vector3d d = ray(*ob, poses[ob->frame], c);
     const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
     A += P;
-    b += P * poses[ob->frame].p;
+    b += P * poses[ob->frame].p_world_cam;
   }
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(A);
   if (ldlt.info() != Eigen::Success) return std::nullopt;

@@ -44,8 +44,8 @@ std::vector<double> motion_scores(const std::vector<CameraPose>& poses) {
   for (size_t i = 0; i < n; ++i) {
     const size_t a = i == 0 ? 0 : i - 1, b = i + 1 == n ? n - 1 : i + 1;
     const double dt = std::max(poses[b].t_s - poses[a].t_s, 1e-9);
-    lin[i] = (poses[b].p - poses[a].p).norm() / dt;
-    ang[i] = poses[a].q.angularDistance(poses[b].q) / dt;
+    lin[i] = (poses[b].p_world_cam - poses[a].p_world_cam).norm() / dt;
+    ang[i] = poses[a].q_world_cam.angularDistance(poses[b].q_world_cam) / dt;
   }
   const std::vector<double> zl = standardize(lin, 1e-3), za = standardize(ang, 1e-3);
   std::vector<double> s(n);

@@ -54,16 +54,18 @@ void make_test_scene(TestScene& s, const TestSceneOptions& o) {
     t.t_s = 100 + 0.1 * static_cast<double>(f);
     const double yaw = o.rotate_rad_per_frame * static_cast<double>(f) -
                        0.5 * o.rotate_rad_per_frame * static_cast<double>(o.frames);
-    t.q = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R0);
+    t.q_world_cam =
+        Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R0);
     const double phase = 2 * M_PI * static_cast<double>(f) / static_cast<double>(o.frames);
-    t.p = Eigen::Vector3d(o.speed_m_per_frame * static_cast<double>(f),
-                          o.speed_m_per_frame > 0 ? o.weave_m * std::sin(phase) : 0, 1.5);
-    if (f > 0) travelled += (t.p - s.truth.back().p).norm();
+    t.p_world_cam = Eigen::Vector3d(o.speed_m_per_frame * static_cast<double>(f),
+                                    o.speed_m_per_frame > 0 ? o.weave_m * std::sin(phase) : 0, 1.5);
+    if (f > 0) travelled += (t.p_world_cam - s.truth.back().p_world_cam).norm();
     s.truth.push_back(t);
     CameraPose e = t;
-    e.p += (o.initial_offset_m + o.drift_per_m * travelled * travelled) * o.drift_dir +
-           o.jitter_m * Eigen::Vector3d(rng.normal(), rng.normal(), rng.normal());
-    e.q = Eigen::AngleAxisd(o.rotation_drift_per_m * travelled, Eigen::Vector3d::UnitZ()) * e.q;
+    e.p_world_cam += (o.initial_offset_m + o.drift_per_m * travelled * travelled) * o.drift_dir +
+                     o.jitter_m * Eigen::Vector3d(rng.normal(), rng.normal(), rng.normal());
+    e.q_world_cam =
+        Eigen::AngleAxisd(o.rotation_drift_per_m * travelled, Eigen::Vector3d::UnitZ()) * e.q_world_cam;
     s.priors.push_back(e);
   }
   // The LiDAR map: the visible surfaces sampled on a grid with 5 mm noise, plane fits.
@@ -78,13 +80,13 @@ void make_test_scene(TestScene& s, const TestSceneOptions& o) {
   for (size_t a = 0; a < o.anchors; ++a) {
     const CameraPose& c = s.truth[static_cast<size_t>(rng.uniform_int(0, static_cast<int>(o.frames) - 1))];
     const Eigen::Vector3d d((rng.uniform(20, 300) - 159.5) / 200, (rng.uniform(20, 236) - 127.5) / 200, 1);
-    const auto hit = w.cast({c.p, (c.q * d).normalized()}, 0.3, 40);
+    const auto hit = w.cast({c.p_world_cam, (c.q_world_cam * d).normalized()}, 0.3, 40);
     if (!hit) continue;
     AnchorPoint ap;
     Eigen::Vector3d sig = Eigen::Vector3d::Constant(o.anchor_sigma_m);
     if (o.anchor_min_sigma_m > 0) sig.z() = o.anchor_min_sigma_m;
     ap.cov = sig.cwiseAbs2().asDiagonal();
-    ap.p =
+    ap.p_world =
         hit->point + Eigen::Vector3d(sig.x() * rng.normal(), sig.y() * rng.normal(), sig.z() * rng.normal());
     s.anchors.push_back(ap);
     s.anchors_true.push_back(hit->point);

@@ -24,7 +24,7 @@ struct WallScene {
     TrackPoint t;
     t.X = X;
     for (size_t f = 0; f < frames; ++f) {
-      const Eigen::Vector3d x = poses[f].q.conjugate() * (X - poses[f].p);
+      const Eigen::Vector3d x = poses[f].q_world_cam.conjugate() * (X - poses[f].p_world_cam);
       t.obs.push_back({static_cast<uint32_t>(f),
                        {camera.fx * x.x() / x.z() + camera.cx, camera.fy * x.y() / x.z() + camera.cy}});
     }
@@ -41,7 +41,8 @@ TEST(RefineAssociateAnchors, AnAnchorOnATrackIsTakenAndOneOffAlongTheRayFailsThe
   std::vector<TrackPoint> points = {s.track({0.3, 0.2, 5.0}), s.track({-0.5, 0.4, 5.0})};
   // Anchor 0 on track 0 (within 5 mm); anchor 1 on track 1's first ray but 30 cm nearer: within 1.5 px of
   // the track in every frame (0.6 m of baseline at 5 m), but 15 sigma from its point.
-  const Eigen::Vector3d nearer = s.poses[0].p + (points[1].X - s.poses[0].p) * (4.7 / 5.0);
+  const Eigen::Vector3d nearer =
+      s.poses[0].p_world_cam + (points[1].X - s.poses[0].p_world_cam) * (4.7 / 5.0);
   const std::vector<AnchorPoint> anchors = {anchor_at({0.305, 0.2, 5.0}, 0.02), anchor_at(nearer, 0.02)};
   const AnchorAssociationReport r =
       associate_anchors(points, anchors, s.poses, s.camera, &s.map, AnchorAssociationOptions{});

@@ -47,9 +47,9 @@ TEST(RefineCostFunctions, ReprojectionIsThePinholeProjectionLessTheObservation) 
   const Eigen::Vector2d uv(150.0, 140.0);
   const Reprojection f{uv, c};
   double r[2];
-  ASSERT_TRUE(f(pose.q.coeffs().data(), pose.p.data(), X.data(), r));
+  ASSERT_TRUE(f(pose.q_world_cam.coeffs().data(), pose.p_world_cam.data(), X.data(), r));
   // Independently: the point in the camera frame through the rotation matrix.
-  const Eigen::Vector3d x = pose.q.toRotationMatrix().transpose() * (X - pose.p);
+  const Eigen::Vector3d x = pose.q_world_cam.toRotationMatrix().transpose() * (X - pose.p_world_cam);
   EXPECT_NEAR(r[0], c.fx * x.x() / x.z() + c.cx - uv.x(), 1e-9);
   EXPECT_NEAR(r[1], c.fy * x.y() / x.z() + c.cy - uv.y(), 1e-9);
   EXPECT_NEAR(std::hypot(r[0], r[1]), reprojection_error_px(pose, c, X, uv), 1e-9);
@@ -57,7 +57,8 @@ TEST(RefineCostFunctions, ReprojectionIsThePinholeProjectionLessTheObservation) 
   ceres::AutoDiffCostFunction<Reprojection, 2, 4, 3, 3> automatic(new Reprojection(f));
   ceres::NumericDiffCostFunction<Reprojection, ceres::CENTRAL, 2, 4, 3, 3> numeric(new Reprojection(f));
   Eigen::Vector3d Xv = X;
-  expect_jacobians_agree(automatic, numeric, {pose.q.coeffs().data(), pose.p.data(), Xv.data()}, 1e-5);
+  expect_jacobians_agree(automatic, numeric,
+                         {pose.q_world_cam.coeffs().data(), pose.p_world_cam.data(), Xv.data()}, 1e-5);
 }
 
 TEST(RefineCostFunctions, APointBehindTheCameraGivesALargeFiniteResidual) {

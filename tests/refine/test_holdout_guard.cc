@@ -64,7 +64,8 @@ TEST(RefineHoldoutGuard, ARefinementThatMakesThePosesWorseKeepsThePriors) {
   ASSERT_TRUE(r.holdout.measured);
   EXPECT_GT(r.holdout.refined_median_px, r.holdout.prior_median_px);
   EXPECT_EQ(r.outcome, "kept the priors");
-  for (size_t f = 0; f < poses.size(); ++f) EXPECT_EQ(poses[f].p, priors[f].p) << "frame " << f;
+  for (size_t f = 0; f < poses.size(); ++f)
+    EXPECT_EQ(poses[f].p_world_cam, priors[f].p_world_cam) << "frame " << f;
 
   // The same solve without the guard returns the corrupted poses: what the guard prevented.
   TestScene s2;

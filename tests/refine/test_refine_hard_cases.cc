@@ -68,8 +68,8 @@ TEST(RefineHardCases, SinglePlaneHoldsTranslationAlongItWithPriors) {
   EXPECT_FALSE(r.report.stopped_early);
   EXPECT_LT(r.ate_after, r.ate_before);
   // The along-wall component of the last pose may not wander beyond the priors' drift.
-  const double along_prior = std::abs(s.priors.back().p.x() - s.truth.back().p.x());
-  EXPECT_LT(std::abs(r.poses.back().p.x() - s.truth.back().p.x()), along_prior + 0.05);
+  const double along_prior = std::abs(s.priors.back().p_world_cam.x() - s.truth.back().p_world_cam.x());
+  EXPECT_LT(std::abs(r.poses.back().p_world_cam.x() - s.truth.back().p_world_cam.x()), along_prior + 0.05);
 }
 
 TEST(RefineHardCases, PureRotationStopsWithAClearMessage) {
@@ -83,7 +83,7 @@ TEST(RefineHardCases, PureRotationStopsWithAClearMessage) {
   // No baseline: nothing can be triangulated, the priors are kept and the report says why.
   EXPECT_TRUE(r.report.stopped_early);
   EXPECT_NE(r.report.status.find("triangulated"), std::string::npos) << r.report.status;
-  for (size_t f = 0; f < r.poses.size(); ++f) EXPECT_EQ(r.poses[f].p, s.priors[f].p);
+  for (size_t f = 0; f < r.poses.size(); ++f) EXPECT_EQ(r.poses[f].p_world_cam, s.priors[f].p_world_cam);
 }
 
 TEST(RefineHardCases, TooFewObservationsPerFrameKeepThePriors) {
@@ -96,7 +96,7 @@ TEST(RefineHardCases, TooFewObservationsPerFrameKeepThePriors) {
   EXPECT_TRUE(r.report.stopped_early);
   EXPECT_NE(r.report.status.find("too few tracks"), std::string::npos) << r.report.status;
   EXPECT_LT(r.report.median_frame_observations, 30);
-  for (size_t f = 0; f < r.poses.size(); ++f) EXPECT_EQ(r.poses[f].p, s.priors[f].p);
+  for (size_t f = 0; f < r.poses.size(); ++f) EXPECT_EQ(r.poses[f].p_world_cam, s.priors[f].p_world_cam);
 
   // The same scene with the gate off solves (whatever it makes of so few tracks).
   TestScene s2;
@@ -125,12 +125,13 @@ TEST(RefineHardCases, HalfMetreInitialDrift) {
   // The priors drift (quadratically with the distance) to 0.5 m at the last frame, 6 m from the first.
   o.drift_per_m = 0.5 / 36 / 1.3;  // the weave lengthens the 6 m path: about 0.5 m at the end
   make_test_scene(s, o);
-  ASSERT_GT((s.priors.back().p - s.truth.back().p).norm(), 0.45);
+  ASSERT_GT((s.priors.back().p_world_cam - s.truth.back().p_world_cam).norm(), 0.45);
   const RefineRun r = run(s);
   EXPECT_FALSE(r.report.stopped_early);
   EXPECT_LE(r.ate_after, 0.3 * r.ate_before);
-  std::cout << "  last frame's position error " << (s.priors.back().p - s.truth.back().p).norm() << " -> "
-            << (r.poses.back().p - s.truth.back().p).norm() << " m\n";
+  std::cout << "  last frame's position error "
+            << (s.priors.back().p_world_cam - s.truth.back().p_world_cam).norm() << " -> "
+            << (r.poses.back().p_world_cam - s.truth.back().p_world_cam).norm() << " m\n";
 }
 
 // A constant 0.5 m offset of every prior (the map in the true frame): a rigid motion of the whole
@@ -142,12 +143,13 @@ TEST(RefineHardCases, ConstantHalfMetreOffsetOfThePriors) {
   TestSceneOptions o;
   o.initial_offset_m = 0.5;
   make_test_scene(s, o);
-  ASSERT_GT((s.priors.front().p - s.truth.front().p).norm(), 0.45);
+  ASSERT_GT((s.priors.front().p_world_cam - s.truth.front().p_world_cam).norm(), 0.45);
   const RefineRun r = run(s);
   EXPECT_FALSE(r.report.stopped_early);
   EXPECT_LE(r.ate_after, 0.5 * r.ate_before);
-  std::cout << "  first frame's position error " << (s.priors.front().p - s.truth.front().p).norm() << " -> "
-            << (r.poses.front().p - s.truth.front().p).norm() << " m\n";
+  std::cout << "  first frame's position error "
+            << (s.priors.front().p_world_cam - s.truth.front().p_world_cam).norm() << " -> "
+            << (r.poses.front().p_world_cam - s.truth.front().p_world_cam).norm() << " m\n";
 }
 
 // The odometry jumps 0.3 m sideways between frames 19 and 20 (a LIO re-localization): the priors after the
@@ -159,7 +161,8 @@ TEST(RefineHardCases, OdometryJumpOfThirtyCentimetres) {
   TestSceneOptions o;
   o.drift_per_m = 0.002;
   make_test_scene(s, o);
-  for (size_t f = 20; f < s.input.priors.size(); ++f) s.input.priors[f].p += Eigen::Vector3d(0, 0.3, 0);
+  for (size_t f = 20; f < s.input.priors.size(); ++f)
+    s.input.priors[f].p_world_cam += Eigen::Vector3d(0, 0.3, 0);
   s.priors = s.input.priors;
   const RefineRun r = run(s);
   EXPECT_FALSE(r.report.stopped_early) << r.report.status;

@@ -86,7 +86,7 @@ TEST(RefineWeights, AlphaFollowsMotionWithinItsBounds) {
     CameraPose c;
     c.t_s = 0.1 * i;
     x += (i >= 30 && i < 40) ? 0.5 : 0.1;  // a fast stretch
-    c.p = {x, 0, 0};
+    c.p_world_cam = {x, 0, 0};
     poses.push_back(c);
   }
   WeightOptions o;
@@ -142,18 +142,18 @@ TEST(RefineWeights, AnchoredObservationsCarryAlphaOfTheFrame) {
 TEST(RefineTriangulation, RecoversAPointAndRefusesNoParallax) {
   PinholeCamera c{200, 200, 160, 120, 320, 240};
   std::vector<CameraPose> poses(3);
-  for (size_t i = 0; i < 3; ++i) poses[i].p = {0.5 * static_cast<double>(i), 0, 0};
+  for (size_t i = 0; i < 3; ++i) poses[i].p_world_cam = {0.5 * static_cast<double>(i), 0, 0};
   const Eigen::Vector3d X(0.4, -0.2, 6);
   std::vector<Observation> obs;
   for (uint32_t i = 0; i < 3; ++i) {
-    const Eigen::Vector3d q = X - poses[i].p;
+    const Eigen::Vector3d q = X - poses[i].p_world_cam;
     obs.push_back({i, Eigen::Vector2d(200 * q.x() / q.z() + 160, 200 * q.y() / q.z() + 120), true, 1});
   }
   obs.push_back({1, Eigen::Vector2d(10, 10), true, 1});  // a wrong match in frame 1
   const auto T = triangulate(obs, poses, c);
   ASSERT_TRUE(T.has_value());
   EXPECT_LT((*T - X).norm(), 1e-9);
-  for (auto& p : poses) p.p.setZero();  // one centre: pure rotation
+  for (auto& p : poses) p.p_world_cam.setZero();  // one centre: pure rotation
   EXPECT_FALSE(triangulate(obs, poses, c).has_value());
 }
 

@@ -28,7 +28,7 @@ io::CameraIntrinsics distorted_camera() {
 
 io::SfmKeypoint distorted_pixel(const io::CameraIntrinsics& k, const CameraPose& pose,
                                 const Eigen::Vector3d& X) {
-  const Eigen::Vector3d x = pose.q.conjugate() * (X - pose.p);
+  const Eigen::Vector3d x = pose.q_world_cam.conjugate() * (X - pose.p_world_cam);
   const double u = x.x() / x.z(), v = x.y() / x.z(), s = 1 + k.distortion[0] * (u * u + v * v);
   return {static_cast<float>(k.fx * u * s + k.cx), static_cast<float>(k.fy * v * s + k.cy), 2, -1};
 }
@@ -41,7 +41,7 @@ struct SmallSfm {
   SmallSfm() {
     for (int f = 0; f < 3; ++f) {
       CameraPose p;
-      p.p = Eigen::Vector3d(0.5 * f, 0, 0);
+      p.p_world_cam = Eigen::Vector3d(0.5 * f, 0, 0);
       poses.push_back(p);
       sfm.images.push_back({"thermal/" + std::to_string(f) + ".png",
                             false,

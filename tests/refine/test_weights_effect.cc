@@ -12,7 +12,7 @@ namespace {
 const PinholeCamera kCamera{200, 200, 159.5, 127.5, 320, 256};
 
 Eigen::Vector2d project(const CameraPose& pose, const Eigen::Vector3d& X) {
-  const Eigen::Vector3d x = pose.q.conjugate() * (X - pose.p);
+  const Eigen::Vector3d x = pose.q_world_cam.conjugate() * (X - pose.p_world_cam);
   return {kCamera.fx * x.x() / x.z() + kCamera.cx, kCamera.fy * x.y() / x.z() + kCamera.cy};
 }
 
