@@ -32,6 +32,12 @@ Column column(const std::string& header, const std::string& stage, const std::st
   return {header, [=](const json& r) { return fixed(metric(r, stage, key), digits); }};
 }
 
+// Held-out PSNR over the pixels some training view saw (eval's covisibility, where the scene has true
+// depth); "-" where it was not measured.
+Column covisible_psnr_column() {
+  return column("covisible PSNR (dB)", "eval", "covisible_psnr_db", 2);
+}
+
 // A stage's wall seconds from a run's record; "-" where it did not run (skipped or absent).
 std::string stage_seconds(const json& record, const std::string& stage) {
   for (const json& s : record.at("stages"))
@@ -52,6 +58,7 @@ AblationStudy refine_study() {
   // eval scores the poses training used: the truth run's ATE is of gt/poses.txt, measured like the others.
   s.measured = {column("ATE (m)", "eval", "ate_m", 4),
                 column("PSNR (dB)", "eval", "psnr_db", 2),
+                covisible_psnr_column(),
                 column("SSIM", "eval", "ssim", 4),
                 column("depth to planes RMSE (m)", "eval", "depth_plane_rmse_m", 4),
                 {"refine (s)", [](const json& r) { return stage_seconds(r, "refine"); }},
@@ -67,6 +74,7 @@ AblationStudy lambda_study() {
   for (const double l : {0.0, 0.2, 0.4, 0.6, 0.8})
     s.variants.push_back({fixed(l, 1), {fixed(l, 1)}, [l](RunConfig& c) { c.train.lambda_geo = l; }});
   s.measured = {column("PSNR (dB)", "eval", "psnr_db", 2),
+                covisible_psnr_column(),
                 column("SSIM", "eval", "ssim", 4),
                 column("depth to planes RMSE (m)", "eval", "depth_plane_rmse_m", 4),
                 column("centres to planes RMS (m)", "eval", "centre_plane_rms_m", 4),
@@ -103,6 +111,7 @@ AblationStudy features_study(const RunConfig& base) {
                             return p.is_array() ? fixed(p[1], 4) : std::string("-");
                           }});
     s.measured.push_back(column("PSNR (dB)", "eval", "psnr_db", 2));
+    s.measured.push_back(covisible_psnr_column());
   } else {
     s.note =
         "ATE, plane residual and PSNR are not measured per feature type here: refine.tracks is oracle "
@@ -134,8 +143,11 @@ AblationStudy strategy_study(const RunConfig& base) {
              c.train.strategy = strategy;
              c.train.max_gaussians = budget;
            }});
-  s.measured = {column("Gaussians", "train", "gaussians", 0), column("PSNR (dB)", "eval", "psnr_db", 2),
-                column("SSIM", "eval", "ssim", 4), column("training (s)", "train", "wall_s", 1),
+  s.measured = {column("Gaussians", "train", "gaussians", 0),
+                column("PSNR (dB)", "eval", "psnr_db", 2),
+                covisible_psnr_column(),
+                column("SSIM", "eval", "ssim", 4),
+                column("training (s)", "train", "wall_s", 1),
                 column("ms/iteration", "train", "ms_per_iteration", 1)};
   s.note =
       "budget: MCMC's fixed number of Gaussians; ADC's cap; auto: derived from the scene's surface (`train "
