@@ -81,7 +81,11 @@ void print_text(const host::ModelEvaluation& e, const nlohmann::json& trajectory
     std::cout << "eval: Gaussian centres to planes (" << e.plane_reference << "): RMS "
               << fixed(e.centre_plane_rms_m, 4) << " m, median " << fixed(e.centre_plane_median_m, 4)
               << " m over " << e.centre_plane_counted << " of " << e.gaussians << " centres\n";
-  if (trajectory.is_object()) {
+  if (trajectory.is_object() && !trajectory["ate_m"].is_number()) {
+    std::cout << "eval: ATE not available: the scene has no gt/poses.txt; refinement moved the frames "
+              << fixed(trajectory["moved_mean_m"].get<double>(), 4) << " m on average (at most "
+              << fixed(trajectory["moved_max_m"].get<double>(), 4) << " m)\n";
+  } else if (trajectory.is_object()) {
     std::cout << "eval: ATE " << fixed(trajectory["ate_m"].get<double>(), 4) << " m";
     if (trajectory["ate_prior_m"].is_number())
       std::cout << " (before refinement " << fixed(trajectory["ate_prior_m"].get<double>(), 4) << " m)";

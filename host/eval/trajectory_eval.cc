@@ -45,6 +45,52 @@ std::vector<Eigen::Vector2d> top_view(const std::vector<io::TumPose>& poses, con
   return out;
 }
 
+// The plane of the positions' two largest principal axes, about their centroid.
+void principal_plane(const std::vector<io::TumPose>& poses, Eigen::Vector3d& centre,
+                     Eigen::Matrix<double, 3, 2>& axes) {
+  centre = Eigen::Vector3d::Zero();
+  for (const auto& p : poses) centre += p.p_world / static_cast<double>(poses.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& p : poses) scatter += (p.p_world - centre) * (p.p_world - centre).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);  // eigenvalues ascending
+  axes.col(0) = eig.eigenvectors().col(2);
+  axes.col(1) = eig.eigenvectors().col(1);
+}
+
+// How far refinement moved each frame (both trajectories at the same times, in one frame).
+void moved(const std::vector<io::TumPose>& prior, const std::vector<io::TumPose>& refined,
+           TrajectoryEvaluation& r) {
+  const size_t n = std::min(prior.size(), refined.size());
+  if (n == 0) return;
+  double sum = 0, most = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double d = (refined[i].p_world - prior[i].p_world).norm();
+    sum += d;
+    most = std::max(most, d);
+  }
+  r.moved_mean_m = sum / static_cast<double>(n);
+  r.moved_max_m = most;
+}
+
+// No ground truth: the prior and refined trajectories as they are, for the report's top view.
+std::optional<TrajectoryEvaluation> without_truth(const std::vector<io::TumPose>& prior,
+                                                  const std::vector<io::TumPose>& refined) {
+  if (prior.size() < 3 || prior.size() != refined.size())
+    throw std::invalid_argument("poses_prior.txt and poses.txt do not cover the same frames (" +
+                                std::to_string(prior.size()) + " and " + std::to_string(refined.size()) +
+                                ")");
+  TrajectoryEvaluation r;
+  r.has_truth = false;
+  r.estimate.pairs = refined.size();
+  Eigen::Vector3d centre;
+  Eigen::Matrix<double, 3, 2> axes;
+  principal_plane(prior, centre, axes);
+  r.prior_top = top_view(prior, {}, centre, axes);
+  r.estimate_top = top_view(refined, {}, centre, axes);
+  moved(prior, refined, r);
+  return r;
+}
+
 }  // namespace
 
 std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, std::string* why_not,
@@ -53,12 +99,16 @@ std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, s
   ro.check_images = false;
   ro.load_map = false;
   const io::Scene scene = io::read_scene(dir, ro);
-  if (!scene.gt || scene.gt->poses.size() < 3) {
-    if (why_not) *why_not = "the scene has no gt/poses.txt (ground truth)";
-    return std::nullopt;
-  }
   std::vector<double> times;
   for (const auto& f : scene.frames) times.push_back(f.t_s);
+  if (!scene.gt || scene.gt->poses.size() < 3) {
+    if (!fs::exists(dir / "poses_prior.txt") || trained_on_truth) {
+      if (why_not) *why_not = "the scene has no gt/poses.txt (ground truth), and refine did not run";
+      return std::nullopt;
+    }
+    return without_truth(at_times(io::read_tum(dir / "poses_prior.txt"), times),
+                         at_times(scene.poses, times));
+  }
   const std::vector<io::TumPose> truth = at_times(scene.gt->poses, times);
   constexpr double kSameTime = 1e-9;  // all three are sampled at the same frame times
   TrajectoryEvaluation r;
@@ -72,17 +122,15 @@ std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, s
   }
   // The top view: the plane of the truth's two largest principal axes (for a ground or facade survey, the
   // horizontal plane).
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const auto& p : truth) centre += p.p_world / static_cast<double>(truth.size());
-  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-  for (const auto& p : truth) scatter += (p.p_world - centre) * (p.p_world - centre).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);  // eigenvalues ascending
+  Eigen::Vector3d centre;
   Eigen::Matrix<double, 3, 2> axes;
-  axes.col(0) = eig.eigenvectors().col(2);
-  axes.col(1) = eig.eigenvectors().col(1);
+  principal_plane(truth, centre, axes);
   r.truth_top = top_view(truth, {}, centre, axes);
   r.estimate_top = top_view(estimate, r.estimate.alignment, centre, axes);
-  if (r.prior) r.prior_top = top_view(prior, r.prior->alignment, centre, axes);
+  if (r.prior) {
+    r.prior_top = top_view(prior, r.prior->alignment, centre, axes);
+    if (!trained_on_truth) moved(prior, estimate, r);
+  }
   return r;
 }
 
@@ -92,11 +140,17 @@ nlohmann::json to_json(const TrajectoryEvaluation& t) {
     for (const auto& p : v) a.push_back({p.x(), p.y()});
     return a;
   };
-  return {{"ate_m", t.estimate.rmse_m},
-          {"ate_prior_m", t.prior ? nlohmann::json(t.prior->rmse_m) : nlohmann::json(nullptr)},
+  const auto or_null = [](bool known, double v) {
+    return known ? nlohmann::json(v) : nlohmann::json(nullptr);
+  };
+  return {{"ate_m", or_null(t.has_truth, t.estimate.rmse_m)},
+          {"ate_prior_m", or_null(t.has_truth && t.prior.has_value(), t.prior ? t.prior->rmse_m : 0.0)},
+          {"moved_mean_m", or_null(t.moved_mean_m >= 0, t.moved_mean_m)},
+          {"moved_max_m", or_null(t.moved_max_m >= 0, t.moved_max_m)},
           {"pairs", t.estimate.pairs},
           {"poses", t.trained_on_truth ? "gt/poses.txt (the model was trained on the truth)" : "poses.txt"},
-          {"alignment", "SE(3) Umeyama, positions at the frame times"},
+          {"alignment", t.has_truth ? "SE(3) Umeyama, positions at the frame times"
+                                    : "none: no ground truth; the prior and refined positions as they are"},
           {"top_view",
            {{"truth", points(t.truth_top)},
             {"prior", points(t.prior_top)},

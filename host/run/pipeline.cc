@@ -288,7 +288,7 @@ class Runner {
                       value("covisible_psnr_db"), 100 * value("covisible_fraction"));
         out_ << line;
       }
-      if (m.contains("ate_m")) {
+      if (m.value("ate_m", json()).is_number()) {
         std::snprintf(line, sizeof line, "run: ATE %.4f m", value("ate_m"));
         out_ << line;
         if (m["ate_prior_m"].is_number()) {

@@ -87,7 +87,12 @@ std::string summary_table(const json& metrics, const json& eval) {
     t += row("peak device memory", number(json(metrics["peak_device_bytes"].get<double>() / 1e6), 0, " MB"),
              "training");
   const json& trajectory = eval.value("trajectory", json("not available: eval wrote no trajectories"));
-  if (trajectory.is_object()) {
+  if (trajectory.is_object() && !trajectory["ate_m"].is_number()) {
+    t += row("ATE", "not available", "the scene has no gt/poses.txt");
+    t += row("refinement moved the frames", number(trajectory["moved_mean_m"], 4, " m"),
+             "mean over " + std::to_string(trajectory.value("pairs", 0)) + " frames, at most " +
+                 number(trajectory["moved_max_m"], 4, " m") + " (poses_prior.txt to poses.txt)");
+  } else if (trajectory.is_object()) {
     const std::string how = escape_html(trajectory.value("alignment", "")) + ", " +
                             std::to_string(trajectory.value("pairs", 0)) + " frames, against gt/poses.txt";
     if (trajectory["ate_prior_m"].is_number())
@@ -210,7 +215,8 @@ const char* kChartsScript = R"(
     const lo = k => Math.min(...all.map(p => p[k])), hi = k => Math.max(...all.map(p => p[k]));
     const half = 0.55 * Math.max(hi(0) - lo(0), hi(1) - lo(1), 1e-6);
     const mid = k => (lo(k) + hi(k)) / 2, xy = v => v.map(p => ({x:p[0], y:p[1]}));
-    const sets = [Object.assign(line('truth', xy(t.truth), '#9467bd'), {borderWidth:6, pointRadius:0, order:3})];
+    const sets = t.truth.length ?
+      [Object.assign(line('truth', xy(t.truth), '#9467bd'), {borderWidth:6, pointRadius:0, order:3})] : [];
     if (t.prior.length) sets.push(Object.assign(line('prior', xy(t.prior), '#ff7f0e'), {pointRadius:2, order:2}));
     sets.push(Object.assign(line(t.prior.length ? 'refined' : 'estimate', xy(t.estimate), '#17becf'),
                             {pointRadius:2, order:1}));

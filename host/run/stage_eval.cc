@@ -52,7 +52,7 @@ nlohmann::json result(const StageContext& c) {
     metrics[key] = e.value(key, nlohmann::json());
   metrics["lpips"] = e.at("lpips");
   if (e.value("trajectory", nlohmann::json()).is_object())
-    metrics.update(pick(e["trajectory"], {"ate_m", "ate_prior_m"}));
+    metrics.update(pick(e["trajectory"], {"ate_m", "ate_prior_m", "moved_mean_m", "moved_max_m"}));
   return {{"eval", (c.stage_dir("eval") / "eval.json").string()}, {"metrics", metrics}};
 }
 
