@@ -75,10 +75,13 @@ void moved(const std::vector<io::TumPose>& prior, const std::vector<io::TumPose>
 // No ground truth: the prior and refined trajectories as they are, for the report's top view.
 std::optional<TrajectoryEvaluation> without_truth(const std::vector<io::TumPose>& prior,
                                                   const std::vector<io::TumPose>& refined) {
-  if (prior.size() < 3 || prior.size() != refined.size())
+  if (prior.size() != refined.size())
     throw std::invalid_argument("poses_prior.txt and poses.txt do not cover the same frames (" +
                                 std::to_string(prior.size()) + " and " + std::to_string(refined.size()) +
                                 ")");
+  if (prior.size() < 3)
+    throw std::invalid_argument("poses_prior.txt covers " + std::to_string(prior.size()) +
+                                " frames, fewer than 3");
   TrajectoryEvaluation r;
   r.has_truth = false;
   r.estimate.pairs = refined.size();

@@ -48,11 +48,6 @@ std::vector<double> LidarDepthImage::candidates(const Eigen::Vector2d& px) const
   return out;
 }
 
-size_t LidarDepthImage::filled_cells() const {
-  return static_cast<size_t>(
-      std::count_if(first_depth_m_.begin(), first_depth_m_.end(), [](float d) { return std::isfinite(d); }));
-}
-
 std::optional<double> lidar_transfer_px(const DepthView& from, const DepthView& to, const PinholeK& K) {
   const std::vector<double> depths = from.depth.candidates(from.px);
   if (depths.empty()) return std::nullopt;

@@ -38,7 +38,6 @@ class LidarDepthImage {
   // The first-surface depths (metres along the optical axis) in the window around pixel `px`; empty where
   // the map has no sample there.
   std::vector<double> candidates(const Eigen::Vector2d& px) const;
-  size_t filled_cells() const;
 
  private:
   uint32_t cells_x_ = 0, cells_y_ = 0, cell_px_ = 1, window_ = 0;

@@ -51,6 +51,24 @@ Support support_of(const Eigen::Vector3d& X, const std::vector<size_t>& remainin
   return s;
 }
 
+// The linear point of the given observations (their views; every one posed); non-finite if degenerate.
+Eigen::Vector3d point_of(const std::vector<size_t>& members,
+                         const std::vector<std::optional<TriangulationView>>& views) {
+  std::vector<TriangulationView> member_views;
+  for (size_t m : members) member_views.push_back(*views[m]);
+  std::vector<size_t> all(member_views.size());
+  for (size_t k = 0; k < all.size(); ++k) all[k] = k;
+  return triangulate_linear(member_views, all);
+}
+
+// Each observation's group (index into `groups`), SIZE_MAX for those in none.
+std::vector<size_t> group_of_each(const std::vector<std::vector<size_t>>& groups, size_t observations) {
+  std::vector<size_t> group_of(observations, SIZE_MAX);
+  for (size_t g = 0; g < groups.size(); ++g)
+    for (size_t m : groups[g]) group_of[m] = g;
+  return group_of;
+}
+
 // Tracks of one point that the priors' drift split in time: two groups without a shared image, joined by
 // verified matches, whose union still reprojects within merge_factor times the bound. Pairs with more
 // matches between them merge first. Empties the groups merged away.
@@ -59,9 +77,7 @@ void merge_disjoint_groups(std::vector<std::vector<size_t>>& groups,
                            const std::vector<std::optional<TriangulationView>>& views, double fx, double fy,
                            const ConflictOptions& o) {
   if (!(o.merge_factor > 0) || groups.size() < 2) return;
-  std::vector<size_t> group_of(component.observations.size(), SIZE_MAX);
-  for (size_t g = 0; g < groups.size(); ++g)
-    for (size_t m : groups[g]) group_of[m] = g;
+  const std::vector<size_t> group_of = group_of_each(groups, component.observations.size());
   std::map<std::pair<size_t, size_t>, size_t> links;
   for (const auto& e : edges) {
     if (e[0] >= group_of.size() || e[1] >= group_of.size()) continue;
@@ -88,14 +104,10 @@ void merge_disjoint_groups(std::vector<std::vector<size_t>>& groups,
     for (size_t m : joined) images.push_back(component.observations[m].image);
     std::sort(images.begin(), images.end());
     if (std::adjacent_find(images.begin(), images.end()) != images.end()) continue;
-    std::vector<TriangulationView> member_views;
-    for (size_t m : joined) member_views.push_back(*views[m]);
-    std::vector<size_t> all(member_views.size());
-    for (size_t k = 0; k < all.size(); ++k) all[k] = k;
-    const Eigen::Vector3d X = triangulate_linear(member_views, all);
+    const Eigen::Vector3d X = point_of(joined, views);
     if (!X.allFinite()) continue;
-    const bool consistent = std::all_of(member_views.begin(), member_views.end(), [&](const auto& v) {
-      return error2_px(v, X, fx, fy) <= bound * bound;
+    const bool consistent = std::all_of(joined.begin(), joined.end(), [&](size_t m) {
+      return error2_px(*views[m], X, fx, fy) <= bound * bound;
     });
     if (!consistent) continue;
     groups[a] = std::move(joined);
@@ -113,9 +125,7 @@ void attach_dropped(std::vector<std::vector<size_t>>& groups, std::vector<char>&
                     const ConflictOptions& o) {
   if (!(o.merge_factor > 0) || groups.empty()) return;
   const size_t n = component.observations.size();
-  std::vector<size_t> group_of(n, SIZE_MAX);
-  for (size_t g = 0; g < groups.size(); ++g)
-    for (size_t m : groups[g]) group_of[m] = g;
+  const std::vector<size_t> group_of = group_of_each(groups, n);
   std::vector<std::map<size_t, size_t>> links(n);  // per dropped observation: group -> matches
   for (const auto& e : edges) {
     if (e[0] >= n || e[1] >= n) continue;
@@ -134,13 +144,7 @@ void attach_dropped(std::vector<std::vector<size_t>>& groups, std::vector<char>&
       if (std::any_of(groups[g].begin(), groups[g].end(),
                       [&](size_t m) { return component.observations[m].image == image; }))
         continue;
-      if (!point[g]) {
-        std::vector<TriangulationView> member_views;
-        for (size_t m : groups[g]) member_views.push_back(*views[m]);
-        std::vector<size_t> all(member_views.size());
-        for (size_t k = 0; k < all.size(); ++k) all[k] = k;
-        point[g] = triangulate_linear(member_views, all);
-      }
+      if (!point[g]) point[g] = point_of(groups[g], views);
       if (!point[g]->allFinite() || !(error2_px(*views[i], *point[g], fx, fy) <= bound2)) continue;
       groups[g].push_back(i);
       used[i] = 1;
@@ -234,11 +238,7 @@ ConflictSplit split_conflicting_component(const io::SfmTrack& component,
     // fall outside the bound and would become a second track. Re-triangulating from every member and
     // collecting again (local optimisation, as in LO-RANSAC) keeps them in one.
     for (int round = 0; round < 3; ++round) {
-      std::vector<TriangulationView> member_views;
-      for (size_t m : best.members) member_views.push_back(*views[m]);
-      std::vector<size_t> all(member_views.size());
-      for (size_t k = 0; k < all.size(); ++k) all[k] = k;
-      const Eigen::Vector3d X = triangulate_linear(member_views, all);
+      const Eigen::Vector3d X = point_of(best.members, views);
       if (!X.allFinite()) break;
       Support grown = support_of(X, remaining, component, views, fx, fy, bound2);
       if (grown.members.size() <= best.members.size()) break;

@@ -37,9 +37,11 @@ TEST(FrontendLidarCheck, TheDepthImageHoldsTheNearestSurface) {
   const std::vector<Eigen::Vector3d> near = wall(5.0, -0.5, 0.5);
   map.insert(map.end(), near.begin(), near.end());
   const LidarDepthImage depth(map, kA.R, kA.t, kK, kWidth, kHeight, {});
-  for (double d : depth.candidates(kA.project({0, 0, 5}))) EXPECT_NEAR(d, 5.0, 1e-6);
+  ASSERT_FALSE(depth.candidates(kA.project({0, 0, 5})).empty());
+  for (double d : depth.candidates(kA.project({0, 0, 5})))
+    EXPECT_NEAR(d, 5.0, 1e-6);  // the wall behind hidden
+  ASSERT_FALSE(depth.candidates(kA.project({2, 0, 8})).empty());
   for (double d : depth.candidates(kA.project({2, 0, 8}))) EXPECT_NEAR(d, 8.0, 1e-6);
-  EXPECT_FALSE(depth.candidates(kA.project({2, 0, 8})).empty());
   // Behind the camera and outside the image nothing lands; an empty map judges nothing.
   EXPECT_TRUE(LidarDepthImage({{0, 0, -5}, {100, 0, 5}}, kA.R, kA.t, kK, kWidth, kHeight, {})
                   .candidates({159.5, 127.5})
