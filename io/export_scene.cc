@@ -157,11 +157,35 @@ ColmapExportReport export_colmap(const ColmapExportOptions& o) {
   return report;
 }
 
+std::vector<TumPose> imu_trajectory(const SceneConfig& c, const std::vector<TumPose>& poses,
+                                    const fs::path& file) {
+  if (c.poses_frame == PoseFrame::kImu) return poses;
+  const Eigen::Matrix4d T_cam_imu = c.T_cam_lidar * rigid_inverse(c.T_imu_lidar);
+  std::vector<TumPose> out;
+  out.reserve(poses.size());
+  for (size_t i = 0; i < poses.size(); ++i) {
+    if (!poses[i].has_rotation)
+      fail(file, static_cast<int64_t>(i) + 1,
+           "a camera pose of unknown rotation cannot be moved to the IMU (the lever arm needs the rotation)");
+    Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+    T.topLeftCorner<3, 3>() = poses[i].q_world_body.toRotationMatrix();
+    T.topRightCorner<3, 1>() = poses[i].p_world;
+    T = T * T_cam_imu;
+    TumPose p;
+    p.t_s = poses[i].t_s + c.time_offset_cam_lidar_s;
+    p.p_world = T.topRightCorner<3, 1>();
+    p.q_world_body = Eigen::Quaterniond(Eigen::Matrix3d(T.topLeftCorner<3, 3>())).normalized();
+    out.push_back(p);
+  }
+  return out;
+}
+
 void TumExportOptions::check() const {
   if (scene.empty()) throw std::invalid_argument("scene: required");
   if (out.empty()) throw std::invalid_argument("out: required");
   if (!fs::is_directory(scene)) throw std::invalid_argument("scene: not a directory: " + scene.string());
   if (camera && ground_truth) throw std::invalid_argument("camera: not with ground_truth");
+  if (camera && imu) throw std::invalid_argument("imu: not with camera");
 }
 
 size_t export_tum(const TumExportOptions& o) {
@@ -186,6 +210,8 @@ size_t export_tum(const TumExportOptions& o) {
   } else {
     poses = scene.poses;
   }
+  if (o.imu)
+    poses = imu_trajectory(scene.config, poses, o.scene / (o.ground_truth ? "gt/poses.txt" : "poses.txt"));
   for (auto& p : poses) p.p_world += offset;
   write_tum(o.out, poses);
   return poses.size();

@@ -19,6 +19,13 @@ namespace litgs::io {
 // outside the trajectory, or next to a pose of unknown rotation, there is no pose.
 std::vector<std::optional<Eigen::Matrix4d>> camera_poses_at_frames(const Scene& scene);
 
+// `poses`, held in config.poses_frame, as poses of the IMU (the body frame of LIO odometry): camera poses
+// become T_world_imu = T_world_cam * T_cam_lidar * inverse(T_imu_lidar), stamped t + time_offset_cam_lidar_s
+// (the IMU shares the LiDAR's clock); IMU poses come back as they are. IoError naming `file` where a camera
+// pose of unknown rotation would need the lever arm.
+std::vector<TumPose> imu_trajectory(const SceneConfig& config, const std::vector<TumPose>& poses,
+                                    const std::filesystem::path& file);
+
 struct ColmapExportOptions {
   std::filesystem::path scene;  // scene directory to read
   std::filesystem::path out;    // folder to write: out/images/<frame>.png|.tiff, out/sparse/0/*.bin|.txt
@@ -55,6 +62,7 @@ struct TumExportOptions {
   // frame's timestamp (camera_poses_at_frames; frames without a pose are left out).
   bool camera = false;
   bool ground_truth = false;  // gt/poses.txt instead of poses.txt (not with camera)
+  bool imu = false;           // the poses (or the truth) as IMU poses (imu_trajectory; not with camera)
   bool recentred = false;     // as in ColmapExportOptions
 
   // Throws std::invalid_argument naming the bad field.

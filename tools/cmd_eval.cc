@@ -1,5 +1,6 @@
 // `litgs-engine eval --model M.ply --scene SCENE`: a trained model's quality on the scene's held-out views,
-// its geometry against the reference cloud and planes, and its render speed (host/eval/evaluate_model.h).
+// its geometry against the reference cloud and planes, and its render speed (host/eval/evaluate_model.h);
+// without --model, only the scene's trajectories (host/eval/trajectory_eval.h).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -30,6 +31,23 @@ std::string fixed(double v, int digits) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.*f", digits, v);
   return buf;
+}
+
+// The trajectory line: ATE against the truth, or how far refinement moved the frames, or why neither.
+void print_trajectory(const nlohmann::json& trajectory) {
+  if (trajectory.is_object() && !trajectory["ate_m"].is_number()) {
+    std::cout << "eval: ATE not available: the scene has no gt/poses.txt; refinement moved the frames "
+              << fixed(trajectory["moved_mean_m"].get<double>(), 4) << " m on average (at most "
+              << fixed(trajectory["moved_max_m"].get<double>(), 4) << " m)\n";
+  } else if (trajectory.is_object()) {
+    std::cout << "eval: ATE " << fixed(trajectory["ate_m"].get<double>(), 4) << " m";
+    if (trajectory["ate_prior_m"].is_number())
+      std::cout << " (before refinement " << fixed(trajectory["ate_prior_m"].get<double>(), 4) << " m)";
+    std::cout << " against gt/poses.txt (" << trajectory["frame"].get<std::string>() << " poses), "
+              << trajectory["alignment"].get<std::string>() << "\n";
+  } else {
+    std::cout << "eval: ATE " << trajectory.get<std::string>() << "\n";
+  }
 }
 
 void print_text(const host::ModelEvaluation& e, const nlohmann::json& trajectory) {
@@ -81,37 +99,27 @@ void print_text(const host::ModelEvaluation& e, const nlohmann::json& trajectory
     std::cout << "eval: Gaussian centres to planes (" << e.plane_reference << "): RMS "
               << fixed(e.centre_plane_rms_m, 4) << " m, median " << fixed(e.centre_plane_median_m, 4)
               << " m over " << e.centre_plane_counted << " of " << e.gaussians << " centres\n";
-  if (trajectory.is_object() && !trajectory["ate_m"].is_number()) {
-    std::cout << "eval: ATE not available: the scene has no gt/poses.txt; refinement moved the frames "
-              << fixed(trajectory["moved_mean_m"].get<double>(), 4) << " m on average (at most "
-              << fixed(trajectory["moved_max_m"].get<double>(), 4) << " m)\n";
-  } else if (trajectory.is_object()) {
-    std::cout << "eval: ATE " << fixed(trajectory["ate_m"].get<double>(), 4) << " m";
-    if (trajectory["ate_prior_m"].is_number())
-      std::cout << " (before refinement " << fixed(trajectory["ate_prior_m"].get<double>(), 4) << " m)";
-    std::cout << " against gt/poses.txt, " << trajectory["alignment"].get<std::string>() << "\n";
-  } else {
-    std::cout << "eval: ATE " << trajectory.get<std::string>() << "\n";
-  }
+  print_trajectory(trajectory);
   std::cout << "eval: LPIPS " << host::kLpipsNote << "\n";
 }
 
 void run_eval(const EvalCliOptions& cli) {
   host::EvalOptions o = cli.eval;
   apply_data_flags(cli.data_flags, o.data);
+  if (cli.model.empty()) {  // the poses only
+    const nlohmann::json j = {{"trajectory", host::trajectory_json_or_reason(cli.scene, o.data.true_poses)}};
+    if (!cli.out.empty()) io::write_file_atomic(cli.out, [&](std::ostream& s) { s << j.dump(2) << "\n"; });
+    if (cli.json)
+      std::cout << j.dump(2) << "\n";
+    else
+      print_trajectory(j["trajectory"]);
+    return;
+  }
   std::vector<host::ViewImages> images;
   const host::ModelEvaluation e =
       host::evaluate_model(cli.model, cli.scene, o, cli.views_out.empty() ? nullptr : &images);
   nlohmann::json j = host::to_json(e);
-  // The trajectories where the scene has ground truth; a trajectory ATE cannot use is said, not fatal.
-  std::string why_not;
-  try {
-    const auto trajectories = host::evaluate_trajectories(cli.scene, &why_not, o.data.true_poses);
-    if (trajectories) j["trajectory"] = host::to_json(*trajectories);
-  } catch (const std::invalid_argument& error) {
-    why_not = error.what();
-  }
-  if (!j.contains("trajectory")) j["trajectory"] = "not available: " + why_not;
+  j["trajectory"] = host::trajectory_json_or_reason(cli.scene, o.data.true_poses);
   if (!cli.views_out.empty()) {
     std::filesystem::create_directories(cli.views_out);
     nlohmann::json pictures = nlohmann::json::array();
@@ -130,9 +138,11 @@ void run_eval(const EvalCliOptions& cli) {
 
 void add_eval_command(CLI::App& app) {
   auto o = std::make_shared<EvalCliOptions>();
-  CLI::App* cmd = app.add_subcommand("eval", "Evaluate a trained model on its scene's held-out views");
-  cmd->add_option("--model", o->model, "3DGS PLY model (train's point_cloud.ply)")
-      ->required()
+  CLI::App* cmd = app.add_subcommand(
+      "eval",
+      "Evaluate a trained model on its scene's held-out views, or (without --model) the scene's poses");
+  cmd->add_option("--model", o->model,
+                  "3DGS PLY model (train's point_cloud.ply); without it only the poses are scored")
       ->check(CLI::ExistingFile);
   cmd->add_option("--scene", o->scene, "Scene directory the model was trained on")
       ->required()

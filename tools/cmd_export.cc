@@ -1,6 +1,6 @@
-// `litgs-engine export colmap|tum --scene SCENE --out ...`: a scene directory into the formats other tools
-// read (COLMAP, 3DGS trainers, evo); `export splat --model M.ply --out M.splat`: a model for web splat
-// viewers. CPU only: no Vulkan device is created.
+// `litgs-engine export colmap|tum|bag --scene SCENE --out ...`: a scene directory into the formats other
+// tools read (COLMAP, 3DGS trainers, evo, ROS 1); `export splat --model M.ply --out M.splat`: a model for web
+// splat viewers. CPU only: no Vulkan device is created.
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <memory>
@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "io/export_bag.h"
 #include "io/export_scene.h"
 #include "io/gaussian_ply.h"
 #include "io/splat_export.h"
@@ -70,10 +71,29 @@ void add_export_command(CLI::App& app) {
   tum->add_option("--out", t->out, "TUM file to write")->required();
   tum->add_flag("--camera", t->camera, "Camera poses at the frame timestamps (default: poses.txt as stored)");
   tum->add_flag("--gt", t->ground_truth, "Export gt/poses.txt instead of poses.txt");
+  tum->add_flag("--imu", t->imu, "As IMU (body) poses, converted through the scene's extrinsics if need be");
   tum->add_flag("--recentred", t->recentred, "Keep the scene's recentred coordinates (default: original)");
   tum->callback([t] {
     const size_t n = io::export_tum(*t);
     std::cout << "export tum: " << n << " poses into " << t->out.string() << "\n";
+  });
+
+  auto b = std::make_shared<io::BagExportOptions>();
+  CLI::App* bag = exp->add_subcommand(
+      "bag", "ROS 1 bag laid out like an M2DGR sequence: frames, scans, IMU, odometry of the IMU");
+  bag->add_option("--scene", b->scene, "Scene directory")->required()->check(CLI::ExistingDirectory);
+  bag->add_option("--out", b->out, ".bag file to write")->required();
+  bag->add_option("--thermal-topic", b->topics.thermal, "sensor_msgs/Image")->capture_default_str();
+  bag->add_option("--lidar-topic", b->topics.lidar, "sensor_msgs/PointCloud2 (empty: none)")
+      ->capture_default_str();
+  bag->add_option("--imu-topic", b->topics.imu, "sensor_msgs/Imu (empty: none)")->capture_default_str();
+  bag->add_option("--odom-topic", b->topics.odom, "nav_msgs/Odometry of poses.txt (empty: none)")
+      ->capture_default_str();
+  bag->add_flag("--recentred", b->recentred, "Keep the scene's recentred coordinates (default: original)");
+  bag->callback([b] {
+    const io::BagExportReport r = io::export_bag(*b);
+    std::cout << "export bag: " << r.frames << " frames, " << r.scans << " scans, " << r.imu
+              << " IMU samples, " << r.odometry << " odometry poses into " << b->out.string() << "\n";
   });
   add_export_splat_command(*exp);
 }

@@ -40,6 +40,15 @@ void add_synth_command(CLI::App& app) {
       ->add_option("--lidar-holdout-every", o->lidar_holdout_every,
                    "Leave scans 0, N, 2N, ... out of lidar/map.pcd, as map does (0: every scan in the map)")
       ->capture_default_str();
+  synth
+      ->add_option("--rig", o->rig,
+                   "M2DGR calibration_results.txt: simulate its thermal camera (intrinsics, distortion, "
+                   "extrinsic) and IMU lever arm instead of the preset's rig; --width/--height scale it")
+      ->check(CLI::ExistingFile);
+  synth->add_option("--rig-camera", o->rig_camera_block, "The --rig block of the camera")
+      ->capture_default_str();
+  synth->add_option("--rig-imu", o->rig_imu_block, "The --rig block of the IMU (the body frame)")
+      ->capture_default_str();
   synth->add_flag("--force", o->force, "Replace the scene files in a non-empty --out");
   synth->add_flag("--drift", o->drift,
                   "A known sensor level drift (slow gain and offset warm-up, an offset jump at the first NUC "

@@ -73,8 +73,8 @@ void moved(const std::vector<io::TumPose>& prior, const std::vector<io::TumPose>
 }
 
 // No ground truth: the prior and refined trajectories as they are, for the report's top view.
-std::optional<TrajectoryEvaluation> without_truth(const std::vector<io::TumPose>& prior,
-                                                  const std::vector<io::TumPose>& refined) {
+TrajectoryEvaluation without_truth(const std::vector<io::TumPose>& prior,
+                                   const std::vector<io::TumPose>& refined) {
   if (prior.size() != refined.size())
     throw std::invalid_argument("poses_prior.txt and poses.txt do not cover the same frames (" +
                                 std::to_string(prior.size()) + " and " + std::to_string(refined.size()) +
@@ -94,6 +94,10 @@ std::optional<TrajectoryEvaluation> without_truth(const std::vector<io::TumPose>
   return r;
 }
 
+std::string frame_name(io::PoseFrame f) {
+  return f == io::PoseFrame::kImu ? "imu" : "camera";
+}
+
 }  // namespace
 
 std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, std::string* why_not,
@@ -109,13 +113,16 @@ std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, s
       if (why_not) *why_not = "the scene has no gt/poses.txt (ground truth), and refine did not run";
       return std::nullopt;
     }
-    return without_truth(at_times(io::read_tum(dir / "poses_prior.txt"), times),
-                         at_times(scene.poses, times));
+    TrajectoryEvaluation r =
+        without_truth(at_times(io::read_tum(dir / "poses_prior.txt"), times), at_times(scene.poses, times));
+    r.frame = frame_name(scene.config.poses_frame);
+    return r;
   }
   const std::vector<io::TumPose> truth = at_times(scene.gt->poses, times);
   constexpr double kSameTime = 1e-9;  // all three are sampled at the same frame times
   TrajectoryEvaluation r;
   r.trained_on_truth = trained_on_truth;
+  r.frame = frame_name(scene.config.poses_frame);
   const std::vector<io::TumPose> estimate = at_times(trained_on_truth ? scene.gt->poses : scene.poses, times);
   r.estimate = refine::absolute_trajectory_error(estimate, truth, refine::AteAlignment::kSE3, kSameTime);
   std::vector<io::TumPose> prior;
@@ -151,6 +158,7 @@ nlohmann::json to_json(const TrajectoryEvaluation& t) {
           {"moved_mean_m", or_null(t.moved_mean_m >= 0, t.moved_mean_m)},
           {"moved_max_m", or_null(t.moved_max_m >= 0, t.moved_max_m)},
           {"pairs", t.estimate.pairs},
+          {"frame", t.frame},
           {"poses", t.trained_on_truth ? "gt/poses.txt (the model was trained on the truth)" : "poses.txt"},
           {"alignment", t.has_truth ? "SE(3) Umeyama, positions at the frame times"
                                     : "none: no ground truth; the prior and refined positions as they are"},
@@ -158,6 +166,16 @@ nlohmann::json to_json(const TrajectoryEvaluation& t) {
            {{"truth", points(t.truth_top)},
             {"prior", points(t.prior_top)},
             {"estimate", points(t.estimate_top)}}}};
+}
+
+nlohmann::json trajectory_json_or_reason(const std::filesystem::path& scene_dir, bool trained_on_truth) {
+  std::string why_not;
+  try {
+    if (const auto t = evaluate_trajectories(scene_dir, &why_not, trained_on_truth)) return to_json(*t);
+  } catch (const std::invalid_argument& error) {
+    why_not = error.what();
+  }
+  return "not available: " + why_not;
 }
 
 }  // namespace litgs::host

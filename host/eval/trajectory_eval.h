@@ -22,7 +22,8 @@ struct TrajectoryEvaluation {
       prior;                   // poses_prior.txt: before refinement (absent if refine did not run)
   refine::AteResult estimate;  // poses.txt (gt/poses.txt when the model was trained on it)
   bool trained_on_truth = false;
-  bool has_truth = true;  // false: no gt/poses.txt, only the prior and the refined poses (no ATE)
+  std::string frame = "camera";  // which moving frame the poses describe: "camera" or "imu" (poses_frame)
+  bool has_truth = true;         // false: no gt/poses.txt, only the prior and the refined poses (no ATE)
   // Where refine ran: how far it moved the frames' positions (prior to refined), metres; -1 otherwise.
   double moved_mean_m = -1, moved_max_m = -1;
   // Top view: positions (truth, and the others after their alignment) in the plane of the truth's two
@@ -38,6 +39,11 @@ struct TrajectoryEvaluation {
 std::optional<TrajectoryEvaluation> evaluate_trajectories(const std::filesystem::path& scene_dir,
                                                           std::string* why_not = nullptr,
                                                           bool trained_on_truth = false);
+
+// to_json of evaluate_trajectories, or the string "not available: <why>" where the scene has no trajectory to
+// score or too few frames within it (what eval writes; io::IoError still propagates).
+nlohmann::json trajectory_json_or_reason(const std::filesystem::path& scene_dir,
+                                         bool trained_on_truth = false);
 
 // {"ate_m" (null without truth), "ate_prior_m" (or null), "moved_mean_m", "moved_max_m" (or null), "pairs",
 // "alignment": "SE(3) Umeyama", "top_view": {"truth", "prior", "estimate"}: [[x, y], ...]}.

@@ -2,9 +2,11 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "host/synth/thermal_camera.h"
+#include "io/lens_distortion.h"
 
 namespace litgs::host::synth {
 namespace {
@@ -76,7 +78,9 @@ std::vector<io::Anchor> pick_anchors(const World& world, const io::CameraIntrins
     const double gy =
         pixel_radiance(world, K, T_world_cam, x, y + 1) - pixel_radiance(world, K, T_world_cam, x, y - 1);
     if (std::hypot(gx, gy) / 2 < o.anchor_min_gradient_raw) continue;
-    const Eigen::Vector3d d_cam = Eigen::Vector3d((x - K.cx) / K.fx, (y - K.cy) / K.fy, 1).normalized();
+    const std::optional<Eigen::Vector3d> ray = io::pixel_ray(K, x, y);
+    if (!ray) continue;
+    const Eigen::Vector3d d_cam = ray->normalized();
     const Eigen::Vector3d dir = T_world_cam.linear() * d_cam;
     const auto hit = world.cast({T_world_cam.translation(), dir}, 0.05, 1e4);
     if (!hit) continue;

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "host/synth/level_drift.h"
+#include "host/synth/m2dgr_rig.h"
 #include "host/synth/presets.h"
 #include "io/atomic_file.h"
 #include "io/scene.h"
@@ -119,7 +120,10 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
                                   std::to_string(*options.frames));
     p.frames = *options.frames;
   }
-  if (options.width) {
+  if (!options.rig.empty()) {
+    apply_m2dgr_rig({options.rig, options.rig_camera_block, options.rig_imu_block}, options.width,
+                    options.height, p);
+  } else if (options.width) {
     p.camera.width = *options.width;
     p.camera.height = *options.height;
   }
@@ -202,8 +206,9 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   std::ostringstream source;
   source << "synthetic: litgs-engine synth --preset " << p.name << " --seed " << options.seed << " --frames "
          << n << " --width " << K.width << " --height " << K.height << (options.drift ? " --drift" : "")
-         << (options.appearance != "textured" ? " --appearance " + options.appearance : "") << " ("
-         << p.description << ")";
+         << (options.appearance != "textured" ? " --appearance " + options.appearance : "")
+         << (options.rig.empty() ? "" : " --rig " + options.rig.filename().string()) << " (" << p.description
+         << ")";
   c.source = source.str();
 
   // Ground truth that the io reader does not know: written first, scene.yaml still comes last.

@@ -31,6 +31,11 @@ struct SynthOptions {
   // Scans 0, N, 2N, ... left out of lidar/map.pcd, as `litgs-engine map` does (scene.yaml
   // lidar_holdout_every); 0: every scan in the map. Sequences under 2N frames hold none out.
   int lidar_holdout_every = io::kDefaultLidarHoldoutEvery;
+  // A real rig instead of the preset's (host/synth/m2dgr_rig.h): M2DGR's calibration file, the camera block
+  // to simulate and the IMU block the body follows. width and height then scale the calibrated camera.
+  std::filesystem::path rig;
+  std::string rig_camera_block = "Cam-thermal";
+  std::string rig_imu_block = "Handsfree IMU";
 
   // Empty if valid, else the first bad field and why (std::invalid_argument from generate_* carries it).
   std::string check() const;

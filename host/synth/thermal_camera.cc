@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "host/synth/rng.h"
+#include "io/lens_distortion.h"
 
 namespace litgs::host::synth {
 
@@ -14,6 +15,12 @@ std::string ThermalCameraOptions::check() const {
   if (width < 16 || width > 8192) return "width: must be in [16, 8192]";
   if (height < 16 || height > 8192) return "height: must be in [16, 8192]";
   if (!(hfov_deg > 1 && hfov_deg < 170)) return "hfov_deg: must be in (1, 170)";
+  if (calibrated) {
+    const io::CameraIntrinsics& k = *calibrated;
+    if (k.width != width || k.height != height) return "calibrated: its size differs from width x height";
+    if (!(k.fx > 0 && k.fy > 0 && std::isfinite(k.cx) && std::isfinite(k.cy)))
+      return "calibrated: fx and fy must be positive, cx and cy finite";
+  }
   if (!(temporal_noise_raw >= 0)) return "temporal_noise_raw: must be >= 0";
   if (!(fixed_pattern_raw >= 0)) return "fixed_pattern_raw: must be >= 0";
   if (!(vignetting_raw >= 0)) return "vignetting_raw: must be >= 0";
@@ -25,6 +32,11 @@ std::string ThermalCameraOptions::check() const {
 }
 
 io::CameraIntrinsics ThermalCameraOptions::intrinsics() const {
+  if (calibrated) {
+    io::CameraIntrinsics K = *calibrated;
+    K.bit_depth = 16;
+    return K;
+  }
   io::CameraIntrinsics K;
   K.width = width;
   K.height = height;
@@ -37,7 +49,9 @@ io::CameraIntrinsics ThermalCameraOptions::intrinsics() const {
 
 double pixel_radiance(const World& world, const io::CameraIntrinsics& K, const Eigen::Isometry3d& T_world_cam,
                       double x, double y) {
-  const Eigen::Vector3d d_cam((x - K.cx) / K.fx, (y - K.cy) / K.fy, 1);
+  const std::optional<Eigen::Vector3d> ray = io::pixel_ray(K, x, y);
+  if (!ray) return world.sky_raw;
+  const Eigen::Vector3d d_cam = *ray;
   const Eigen::Vector3d dir = T_world_cam.linear() * d_cam.normalized();
   const auto hit = world.cast({T_world_cam.translation(), dir}, 0.05, 1e4);
   if (!hit) return world.sky_raw;
@@ -56,7 +70,9 @@ io::Image true_depth_mm(const World& world, const io::CameraIntrinsics& K,
   depth.data.assign(static_cast<size_t>(K.width) * K.height, 0);
   for (int y = 0; y < K.height; ++y)
     for (int x = 0; x < K.width; ++x) {
-      const Eigen::Vector3d d_cam((x - K.cx) / K.fx, (y - K.cy) / K.fy, 1);
+      const std::optional<Eigen::Vector3d> ray = io::pixel_ray(K, x, y);
+      if (!ray) continue;
+      const Eigen::Vector3d d_cam = *ray;
       const auto hit =
           world.cast({T_world_cam.translation(), T_world_cam.linear() * d_cam.normalized()}, 0.05, 1e4);
       if (!hit) continue;
@@ -101,20 +117,20 @@ io::Image render_thermal(const World& world, const ThermalCameraOptions& o,
                          const Eigen::Isometry3d& T_world_cam, uint64_t seed, uint64_t frame_index,
                          int threads) {
   const io::CameraIntrinsics K = o.intrinsics();
-  const size_t pixels = static_cast<size_t>(o.width) * o.height;
+  const size_t pixels = static_cast<size_t>(K.width) * K.height;
   // The scene's radiance through the optics first, then the sensor's noise on top of it.
   std::vector<double> radiance(pixels);
   auto render_rows = [&](int y0, int step) {
-    for (int y = y0; y < o.height; y += step)
-      for (int x = 0; x < o.width; ++x)
-        radiance[static_cast<size_t>(y) * o.width + x] = pixel_radiance(world, K, T_world_cam, x, y);
+    for (int y = y0; y < K.height; y += step)
+      for (int x = 0; x < K.width; ++x)
+        radiance[static_cast<size_t>(y) * K.width + x] = pixel_radiance(world, K, T_world_cam, x, y);
   };
   threads = std::clamp(threads, 1, 64);
   std::vector<std::thread> pool;
   for (int i = 1; i < threads; ++i) pool.emplace_back(render_rows, i, threads);
   render_rows(0, threads);
   for (auto& t : pool) t.join();
-  gaussian_blur(radiance, o.width, o.height, o.blur_px);
+  gaussian_blur(radiance, K.width, K.height, o.blur_px);
 
   const uint64_t frame_key =
       hash_combine(hash_combine(seed, static_cast<uint64_t>(Stream::kThermal)), frame_index);
@@ -123,13 +139,13 @@ io::Image render_thermal(const World& world, const ThermalCameraOptions& o,
   const uint64_t column_key = hash_combine(pattern_key, 0xc01ull);
   const double r2_corner = K.cx * K.cx + K.cy * K.cy;
   io::Image image;
-  image.width = o.width;
-  image.height = o.height;
+  image.width = K.width;
+  image.height = K.height;
   image.bit_depth = 16;
   image.data.assign(pixels, 0);
-  for (int y = 0; y < o.height; ++y)
-    for (int x = 0; x < o.width; ++x) {
-      const uint64_t pixel = static_cast<uint64_t>(y) * o.width + x;
+  for (int y = 0; y < K.height; ++y)
+    for (int x = 0; x < K.width; ++x) {
+      const uint64_t pixel = static_cast<uint64_t>(y) * K.width + x;
       double raw = radiance[pixel];
       const double r2 = ((x - K.cx) * (x - K.cx) + (y - K.cy) * (y - K.cy)) / r2_corner;
       raw -= o.vignetting_raw * r2;

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "host/synth/geometry.h"
@@ -15,9 +16,12 @@
 namespace litgs::host::synth {
 
 struct ThermalCameraOptions {
-  int width = 320;                  // pixels
-  int height = 256;                 // pixels
-  double hfov_deg = 50;             // horizontal field of view; fx = fy, principal point at the centre
+  int width = 320;       // pixels
+  int height = 256;      // pixels
+  double hfov_deg = 50;  // horizontal field of view; fx = fy, principal point at the centre
+  // A calibrated camera instead (e.g. from M2DGR's file, host/synth/m2dgr_rig.h): its intrinsics and lens
+  // distortion replace width, height and hfov_deg; the frames are rendered through the distortion.
+  std::optional<io::CameraIntrinsics> calibrated;
   double temporal_noise_raw = 3;    // per pixel and frame (standard deviation, counts)
   double fixed_pattern_raw = 2;     // per pixel, the same in every frame (residual non-uniformity)
   double vignetting_raw = 60;       // counts lost at the image corners (quadratic in the radius)
@@ -30,7 +34,8 @@ struct ThermalCameraOptions {
   io::CameraIntrinsics intrinsics() const;
 };
 
-// The noise-free radiance along the ray through pixel (x, y) (pixel centres at integers).
+// The noise-free radiance along the ray through pixel (x, y) (pixel centres at integers), through K's lens
+// distortion; the sky's where the lens model has no ray.
 double pixel_radiance(const World& world, const io::CameraIntrinsics& K, const Eigen::Isometry3d& T_world_cam,
                       double x, double y);
 
@@ -40,8 +45,9 @@ io::Image render_thermal(const World& world, const ThermalCameraOptions& options
                          const Eigen::Isometry3d& T_world_cam, uint64_t seed, uint64_t frame_index,
                          int threads);
 
-// The true depth of every pixel centre: z along the camera's axis in millimetres (16-bit, rounded), 0 where
-// the ray meets nothing (sky) or the depth exceeds 65.535 m. The scene's gt/depth/<frame>.png.
+// The true depth of every pixel centre (through K's lens distortion): z along the camera's axis in
+// millimetres (16-bit, rounded), 0 where the ray meets nothing (sky) or the depth exceeds 65.535 m. The
+// scene's gt/depth/<frame>.png.
 io::Image true_depth_mm(const World& world, const io::CameraIntrinsics& K,
                         const Eigen::Isometry3d& T_world_cam);
 

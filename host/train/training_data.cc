@@ -8,6 +8,7 @@
 
 #include "host/frontend/frozen_frames.h"
 #include "host/frontend/intensity.h"
+#include "io/lens_distortion.h"
 #include "io/scene.h"
 
 namespace litgs::host {
@@ -48,24 +49,6 @@ Eigen::Isometry3d pose_at(const io::Scene& scene, const std::vector<io::TumPose>
     T = T * Eigen::Isometry3d(T_imu_cam);
   }
   return T;
-}
-
-// Normalized undistorted (x, y) -> normalized distorted, for the scene's camera model.
-Eigen::Vector2d distort(const io::CameraIntrinsics& k, double x, double y) {
-  const auto& d = k.distortion;
-  auto coef = [&](size_t i) { return i < d.size() ? d[i] : 0.0; };
-  if (k.model == io::CameraModel::kEquidistant) {
-    const double r = std::sqrt(x * x + y * y);
-    if (r < 1e-12) return {x, y};
-    const double th = std::atan(r), th2 = th * th;
-    const double thd = th * (1 + th2 * (coef(0) + th2 * (coef(1) + th2 * (coef(2) + th2 * coef(3)))));
-    return {x * thd / r, y * thd / r};
-  }
-  const double r2 = x * x + y * y;
-  const double radial = 1 + r2 * (coef(0) + r2 * (coef(1) + r2 * coef(4)));
-  const double p1 = coef(2), p2 = coef(3);
-  return {x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
-          y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y};
 }
 
 // Bilinear sample at OpenCV pixel coordinates (pixel centres at integers); -1 outside the image.
@@ -212,7 +195,7 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
         for (int sy_i = 0; sy_i < sub; ++sy_i)
           for (int sx_i = 0; sx_i < sub; ++sx_i) {
             const double px = x + (sx_i + 0.5) / sub, py = y + (sy_i + 0.5) / sub;  // training pixel coords
-            const Eigen::Vector2d d = distort(k, (px - cx) / fx, (py - cy) / fy);
+            const Eigen::Vector2d d = io::distort_normalized(k, {(px - cx) / fx, (py - cy) / fy});
             const double v = sample(raw[i], k.width, k.height, k.fx * d.x() + k.cx, k.fy * d.y() + k.cy);
             if (v >= 0) {
               sum += v;
