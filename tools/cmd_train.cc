@@ -34,7 +34,7 @@ struct TrainCliOptions {
   host::InitialModelOptions initial;  // --init and its options (seed and SH degree from `train`)
   DataFlags data_flags;               // --intensity, --poses
   std::string trace;                  // JSON lines appended at every progress report (the report's curves)
-  std::string max_gaussians = "2000000";  // a count, auto or search (host/train/budget_flag.h)
+  std::string max_gaussians = "2000000";  // a count, auto, search or grow (host/train/budget_flag.h)
   host::BudgetSearchOptions budget_search;
   std::vector<std::string> search_options_given;  // the --budget-* options on the command line
   host::TrainingDataOptions data;
@@ -99,6 +99,7 @@ void run_train(TrainCliOptions o) {
                  "budget, "
               << o.max_gaussians << " Gaussians (budget.json)\n";
   apply_data_flags(o.data_flags, o.data);
+  o.train.growth.enabled = o.max_gaussians == "grow";
   o.train.check();
   const host::TrainingData data = host::load_training_data(o.scene, o.data);
 
@@ -282,7 +283,9 @@ void add_train_command(CLI::App& app) {
                   "training views see at their resolution: the LiDAR map, else the initialization's points), "
                   "or search (two trainings per doubling budget, each on the training views less its own "
                   "validation eighth, while their mean validation PSNR still rises, looking one doubling "
-                  "past a plateau; then the final training at the budget found)")
+                  "past a plateau; then the final training at the budget found), or grow (mcmc: doubled "
+                  "inside one training while every 8th training view, held back meanwhile, still gains "
+                  "beyond its noise)")
       ->capture_default_str();
   cmd->add_option("--budget-parsimony", o->budget_search.parsimony_se,
                   "With --max-gaussians search: keep the smallest budget whose validation PSNR, paired per "

@@ -122,14 +122,15 @@ AblationStudy features_study(const RunConfig& base) {
 }
 
 // The budgets the strategy study compares: 1/4, 1/2 and 1 times a fixed train.max_gaussians; with auto or
-// search, the derived or searched budget beside fixed ones spanning docs/budget.md's DUNR sweep (5k to 80k).
+// search or grow, the derived, searched or grown budget beside fixed ones spanning docs/budget.md's DUNR
+// sweep (5k to 80k).
 std::vector<std::string> compared_budgets(const std::string& base) {
-  if (base == "auto" || base == "search") return {"5000", "20000", "80000", base};
+  if (base == "auto" || base == "search" || base == "grow") return {"5000", "20000", "80000", base};
   const bool count = !base.empty() && base.find_first_not_of("0123456789") == std::string::npos &&
                      base.size() <= 9 && std::stoul(base) >= 4;
   if (!count)
-    throw std::invalid_argument("train.max_gaussians must be a count (at least 4), auto or search, not '" +
-                                base + "'");
+    throw std::invalid_argument(
+        "train.max_gaussians must be a count (at least 4), auto, search or grow, not '" + base + "'");
   const unsigned long b = std::stoul(base);
   return {std::to_string(b / 4), std::to_string(b / 2), base};
 }

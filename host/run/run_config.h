@@ -130,8 +130,9 @@ void for_each_field(Config& c, F&& f) {
   f("train", "max_gaussians", c.train.max_gaussians,
     "MCMC budget (adc: cap): search (the default: doubled while the validation PSNR of trainings on the "
     "training views less a validation eighth still rises, two trainings per budget; a cut-short search "
-    "continues on rerun; docs/budget.md), a count (40000 for a quick run) or auto (from the surface the "
-    "training views see)");
+    "continues on rerun; docs/budget.md), a count (40000 for a quick run), auto (from the surface the "
+    "training views see) or grow (doubled inside one training while held-back views still gain: "
+    "docs/cli/train.md)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
   f("train", "init", c.train.init,

@@ -25,8 +25,8 @@ uint32_t parse_count(const std::string& flag) {
                       std::all_of(flag.begin(), flag.end(), [](unsigned char c) { return std::isdigit(c); });
   const unsigned long long n = digits ? std::stoull(flag) : 0;
   if (n == 0 || n > UINT32_MAX)
-    throw std::invalid_argument("--max-gaussians must be a positive integer, auto or search, not '" + flag +
-                                "'");
+    throw std::invalid_argument("--max-gaussians must be a positive integer, auto, search or grow, not '" +
+                                flag + "'");
   return static_cast<uint32_t>(n);
 }
 
@@ -57,6 +57,7 @@ uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
                                const std::filesystem::path& out) {
   const std::filesystem::path record = out / "budget.json";
   if (flag == "search") return in.resume ? budget_of_earlier_run(record) : BudgetSearchOptions{}.max_budget;
+  if (flag == "grow") return BudgetSearchOptions{}.max_budget;  // the ceiling; the training grows below it
   if (flag != "auto") return parse_count(flag);
   if (in.resume) return budget_of_earlier_run(record);
 

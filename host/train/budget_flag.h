@@ -30,7 +30,8 @@ struct BudgetInputs {
 
 // `flag` is a positive integer or "auto"; std::invalid_argument naming the problem otherwise, or when auto
 // has no surface to measure (no LiDAR map and a random initialization). "search" is resolved by
-// search_max_gaussians; here it gives the search's cap (or, resuming, the budget it recorded).
+// search_max_gaussians; here it gives the search's cap (or, resuming, the budget it recorded). "grow" gives
+// the same cap as the ceiling of a budget grown inside the training (TrainOptions::growth).
 uint32_t resolve_max_gaussians(const std::string& flag, const BudgetInputs& in,
                                const std::filesystem::path& out);
 

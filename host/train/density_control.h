@@ -29,6 +29,11 @@ class DensityControl {
   // removed to `counters`.
   void after_step(kernels::TrainableGaussians& model, kernels::McmcStrategy* mcmc, uint32_t step,
                   TrainingCounters& counters);
+  // The model's cap from now on (a growing budget: host/train/budget_growth.h).
+  void set_budget(uint32_t max_gaussians) {
+    densify_.max_gaussians = max_gaussians;
+    mcmc_.max_gaussians = max_gaussians;
+  }
 
  private:
   engine::Context* context_;

@@ -49,6 +49,8 @@ nlohmann::json metrics_json(const TrainReport& report, const TrainingData& data,
   metrics["counters"] = to_json(report.counters);
   metrics["resumes"] = nlohmann::json::array();
   for (const auto& r : report.resumes) metrics["resumes"].push_back(to_json(r));
+  // `--max-gaussians grow`: each phase's budget, size, validation score and decision, and why it stopped.
+  if (!report.growth.is_null()) metrics["budget_growth"] = report.growth;
   // wall_s, ms_per_iteration and kernel_ms_per_iteration are of this call: iterations
   // start_iteration..iterations.
   metrics["start_iteration"] = report.start_iteration;

@@ -157,6 +157,14 @@ json run_options_json(const TrainOptions& o, const TrainingData& data) {
                 {"level_lr_vignetting", shortest(o.level_lr_vignetting)},
                 {"level_lambda_identity", shortest(o.level_lambda_identity)},
                 {"level_lambda_smooth", shortest(o.level_lambda_smooth)}};
+  if (o.growth.enabled)  // only then, so that other runs' stored options stay as they were
+    train["growth"] = {{"start", o.growth.start},
+                       {"factor", o.growth.factor},
+                       {"phase_refinements", o.growth.phase_refinements},
+                       {"validation_every", o.growth.validation_every},
+                       {"min_gain_db", o.growth.min_gain_db},
+                       {"noise_multiple", o.growth.noise_multiple},
+                       {"min_transfer", o.growth.min_transfer}};
   const TrainingDataOptions& d = data.options;
   json data_options = {{"downscale", d.downscale},
                        {"holdout_every", d.holdout_every},

@@ -77,6 +77,8 @@ struct RunRecord {
   TrainingCounters counters;
   std::vector<EvalResult> evaluations;  // in iteration order, up to the checkpoint
   std::vector<ResumeRecord> resumes;
+  // `--max-gaussians grow`: the growth's state (host/train/budget_growth.h); null otherwise.
+  nlohmann::json growth;
 };
 
 // JSON forms (metrics.json and the checkpoint's run record use the same).
@@ -144,6 +146,7 @@ inline nlohmann::json to_json(const RunRecord& r) {
                       {"resumes", nlohmann::json::array()}};
   for (const auto& e : r.evaluations) j["evaluations"].push_back(to_json(e));
   for (const auto& e : r.resumes) j["resumes"].push_back(to_json(e));
+  if (!r.growth.is_null()) j["growth"] = r.growth;
   return j;
 }
 // Throws nlohmann::json::exception on a missing key or a wrong type.
@@ -154,6 +157,7 @@ inline RunRecord run_record_from_json(const nlohmann::json& j) {
   r.counters = counters_from_json(j.at("counters"));
   for (const auto& e : j.at("evaluations")) r.evaluations.push_back(eval_from_json(e));
   for (const auto& e : j.at("resumes")) r.resumes.push_back(resume_from_json(e));
+  if (j.contains("growth")) r.growth = j.at("growth");
   return r;
 }
 

@@ -10,6 +10,25 @@
 
 namespace litgs::host {
 
+// `--max-gaussians grow` (MCMC): the budget grown inside one training while validation says it pays
+// (host/train/budget_growth.h). Phases of `phase_refinements` refinements; at each phase's end, once the
+// model fills its budget, the validation views (every `validation_every`-th training view, held back from
+// training while the budget grows) are scored, and the budget is multiplied by `factor` while the paired
+// per-view PSNR gain over the last measurement is above `min_gain_db` and `noise_multiple` standard errors,
+// and at least `min_transfer` times the gain of as many training views over the same phase (a larger model
+// that gains on the views it trains on but not on the others is fitting them, not the scene).
+struct BudgetGrowthOptions {
+  bool enabled = false;
+  uint32_t start = 5000;  // the first budget (raised to the initialization's size where larger)
+  double factor = 2.0;
+  uint32_t phase_refinements = 3;
+  uint32_t validation_every = 8;
+  double min_gain_db = 0.05;
+  double noise_multiple = 2.0;
+  double min_transfer = 0.5;
+  void check() const;  // throws std::invalid_argument naming the bad field
+};
+
 struct TrainOptions {
   uint32_t iterations = 7000;
   double lambda_geo = 0.6;   // L = (1 - lambda_geo) L_pho + lambda_geo L_geo (0: photometric only)
@@ -38,6 +57,7 @@ struct TrainOptions {
   // such distances (at least 10 cm) are pruned at each refinement; 0 turns it off.
   double plane_prune_k = 5.0;
   uint32_t max_gaussians = 2000000;  // cap of the model size (the budget of the MCMC strategy)
+  BudgetGrowthOptions growth;        // enabled: max_gaussians is the ceiling the growth may reach
   // Densification strategy: "adc" (3DGS adaptive density control: clone, split, prune, opacity resets) or
   // "mcmc" (3DGS-MCMC: a fixed budget, relocation of dead Gaussians, position noise, regularizers; the same
   // window and cadence).

@@ -1,14 +1,17 @@
 #include "host/train/trainer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
 #include "engine/buffer.h"
+#include "host/train/budget_growth.h"
 #include "host/train/checkpoint.h"
 #include "host/train/density_control.h"
 #include "host/train/evaluation.h"
@@ -47,9 +50,12 @@ std::unique_ptr<kernels::TrainableGaussians> trainable_model(engine::Context& ct
                                                        o.strategy == "adc");
 }
 
+// `before_restore` sees the checkpoint's run record before the sampler's state is restored (the growth's
+// state decides which views the sampler visits).
 RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, const TrainOptions& o,
                    const fs::path& out_dir, const nlohmann::json& options, ViewSampler& sampler,
-                   const std::function<void(const std::string&)>& notice) {
+                   const std::function<void(const std::string&)>& notice,
+                   const std::function<void(const RunRecord&)>& before_restore) {
   RunStart s;
   if (!o.resume) {
     s.model = trainable_model(ctx, kernels::TrainingState::fresh(initial), o);
@@ -74,6 +80,7 @@ RunStart start_run(engine::Context& ctx, const kernels::GaussianModel& initial, 
     throw std::invalid_argument(ckpt.string() + ": the checkpoint is at iteration " +
                                 std::to_string(c.iteration) + ", beyond --iterations " +
                                 std::to_string(o.iterations));
+  before_restore(c.record);
   try {
     sampler.restore(c);
   } catch (const std::invalid_argument& e) {
@@ -154,7 +161,15 @@ TrainReport make_report(const RunRecord& record, const kernels::TrainableGaussia
   report.nonfinite_pruned = record.counters.pruned_nonfinite;
   report.plane_pruned = record.counters.pruned_plane;
   report.resumes = record.resumes;
+  report.growth = record.growth;
   return report;
+}
+
+// The most Gaussians the device's buffers can hold: its storage-buffer range over the widest per-Gaussian
+// array (the SH coefficients), as the model's own growth caps itself (kernels/optim/trainable_gaussians.cc).
+uint64_t device_row_limit(engine::Context& ctx, const kernels::GaussianModel& initial) {
+  const uint64_t widest = std::max<uint64_t>(4, uint64_t{initial.sh_coeffs()} * initial.channels);
+  return ctx.info().max_storage_buffer_range / (4 * widest);
 }
 
 }  // namespace
@@ -177,6 +192,10 @@ void TrainOptions::check() const {
   if (!(lr_scale > 0) || !std::isfinite(lr_scale)) bad("lr_scale must be positive");
   if (strategy != "adc" && strategy != "mcmc") bad("strategy must be adc or mcmc, not '" + strategy + "'");
   if (strategy == "mcmc") mcmc_options().check();
+  if (growth.enabled) {
+    if (strategy != "mcmc") bad("growth needs the mcmc strategy (ADC has no budget to grow)");
+    growth.check();
+  }
   parse_level_model(level_model);
   for (const auto& [name, value] : {std::pair{"level_lr_log_gain", level_lr_log_gain},
                                     {"level_lr_offset", level_lr_offset},
@@ -219,14 +238,48 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   kernels::Rasterizer rasterizer(ctx, 1, ropt);
   TrainingStep training_step(ctx, data, planes, o, rasterizer);
   Evaluator evaluator(data, o, gt_planes, rasterizer);
-  ViewSampler sampler(train_views, o.seed);
-  RunStart run = start_run(ctx, initial, o, out_dir, run_options_json(o, data), sampler, notice);
+  // A growing budget holds its validation views back from training while it grows.
+  std::optional<BudgetGrowth> growth;
+  std::vector<uint32_t> growth_pool = train_views;
+  std::unique_ptr<TrainingData> validation_data, probe_data;
+  std::unique_ptr<Evaluator> validator, probe;  // the validation views, and as many training views
+  if (o.growth.enabled) {
+    const std::vector<uint32_t> validation = growth_validation_views(train_views, o.growth.validation_every);
+    growth.emplace(o.growth, static_cast<uint32_t>(initial.size()),
+                   std::min<uint64_t>(o.max_gaussians, device_row_limit(ctx, initial)), validation.size());
+    if (growth->growing()) {
+      std::erase_if(growth_pool,
+                    [&](uint32_t v) { return std::count(validation.begin(), validation.end(), v); });
+      const auto scored = [&](const std::vector<uint32_t>& views) {
+        auto d = std::make_unique<TrainingData>(data);
+        for (uint32_t v = 0; v < d->views.size(); ++v)
+          d->views[v].heldout = std::count(views.begin(), views.end(), v) > 0;
+        return d;
+      };
+      validation_data = scored(validation);
+      probe_data = scored(growth_training_probe_views(train_views, o.growth.validation_every));
+      validator = std::make_unique<Evaluator>(*validation_data, o, nullptr, rasterizer);
+      probe = std::make_unique<Evaluator>(*probe_data, o, nullptr, rasterizer);
+    }
+  }
+  ViewSampler sampler(growth_pool, o.seed);
+  RunStart run = start_run(ctx, initial, o, out_dir, run_options_json(o, data), sampler, notice,
+                           [&](const RunRecord& checkpointed) {
+                             if (!growth || checkpointed.growth.is_null()) return;
+                             growth = BudgetGrowth::from_json(o.growth, checkpointed.growth);
+                             if (!growth->growing()) sampler.set_pool(train_views);
+                           });
   kernels::TrainableGaussians& model = *run.model;
   RunRecord& record = run.record;
   const uint32_t start = run.iteration;
   std::unique_ptr<kernels::McmcStrategy> mcmc;
   if (o.strategy == "mcmc") mcmc = std::make_unique<kernels::McmcStrategy>(ctx);
   DensityControl density_control(ctx, o, planes, static_cast<float>(data.scene_extent_m));
+  if (growth) {
+    density_control.set_budget(growth->budget());
+    record.growth = growth->to_json();
+    if (start == 0 && !growth->growing()) notice("budget growth: " + growth->stop_reason());
+  }
   // The level model: one row per view (held-out rows stay at identity: their level is interpolated).
   const LevelModelKind level_kind = parse_level_model(o.level_model);
   const LevelPlan level_plan(data);
@@ -268,6 +321,21 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     training_step.run(model, mcmc.get(), level.get(),
                       level ? level_plan.step(view, it, o) : kernels::LevelStep{}, it, view, kernel_ms,
                       record.counters);
+    if (growth && growth->growing() && growth->phase_ends_at(step, o)) {
+      // Judged before this step's refinement, which then grows towards the new budget.
+      const auto scores = [&](Evaluator& e) {
+        std::vector<double> psnr;
+        for (const auto& [name, db] : e.evaluate(model.gaussians(), step).view_psnr_db) psnr.push_back(db);
+        return psnr;
+      };
+      const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      growth->end_phase(step, static_cast<uint32_t>(model.size()), scores(*validator), scores(*probe),
+                        growth->another_phase_fits(step, o), secs);
+      density_control.set_budget(growth->budget());
+      notice("budget growth at iteration " + std::to_string(step) + ": " + growth->phases().back().decision);
+      if (!growth->growing()) sampler.set_pool(train_views);
+      record.growth = growth->to_json();
+    }
     density_control.after_step(model, mcmc.get(), step, record.counters);
     const bool last = step == o.iterations;
     if (last) wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

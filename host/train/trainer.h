@@ -18,6 +18,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <utility>
@@ -50,6 +51,7 @@ struct TrainReport {
   std::vector<std::pair<std::string, double>> kernel_ms_per_iteration;  // GPU timestamps, training steps only
   LevelTable levels;                   // every view's level (identity without a level model): levels.json
   uint64_t level_nonfinite_skips = 0;  // level updates skipped for a non-finite value
+  nlohmann::json growth;               // `--max-gaussians grow`: BudgetGrowth::to_json(); null otherwise
 };
 
 struct TrainProgress {

@@ -19,6 +19,11 @@ namespace litgs::host {
 class ViewSampler {
  public:
   ViewSampler(std::vector<uint32_t> pool, uint32_t seed) : pool_(std::move(pool)), rng_(seed) { reshuffle(); }
+  // Visits `pool` from now on, in a new random order (a growing budget's validation views rejoin training).
+  void set_pool(std::vector<uint32_t> pool) {
+    pool_ = std::move(pool);
+    reshuffle();
+  }
   uint32_t next() {
     if (position_ >= order_.size()) reshuffle();
     return order_[position_++];

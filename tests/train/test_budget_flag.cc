@@ -60,7 +60,7 @@ TEST_F(BudgetFlagTest, ACountIsTakenAndAnythingElseIsRefusedByName) {
   for (const std::string bad : {"12k", "0", "-5", "4294967296", "", "1e6"})
     EXPECT_NE(error_of([&] {
                 resolve_max_gaussians(bad, inputs(), out_);
-              }).find("positive integer, auto or search, not '" + bad + "'"),
+              }).find("positive integer, auto, search or grow, not '" + bad + "'"),
               std::string::npos)
         << bad;
 }

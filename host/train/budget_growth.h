@@ -1,0 +1,79 @@
+// `train --max-gaussians grow` (MCMC): the Gaussian budget grown inside one training, instead of one training
+// per budget tried (`search`, host/train/budget_search.h). The model starts at a small budget; at the end of
+// each phase (BudgetGrowthOptions), once MCMC's growth has filled the budget, the validation views are
+// scored, and the budget rises by `factor` while the validation PSNR, paired view by view with the last
+// measurement, still gains more than min_gain_db and noise_multiple standard errors. Then it stops, the
+// validation views rejoin the training views, and the remaining iterations train at that size. The gain
+// between two phases also holds the phase's training progress at a fixed size, so the rule leans towards
+// growing; the margin is there for that. The state is a small JSON document that checkpoints carry, so a
+// training interrupted during growth resumes with the same budget, views and decisions.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "host/train/train_options.h"
+
+namespace litgs::host {
+
+struct GrowthPhase {
+  uint32_t iteration = 0;                  // the step at whose end the phase was judged
+  uint32_t budget = 0;                     // the budget trained in the phase
+  uint32_t gaussians = 0;                  // the model's size then
+  double validation_psnr_db = NAN;         // mean over the validation views; NaN: not scored (not full yet)
+  double gain_db = NAN, gain_se_db = NAN;  // against the last scored phase, paired by view
+  double training_psnr_db = NAN, training_gain_db = NAN;  // the training views scored beside them
+  double wall_s = 0;                                      // since this call of train started
+  std::string decision;                                   // grow, wait, or stop, and why
+};
+
+class BudgetGrowth {
+ public:
+  // `ceiling`: the largest budget allowed (the user's --max-gaussians cap, or what the device can hold).
+  // `validation_views`: how many views validate; fewer than two cannot measure the noise, and growth stops
+  // at once (said in stop_reason()).
+  BudgetGrowth(const BudgetGrowthOptions& options, uint32_t initial_gaussians, uint32_t ceiling,
+               size_t validation_views);
+
+  uint32_t budget() const { return budget_; }
+  bool growing() const { return stop_reason_.empty(); }
+  const std::string& stop_reason() const { return stop_reason_; }
+  const std::vector<GrowthPhase>& phases() const { return phases_; }
+
+  // Whether `step` (1-based, before its refinement) ends a phase: every phase_refinements-th refinement step
+  // of `train` (the densification window and cadence). `another_phase_fits`: whether a phase after it
+  // would still end inside the window.
+  bool phase_ends_at(uint32_t step, const TrainOptions& train) const;
+  bool another_phase_fits(uint32_t step, const TrainOptions& train) const;
+
+  // The decision at a phase's end: the validation views' and the training views' PSNR, each in the same
+  // view order every time.
+  void end_phase(uint32_t step, uint32_t gaussians, const std::vector<double>& validation_psnr_db,
+                 const std::vector<double>& training_psnr_db, bool another_phase_fits, double wall_s);
+  // Stops growing for a reason found outside the rule (the device's limits).
+  void stop(const std::string& reason);
+
+  // The checkpoint's and metrics.json's form; from_json throws nlohmann::json::exception on a bad document.
+  nlohmann::json to_json() const;
+  static BudgetGrowth from_json(const BudgetGrowthOptions& options, const nlohmann::json& j);
+
+ private:
+  BudgetGrowthOptions options_;
+  uint32_t budget_ = 0, ceiling_ = 0;
+  std::string stop_reason_;
+  std::vector<GrowthPhase> phases_;
+  std::vector<double> last_scored_, last_training_;  // the last scored phase's per-view PSNR
+};
+
+// The validation views of a growing training: every validation_every-th of `train_views`, from the middle
+// of the first stride (as the budget search's first fold); the training views scored beside them: as many,
+// each the training view after one.
+std::vector<uint32_t> growth_validation_views(const std::vector<uint32_t>& train_views,
+                                              uint32_t validation_every);
+std::vector<uint32_t> growth_training_probe_views(const std::vector<uint32_t>& train_views,
+                                                  uint32_t validation_every);
+
+}  // namespace litgs::host

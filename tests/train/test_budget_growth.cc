@@ -1,0 +1,132 @@
+// The rule of `--max-gaussians grow` (host/train/budget_growth.h) on made-up scores: when it grows, waits and
+// stops, and the named hard cases: validation noise larger than the gain, a larger model that fits only the
+// views it trains on, a budget above what the device holds, a scene whose validation set is one view, an
+// initialization that already fills the ceiling; and a resume from its JSON state deciding as the
+// uninterrupted run.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "host/train/budget_growth.h"
+
+namespace litgs::host {
+namespace {
+
+std::vector<double> shifted(const std::vector<double>& v, double by) {
+  std::vector<double> out = v;
+  for (double& x : out) x += by;
+  return out;
+}
+
+const std::vector<double> kViews = {30.0, 31.2, 29.5, 32.4, 30.8};
+const std::vector<double> kNoise = {-0.9, 1.1, -0.7, 0.8, 0.0};  // mean 0.06, spread ~0.9 dB
+
+TEST(BudgetGrowth, PhasesEndEveryFewRefinementsInsideTheWindow) {
+  TrainOptions t;
+  t.iterations = 2000;
+  t.densify_from = 500;
+  t.densify_every = 100;
+  BudgetGrowthOptions o;
+  o.phase_refinements = 3;
+  const BudgetGrowth g(o, 1000, 100000, 4);
+  std::vector<uint32_t> ends;
+  for (uint32_t step = 1; step <= t.iterations; ++step)
+    if (g.phase_ends_at(step, t)) ends.push_back(step);
+  EXPECT_EQ(ends, (std::vector<uint32_t>{600, 900, 1200, 1500, 1800}));
+  EXPECT_TRUE(g.another_phase_fits(1500, t));
+  EXPECT_FALSE(g.another_phase_fits(1800, t));  // 2100 is past the window's end at 2000
+}
+
+TEST(BudgetGrowth, GrowsWhileValidationGainsAndStopsWhenItNoLongerDoes) {
+  BudgetGrowthOptions o;
+  BudgetGrowth g(o, 20000, 4000000, kViews.size());
+  EXPECT_EQ(g.budget(), 20000u);  // the initialization's size, above the start of 5000
+  g.end_phase(600, 20000, kViews, shifted(kViews, 2), true, 1);
+  EXPECT_EQ(g.budget(), 40000u);  // the first score is a baseline
+  g.end_phase(900, 40000, shifted(kViews, 0.8), shifted(kViews, 2.8), true, 2);
+  EXPECT_EQ(g.budget(), 80000u);
+  EXPECT_TRUE(g.growing());
+  g.end_phase(1200, 80000, shifted(kViews, 0.82), shifted(kViews, 2.85), true, 3);  // +0.02 dB: no gain
+  EXPECT_FALSE(g.growing());
+  EXPECT_EQ(g.budget(), 80000u);
+  EXPECT_NE(g.stop_reason().find("validation gained 0.020 dB"), std::string::npos) << g.stop_reason();
+  g.end_phase(1500, 80000, shifted(kViews, 5), shifted(kViews, 5), true, 4);  // ignored once stopped
+  EXPECT_EQ(g.phases().size(), 3u);
+}
+
+TEST(BudgetGrowth, ValidationNoiseLargerThanTheGainStopsIt) {
+  BudgetGrowthOptions o;
+  BudgetGrowth g(o, 10000, 4000000, kViews.size());
+  g.end_phase(600, 10000, kViews, kViews, true, 1);
+  std::vector<double> noisy = kViews;
+  for (size_t i = 0; i < noisy.size(); ++i) noisy[i] += 0.3 + kNoise[i];  // mean +0.36, standard error ~0.39
+  g.end_phase(900, 20000, noisy, shifted(kViews, 0.3), true, 2);
+  EXPECT_FALSE(g.growing());
+  EXPECT_EQ(g.budget(), 20000u);
+  EXPECT_GT(g.phases().back().gain_db, o.min_gain_db);  // it did gain on average, within its noise
+}
+
+TEST(BudgetGrowth, ALargerModelThatFitsOnlyTheViewsItTrainsOnStops) {
+  BudgetGrowthOptions o;
+  BudgetGrowth g(o, 10000, 4000000, kViews.size());
+  g.end_phase(600, 10000, kViews, kViews, true, 1);
+  g.end_phase(900, 20000, shifted(kViews, 0.3), shifted(kViews, 1.0), true, 2);  // 0.3 < 0.5 x 1.0
+  EXPECT_FALSE(g.growing());
+  EXPECT_NE(g.stop_reason().find("fits the views it trains on"), std::string::npos) << g.stop_reason();
+}
+
+TEST(BudgetGrowth, WaitsUntilTheModelFillsItsBudgetButNotPastTheWindow) {
+  BudgetGrowthOptions o;
+  BudgetGrowth g(o, 10000, 4000000, kViews.size());
+  g.end_phase(600, 10000, kViews, kViews, true, 1);
+  g.end_phase(900, 15000, shifted(kViews, 2), shifted(kViews, 2), true, 2);  // 15k of 20k: not judged
+  EXPECT_TRUE(g.growing());
+  EXPECT_EQ(g.budget(), 20000u);
+  EXPECT_TRUE(std::isnan(g.phases().back().validation_psnr_db));
+  g.end_phase(1200, 18000, shifted(kViews, 2), shifted(kViews, 2), false, 3);
+  EXPECT_FALSE(g.growing());
+  EXPECT_NE(g.stop_reason().find("window ends"), std::string::npos);
+}
+
+TEST(BudgetGrowth, ABudgetAboveWhatTheDeviceHoldsIsNeverSet) {
+  BudgetGrowthOptions o;
+  BudgetGrowth g(o, 300000, 699050, kViews.size());  // lavapipe's 128 MiB over 48 floats per Gaussian
+  g.end_phase(600, 300000, kViews, kViews, true, 1);
+  EXPECT_EQ(g.budget(), 600000u);
+  g.end_phase(900, 600000, shifted(kViews, 1), shifted(kViews, 1), true, 2);
+  EXPECT_FALSE(g.growing());
+  EXPECT_EQ(g.budget(), 600000u);
+  EXPECT_NE(g.stop_reason().find("above the ceiling of 699050"), std::string::npos) << g.stop_reason();
+}
+
+TEST(BudgetGrowth, OneValidationViewCannotJudgeAndTheBudgetStaysAtItsStart) {
+  BudgetGrowthOptions o;
+  const BudgetGrowth g(o, 3000, 4000000, 1);  // an 8-frame scene: 7 training views, 1 validates
+  EXPECT_FALSE(g.growing());
+  EXPECT_EQ(g.budget(), 5000u);
+  EXPECT_NE(g.stop_reason().find("cannot measure the noise"), std::string::npos);
+}
+
+TEST(BudgetGrowth, AnInitializationThatFillsTheCeilingDoesNotGrow) {
+  BudgetGrowthOptions o;
+  const BudgetGrowth g(o, 5000000, 4000000, kViews.size());
+  EXPECT_FALSE(g.growing());
+  EXPECT_EQ(g.budget(), 4000000u);
+}
+
+TEST(BudgetGrowth, ResumedFromItsJsonItDecidesAsTheUninterruptedRun) {
+  BudgetGrowthOptions o;
+  BudgetGrowth whole(o, 10000, 4000000, kViews.size());
+  whole.end_phase(600, 10000, kViews, kViews, true, 1);
+  BudgetGrowth resumed = BudgetGrowth::from_json(o, nlohmann::json::parse(whole.to_json().dump()));
+  for (BudgetGrowth* g : {&whole, &resumed}) {
+    g->end_phase(900, 20000, shifted(kViews, 0.4), shifted(kViews, 0.5), true, 2);
+    g->end_phase(1200, 40000, shifted(kViews, 0.45), shifted(kViews, 0.9), true, 3);
+  }
+  EXPECT_EQ(resumed.to_json().dump(), whole.to_json().dump());  // as text: NaN never equals itself
+  EXPECT_FALSE(whole.growing());
+  EXPECT_EQ(whole.budget(), 40000u);
+}
+
+}  // namespace
+}  // namespace litgs::host
