@@ -51,7 +51,7 @@ void add_sfm_points(const SfmData& sfm, const Scene& scene, const fs::path& sfm_
           {Eigen::Vector2d(k.x + 0.5, k.y + 0.5), -1});
   }
   const size_t step = std::max<size_t>(1, (sfm.points.size() + max_points - 1) / max_points);
-  if (step > 1) report.notes.push_back("kept every " + std::to_string(step) + "th point");
+  if (step > 1) report.notes.push_back("kept one point in " + std::to_string(step));
   for (size_t i = 0; i < sfm.points.size(); i += step) {
     ColmapPoint3D p;
     p.id = model.points.size() + 1;
@@ -138,10 +138,14 @@ ColmapExportReport export_colmap(const ColmapExportOptions& o) {
       report.notes.push_back("points3D from anchors.txt");
     } else if (scene.map) {
       points = scene.map->positions;
-      report.notes.push_back("points3D from the LiDAR map");
+      report.notes.push_back("points3D from the LiDAR map (" + std::to_string(points.size()) + " points)");
+    } else {
+      report.notes.push_back(
+          "no points3D: the scene has no sfm/ (litgs-engine match), anchors.txt or LiDAR map (litgs-engine "
+          "map builds one from the scans)");
     }
     const size_t step = (points.size() + o.max_points - 1) / o.max_points;
-    if (step > 1) report.notes.push_back("kept every " + std::to_string(step) + "th point");
+    if (step > 1) report.notes.push_back("kept one point in " + std::to_string(step));
     for (size_t i = 0; i < points.size(); i += std::max<size_t>(step, 1)) {
       ColmapPoint3D p;
       p.id = model.points.size() + 1;

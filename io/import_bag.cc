@@ -112,7 +112,13 @@ BagImportReport import_bag(const BagImportOptions& o) {
     };
   h.imu = [&](const ImuSample& s) { scene.imu.push_back(s); };
   h.odom = [&](const TumPose& p) { odom.push_back(p); };
-  report.messages = read_ros_bag(o.bag, o.topics, h);
+  report.messages = read_ros_bag(o.bag, o.topics, h, {.reindex = o.reindex});
+  if (const RosBagRecovery& r = report.messages.recovery; r.used)
+    report.notes.push_back("reindexed: " + std::to_string(r.chunks) + " complete chunks read in file order" +
+                           (r.unread_bytes
+                                ? "; the last " + std::to_string(r.unread_bytes) +
+                                      " bytes were not (an unfinished chunk or index): " + r.stopped_at
+                                : "; nothing left unread"));
   if (frames.empty()) fail(o.bag, 0, "no message on the thermal topic '" + o.topics.thermal + "'");
   k.bit_depth = bit_depth;
 

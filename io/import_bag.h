@@ -25,8 +25,11 @@ struct BagImportOptions {
   // poses_frame says which frame both describe.
   std::filesystem::path poses;
   PoseFrame poses_frame = PoseFrame::kImu;
-  std::filesystem::path ground_truth;    // optional TUM file -> gt/poses.txt (0 0 0 0 rotations allowed)
-  bool scans = true;                     // write every LiDAR message as lidar/scans/<t>.pcd
+  std::filesystem::path ground_truth;  // optional TUM file -> gt/poses.txt (0 0 0 0 rotations allowed)
+  bool scans = true;                   // write every LiDAR message as lidar/scans/<t>.pcd
+  // Read the bag without its index (a recording cut short: RosBagReadOptions::reindex); the notes say how
+  // many chunks were read and how many bytes at the end were not.
+  bool reindex = false;
   std::string image_extension = ".png";  // of the written frames: ".png" or ".tiff"
 
   // Throws std::invalid_argument naming the bad field.

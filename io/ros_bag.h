@@ -41,12 +41,28 @@ struct RosBagHandlers {
   std::function<void(const TumPose& pose)> odom;  // pose.pose of the message: T_world_child
 };
 
-struct RosBagCounts {
-  size_t thermal = 0, lidar = 0, imu = 0, odom = 0;
+// What reading without the index (RosBagReadOptions::reindex) found.
+struct RosBagRecovery {
+  bool used = false;
+  size_t chunks = 0;          // complete chunks read
+  uint64_t unread_bytes = 0;  // from the first record that did not fit or parse to the end of the file
+  std::string stopped_at;     // why reading stopped there (empty: it reached the end)
 };
 
-// Reads the topics of `topics` (empty names are skipped) through the bag's index, in time order (ties in
-// file order), like rosbag::View. Chunks may be uncompressed, bz2 or lz4. IoError naming the bag (and the
+struct RosBagCounts {
+  size_t thermal = 0, lidar = 0, imu = 0, odom = 0;
+  RosBagRecovery recovery;
+};
+
+struct RosBagReadOptions {
+  // Ignore the index and read the records in file order (a recording cut short has no index, or one that
+  // points past its end), keeping the messages of every complete chunk, as `rosbag reindex` does.
+  bool reindex = false;
+};
+
+// Reads the topics of `topics` (empty names are skipped) through the bag's index (or, with
+// options.reindex, by reading its records in order: RosBagRecovery), in time order (ties in file order),
+// like rosbag::View. Chunks may be uncompressed, bz2 or lz4. IoError naming the bag (and the
 // byte, or the message's index, topic and time) on a missing, unindexed (unfinished recording), corrupt or
 // truncated bag, a bag format other than 2.0, a topic whose type (or definition MD5) is not the expected
 // one, or a message that cannot be converted (its bytes do not match its type's layout, unknown image
@@ -54,7 +70,7 @@ struct RosBagCounts {
 // big-endian, a non-finite IMU value or odometry position, a non-unit orientation). Topics absent from the
 // bag give no messages (check the counts).
 RosBagCounts read_ros_bag(const std::filesystem::path& bag, const RosBagTopics& topics,
-                          const RosBagHandlers& handlers);
+                          const RosBagHandlers& handlers, const RosBagReadOptions& options = {});
 
 enum class RosBagCompression { kNone, kBz2, kLz4 };
 

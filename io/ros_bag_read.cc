@@ -622,45 +622,27 @@ class BagReader {
   // index-data records; keeps the entries whose connection `wanted` accepts.
   template <class Wanted>
   void index(Wanted&& wanted) {
-    char magic[kMagic.size()] = {};
-    if (file_.size() < kMagic.size()) file_.fail(0, "not a ROS bag (shorter than its version line)");
-    file_.read(0, magic, kMagic.size());
-    if (std::string_view(magic, kMagic.size()) != kMagic) {
-      if (std::string_view(magic, 8) == "#ROSBAG ")
-        file_.fail(0, "bag format '" + std::string(magic + 8, kMagic.size() - 9) +
-                          "' is not supported (only V2.0; `rosbag fix` converts older bags)");
-      file_.fail(0, "not a ROS bag (no '#ROSBAG V2.0' line)");
-    }
-    const Record header = read_record(file_, kMagic.size(), file_.size());
-    expect_op(file_, header, kOpBagHeader, "bag header");
+    const Record header = read_header();
     const uint64_t index_pos = field_int<uint64_t>(file_, header, "index_pos");
     const uint32_t conn_count = field_int<uint32_t>(file_, header, "conn_count");
     const uint32_t chunk_count = field_int<uint32_t>(file_, header, "chunk_count");
     if (index_pos == 0)
-      file_.fail(header.pos,
-                 "bag is not indexed (the recording did not finish; `rosbag reindex` repairs it)");
+      file_.fail(
+          header.pos,
+          "bag is not indexed (the recording did not finish; `import bag --reindex` reads its complete "
+          "chunks, as `rosbag reindex` would)");
     if (index_pos < header.end() || index_pos > file_.size())
       file_.fail(header.pos, "index position " + std::to_string(index_pos) +
                                  " lies outside the chunks' end (" + std::to_string(header.end()) + ".." +
-                                 std::to_string(file_.size()) + ")");
+                                 std::to_string(file_.size()) +
+                                 "; a bag cut short: `import bag --reindex` reads its complete chunks)");
 
     // Connection records, then chunk-info records (each read consumes >= 8 bytes: forged counts end at EOF).
     uint64_t pos = index_pos;
     for (uint32_t i = 0; i < conn_count; ++i) {
       const Record r = read_record(file_, pos, file_.size());
       expect_op(file_, r, kOpConnection, "connection");
-      const uint32_t id = field_int<uint32_t>(file_, r, "conn");
-      Connection c;
-      c.topic = field(file_, r, "topic");
-      // The data is a second field list: topic, type, md5sum, message_definition, ...
-      std::string data(r.data_len, '\0');
-      file_.read_within(r.data_pos, r.end(), data.data(), data.size(), "connection data");
-      Record d;
-      d.pos = r.pos;
-      d.op = kOpConnection;
-      d.fields = parse_fields(file_, r.pos, data);
-      c.type = field(file_, d, "type");
-      c.md5 = field(file_, d, "md5sum");
+      auto [id, c] = parse_connection(file_, r);
       if (!connections_.emplace(id, std::move(c)).second)
         file_.fail(r.pos, "connection " + std::to_string(id) + " is defined twice");
       pos = r.end();
@@ -733,6 +715,44 @@ class BagReader {
     });
   }
 
+  // Without the index (`reindex`, for a recording cut short, as `rosbag reindex` does): the records are read
+  // in file order from the bag header on, connections from their records (inside chunks and after them),
+  // messages from each complete chunk's message-data records. Reading stops at the first record that does
+  // not fit in the file or does not parse (the chunk being written when the recorder stopped); what was
+  // left unread is reported. Each chunk is checked as index() checks it.
+  template <class Wanted>
+  RosBagRecovery scan(Wanted&& wanted) {
+    const Record header = read_header();
+    RosBagRecovery report;
+    report.used = true;
+    std::vector<Entry> found;
+    uint64_t pos = header.end();
+    while (pos < file_.size()) {
+      try {
+        const Record r = read_record(file_, pos, file_.size());
+        if (r.op == kOpConnection) {
+          add_scanned_connection(file_, r);
+        } else if (r.op == kOpChunk) {
+          scan_chunk(r, found);
+          ++report.chunks;
+        }
+        pos = r.end();
+      } catch (const IoError& error) {
+        report.unread_bytes = file_.size() - pos;
+        report.stopped_at = error.what();
+        break;
+      }
+    }
+    for (const Entry& e : found) {
+      const auto it = connections_.find(e.conn);
+      if (it != connections_.end() && wanted(it->second)) entries_.push_back(e);
+    }
+    std::sort(entries_.begin(), entries_.end(), [](const Entry& a, const Entry& b) {
+      return std::tie(a.time, a.chunk, a.offset) < std::tie(b.time, b.chunk, b.offset);
+    });
+    return report;
+  }
+
   const std::vector<Entry>& entries() const { return entries_; }
   const Connection& connection(uint32_t id) const { return connections_.at(id); }
 
@@ -764,6 +784,89 @@ class BagReader {
   const fs::path& path() const { return file_.path(); }
 
  private:
+  // The version line and the bag header record.
+  Record read_header() {
+    char magic[kMagic.size()] = {};
+    if (file_.size() < kMagic.size()) file_.fail(0, "not a ROS bag (shorter than its version line)");
+    file_.read(0, magic, kMagic.size());
+    if (std::string_view(magic, kMagic.size()) != kMagic) {
+      if (std::string_view(magic, 8) == "#ROSBAG ")
+        file_.fail(0, "bag format '" + std::string(magic + 8, kMagic.size() - 9) +
+                          "' is not supported (only V2.0; `rosbag fix` converts older bags)");
+      file_.fail(0, "not a ROS bag (no '#ROSBAG V2.0' line)");
+    }
+    const Record header = read_record(file_, kMagic.size(), file_.size());
+    expect_op(file_, header, kOpBagHeader, "bag header");
+    return header;
+  }
+
+  // A connection record's id, topic, type and definition MD5.
+  static std::pair<uint32_t, Connection> parse_connection(Bytes& src, const Record& r) {
+    const uint32_t id = field_int<uint32_t>(src, r, "conn");
+    Connection c;
+    c.topic = field(src, r, "topic");
+    // The data is a second field list: topic, type, md5sum, message_definition, ...
+    std::string data(r.data_len, '\0');
+    src.read_within(r.data_pos, r.end(), data.data(), data.size(), "connection data");
+    Record d;
+    d.pos = r.pos;
+    d.op = kOpConnection;
+    d.fields = parse_fields(src, r.pos, data);
+    c.type = field(src, d, "type");
+    c.md5 = field(src, d, "md5sum");
+    return {id, std::move(c)};
+  }
+
+  // A bag repeats each connection record (in the chunk that first uses it, and after the chunks): the same
+  // id with another topic, type or definition is an error.
+  void add_scanned_connection(Bytes& src, const Record& r) {
+    auto [id, c] = parse_connection(src, r);
+    const auto [it, added] = connections_.emplace(id, c);
+    if (!added && (it->second.topic != c.topic || it->second.type != c.type || it->second.md5 != c.md5))
+      src.fail(r.pos, "connection " + std::to_string(id) + " is defined twice, differently");
+  }
+
+  // The chunk record `r` (complete in the file): its connections and message-data records.
+  void scan_chunk(const Record& r, std::vector<Entry>& found) {
+    Chunk c;
+    c.pos = r.pos;
+    c.compression = field(file_, r, "compression");
+    c.size = field_int<uint32_t>(file_, r, "size");
+    c.data_pos = r.data_pos;
+    c.data_len = r.data_len;
+    if (c.compression == "none" && c.size != c.data_len)
+      file_.fail(c.pos, "uncompressed chunk of " + std::to_string(c.data_len) + " bytes says its size is " +
+                            std::to_string(c.size));
+    if (c.size > kMaxChunkBytes) file_.fail(c.pos, "chunk of " + std::to_string(c.size) + " bytes (corrupt)");
+    InFileChunk in_file(file_, c.pos);
+    std::optional<ChunkBytes> unpacked;
+    Bytes* src = &in_file;
+    uint64_t begin = c.data_pos, end = c.data_pos + c.data_len;
+    if (c.compression != "none") {
+      unpacked.emplace(file_.path(), c.pos, decompress(file_, c));
+      src = &*unpacked;
+      begin = 0;
+      end = unpacked->size();
+    }
+    const auto chunk = static_cast<uint32_t>(chunks_.size());
+    for (uint64_t at = begin; at < end;) {
+      const Record m = read_record(*src, at, end);
+      if (m.op == kOpConnection) {
+        add_scanned_connection(*src, m);
+      } else if (m.op == kOpMessageData) {
+        const std::string& time = field(*src, m, "time");
+        if (time.size() != 8) src->fail(m.pos, "message time of " + std::to_string(time.size()) + " bytes");
+        const auto* t = reinterpret_cast<const uint8_t*>(time.data());
+        found.push_back({{le32(t), le32(t + 4)},
+                         chunk,
+                         static_cast<uint32_t>(m.pos - begin),
+                         field_int<uint32_t>(*src, m, "conn")});
+      }
+      at = m.end();
+    }
+    chunks_.push_back(c);
+  }
+
   FileBytes file_;
   std::map<uint32_t, Connection> connections_;
   std::vector<Chunk> chunks_;
@@ -774,7 +877,8 @@ class BagReader {
 
 }  // namespace
 
-RosBagCounts read_ros_bag(const fs::path& path, const RosBagTopics& topics, const RosBagHandlers& h) {
+RosBagCounts read_ros_bag(const fs::path& path, const RosBagTopics& topics, const RosBagHandlers& h,
+                          const RosBagReadOptions& options) {
   if (!fs::exists(path)) fail(path, 0, "bag does not exist");
   enum Kind { kThermal, kLidar, kImuKind, kOdom, kNone };
   // The first of the topics a connection's topic equals (the order the handlers are listed in).
@@ -785,9 +889,13 @@ RosBagCounts read_ros_bag(const fs::path& path, const RosBagTopics& topics, cons
     return kNone;
   };
   BagReader bag(path);
-  bag.index([&](const Connection& c) { return kind_of(c.topic) != kNone; });
-
+  const auto wanted = [&](const Connection& c) { return kind_of(c.topic) != kNone; };
   RosBagCounts counts;
+  if (options.reindex)
+    counts.recovery = bag.scan(wanted);
+  else
+    bag.index(wanted);
+
   size_t index = 0;
   for (const Entry& e : bag.entries()) {
     ++index;

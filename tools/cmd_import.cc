@@ -102,6 +102,9 @@ void add_import_bag(CLI::App* import) {
       ->capture_default_str();
   c->add_option("--gt", o->ground_truth, "TUM ground truth for gt/poses.txt")->check(CLI::ExistingFile);
   c->add_flag("!--no-scans", o->scans, "Do not write the LiDAR scans");
+  c->add_flag("--reindex", o->reindex,
+              "Read a bag cut short (no index, or one past its end) without its index, keeping every "
+              "complete chunk, as rosbag reindex does; the notes say what was lost");
   c->add_option("--image-format", o->image_extension, "Extension of the written frames: .png or .tiff")
       ->capture_default_str();
   auto map = std::make_shared<bool>(true);

@@ -2,7 +2,8 @@
 // message types it decodes: sensor_msgs/Image, PointCloud2, Imu and nav_msgs/Odometry). The topics are the
 // ones litgs_fuzz_seeds writes; every decoded message is checked for consistency (Image::check,
 // PointCloud::check, finite IMU and pose values), so a decoder that returns a malformed object is a finding
-// too (and so is a non-finite IMU value or position, which the reader documents as an error).
+// too (and so is a non-finite IMU value or position, which the reader documents as an error). Each input is
+// read through the index and again without it (reindex, the recovery of a recording cut short).
 #include <cmath>
 #include <cstdlib>
 
@@ -32,5 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!p.p_world.allFinite() || !std::isfinite(p.t_s)) std::abort();
     if (!(std::abs(p.q_world_body.norm() - 1) < 1e-6)) std::abort();  // normalized unit quaternions only
   };
-  return litgs::fuzz::expect_only_io_error([&] { read_ros_bag(path, topics, h); });
+  // Through the index, and without it (`import bag --reindex`: the records in file order).
+  litgs::fuzz::expect_only_io_error([&] { read_ros_bag(path, topics, h); });
+  return litgs::fuzz::expect_only_io_error([&] { read_ros_bag(path, topics, h, {.reindex = true}); });
 }

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 
 #include "io/colmap.h"
 #include "io/export_scene.h"
@@ -67,6 +68,12 @@ TEST_F(ExportSceneTest, ColmapFromImuPosesWithTimeOffsetAndMapPoints) {
   EXPECT_EQ(r.images, 2u);
   EXPECT_EQ(r.skipped_without_pose, 1u);
   EXPECT_EQ(r.points, 4u);
+  const auto said = [&](const std::string& text) {
+    return std::any_of(r.notes.begin(), r.notes.end(),
+                       [&](const std::string& n) { return n.find(text) != std::string::npos; });
+  };
+  EXPECT_TRUE(said("points3D from the LiDAR map (10 points)"));
+  EXPECT_TRUE(said("kept one point in 3"));
   const ColmapModel m = read_colmap_model(o.out / "sparse/0");
   EXPECT_EQ(m.cameras.at(1).model, ColmapCameraModel::kPinhole);
   EXPECT_EQ(m.cameras.at(1).params, (std::vector<double>{10, 10, 2, 1.5}));
@@ -87,6 +94,22 @@ TEST_F(ExportSceneTest, ColmapFromImuPosesWithTimeOffsetAndMapPoints) {
     EXPECT_LT((m.images[static_cast<size_t>(i)].T_world_cam().topRightCorner<3, 1>() - expected).norm(),
               1e-9);
   }
+}
+
+TEST_F(ExportSceneTest, ColmapWithoutAnyPointSourceSaysSo) {
+  Scene s = make_scene();
+  s.map.reset();
+  s.config.has_lidar_map = false;
+  s.anchors.clear();
+  write(s, dir_ / "scene");
+  ColmapExportOptions o;
+  o.scene = dir_ / "scene";
+  o.out = dir_ / "colmap";
+  const ColmapExportReport r = export_colmap(o);
+  EXPECT_EQ(r.points, 0u);
+  EXPECT_TRUE(std::any_of(r.notes.begin(), r.notes.end(), [](const std::string& n) {
+    return n.find("no points3D: the scene has no sfm/") != std::string::npos;
+  }));
 }
 
 TEST_F(ExportSceneTest, TumStoredCameraAndGroundTruth) {
