@@ -30,34 +30,55 @@ void ScanCheckOptions::check() const {
   if (!(tolerance >= 0)) throw std::invalid_argument("refine: scan check tolerance must be >= 0");
 }
 
-ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>& scans,
-                           const ScanCheckOptions& o) {
-  o.check();
-  ScanVerdict v;
-  Cloud cloud;
-  std::vector<size_t> index;  // planar map point -> its index in the map
-  for (size_t i = 0; i < map.points.size(); ++i)
-    if (map.planar[i]) {
-      cloud.pts.push_back(map.points[i].cast<double>());
-      index.push_back(i);
+namespace {
+
+// Distances of world points to the plane of their nearest planar point of one map.
+class PlaneDistances {
+ public:
+  PlaneDistances(const PlanarMap& map, double max_distance_m) : map_(&map), max_(max_distance_m) {
+    for (size_t i = 0; i < map.points.size(); ++i)
+      if (map.planar[i]) {
+        cloud_.pts.push_back(map.points[i].cast<double>());
+        index_.push_back(i);
+      }
+    if (!cloud_.pts.empty()) {
+      tree_ = std::make_unique<Tree>(3, cloud_);
+      tree_->buildIndex();
     }
-  if (cloud.pts.empty() || scans.empty()) {
-    v.summary = "held-out scans: none to compare (no planar map or no scans)";
-    return v;
   }
-  Tree tree(3, cloud);
-  tree.buildIndex();
-  // Distance of a world point to the plane of its nearest planar map point; NaN beyond the bound.
-  auto distance = [&](const Eigen::Vector3d& x) -> double {
+  bool empty() const { return cloud_.pts.empty(); }
+  // NaN beyond the bound.
+  double operator()(const Eigen::Vector3d& x) const {
     size_t nearest = 0;
     double d2 = 0;
     nanoflann::KNNResultSet<double> result(1);
     result.init(&nearest, &d2);
-    tree.findNeighbors(result, x.data(), nanoflann::SearchParams());
-    if (d2 > o.max_distance_m * o.max_distance_m) return NAN;
-    const size_t m = index[nearest];
-    return std::abs(map.normals[m].cast<double>().dot(x - map.centres[m].cast<double>()));
-  };
+    tree_->findNeighbors(result, x.data(), nanoflann::SearchParams());
+    if (d2 > max_ * max_) return NAN;
+    const size_t m = index_[nearest];
+    return std::abs(map_->normals[m].cast<double>().dot(x - map_->centres[m].cast<double>()));
+  }
+
+ private:
+  const PlanarMap* map_;
+  double max_;
+  Cloud cloud_;
+  std::vector<size_t> index_;  // planar map point -> its index in the map
+  std::unique_ptr<Tree> tree_;
+};
+
+}  // namespace
+
+ScanVerdict judge_on_scans(const PlanarMap& prior_map, const PlanarMap& refined_map,
+                           const std::vector<CheckedScan>& scans, const ScanCheckOptions& o) {
+  o.check();
+  ScanVerdict v;
+  const PlaneDistances prior_distance(prior_map, o.max_distance_m),
+      refined_distance(refined_map, o.max_distance_m);
+  if (prior_distance.empty() || refined_distance.empty() || scans.empty()) {
+    v.summary = "held-out scans: none to compare (no planar map or no scans)";
+    return v;
+  }
   double sum_prior = 0, sum_refined = 0;
   for (const CheckedScan& s : scans) {
     if (s.points_lidar.empty()) continue;
@@ -65,8 +86,8 @@ ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>&
     const size_t step = std::max<size_t>(1, s.points_lidar.size() / o.points_per_scan);
     for (size_t k = 0; k < s.points_lidar.size(); k += step) {
       const Eigen::Vector4d x = s.points_lidar[k].homogeneous();
-      const double dp = distance((s.T_world_lidar_prior * x).head<3>());
-      const double dr = distance((s.T_world_lidar_refined * x).head<3>());
+      const double dp = prior_distance((s.T_world_lidar_prior * x).head<3>());
+      const double dr = refined_distance((s.T_world_lidar_refined * x).head<3>());
       if (!std::isfinite(dp) || !std::isfinite(dr) || dp > o.max_distance_m || dr > o.max_distance_m)
         continue;
       sum_prior += dp;

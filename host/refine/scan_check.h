@@ -1,7 +1,8 @@
 // The LiDAR side of the guard against a refinement that makes the poses worse (holdout_guard.h holds the
 // image side): scans the map left out (scene.yaml lidar_holdout_every), taken through the prior and
-// through the refined trajectories, against the local planes of the LiDAR map. Camera poses that the
-// images like but that put the LiDAR's own measurements off the map's surfaces are worse poses.
+// through the refined trajectories, each against the local planes of the map that trajectory builds from
+// the other scans. Camera poses that the images like but that put the LiDAR's own measurements off the
+// surfaces its other scans measured are worse poses.
 #pragma once
 
 #include <Eigen/Core>
@@ -34,11 +35,13 @@ struct ScanVerdict {
   size_t scans = 0, points = 0;                 // points within max_distance_m under both pose sets
   double prior_mean_m = 0, refined_mean_m = 0;  // mean point-to-plane distance
   bool measured = false;                        // at least one point
-  bool keep_refined = true;  // false: the refined poses put the scans farther from the map's planes
+  bool keep_refined = true;  // false: the refined poses put the scans farther from their map's planes
   std::string summary;       // one line for the report
 };
 
-ScanVerdict judge_on_scans(const PlanarMap& map, const std::vector<CheckedScan>& scans,
-                           const ScanCheckOptions& options);
+// Each scan through the priors against `prior_map`, through the refined poses against `refined_map` (the
+// same map twice: both against one map).
+ScanVerdict judge_on_scans(const PlanarMap& prior_map, const PlanarMap& refined_map,
+                           const std::vector<CheckedScan>& scans, const ScanCheckOptions& options);
 
 }  // namespace litgs::host::refine

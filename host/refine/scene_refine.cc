@@ -212,13 +212,33 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
   return j;
 }
 
+// The map of the scans the scene's map holds (all but the held-out ones), built through `trajectory` as
+// `litgs-engine map` builds it, with its local planes.
+PlanarMap map_through(const fs::path& dir, const io::Scene& scene, const LidarPoseAt& trajectory) {
+  std::vector<size_t> kept;
+  std::vector<double> times;
+  for (size_t i = 0; i < scene.scans.size(); ++i)
+    if (!io::is_heldout_scan(i, scene.config.lidar_holdout_every)) {
+      kept.push_back(i);
+      times.push_back(scene.scans[i].t_s);
+    }
+  LidarMapOptions options;
+  options.holdout_every = 0;  // the held-out scans are already left out of `kept`
+  LidarMapReport report;
+  const io::PointCloud map = build_lidar_map(
+      times, [&](size_t j) { return io::read_pcd(dir / scene.scans[kept[j]].file); }, trajectory, options,
+      report);
+  return fit_planes(map.positions, {});
+}
+
 // The scans the map left out (or, in a scene that holds none out, every Nth scan) through the prior and
-// the refined trajectories, each interpolated at the scan's stamp, against the map's planes; refined poses
-// that fit them worse give way to the priors.
+// the refined trajectories, each interpolated at the scan's stamp; refined poses that fit them worse give
+// way to the priors. Where the scene holds scans out, each trajectory is judged against the map it builds
+// itself from the other scans: a map built through one of them (the scene's, through the odometry) would
+// favour it, since a held-out scan placed through the same trajectory shares its local error.
 void guard_with_scans(const fs::path& dir, const io::Scene& scene, const std::vector<CameraPose>& priors,
                       const ScanCheckOptions& o, PlanarMap& planar, RefineReport& refine_report,
                       ScanVerdict& verdict, std::vector<CameraPose>& poses) {
-  if (planar.points.empty()) planar = fit_planes(scene.map->positions, {});
   const bool own_holdout = scene.config.lidar_holdout_every > 0;
   const std::vector<io::TumPose> prior_trajectory = to_tum(priors, scene.config),
                                  refined_trajectory = to_tum(poses, scene.config);
@@ -232,20 +252,28 @@ void guard_with_scans(const fs::path& dir, const io::Scene& scene, const std::ve
     if (!prior || !refined) continue;  // outside the frames' time span
     scans.push_back({io::read_pcd(dir / scene.scans[i].file).positions, *prior, *refined});
   }
+  if (own_holdout) {
+    const PlanarMap prior_map = map_through(dir, scene, prior_at),
+                    refined_map = map_through(dir, scene, refined_at);
+    verdict = judge_on_scans(prior_map, refined_map, scans, o);
+  } else {
+    if (planar.points.empty()) planar = fit_planes(scene.map->positions, {});
+    verdict = judge_on_scans(planar, planar, scans, o);
+  }
   if (!own_holdout)
     refine_report.notes.push_back(
         "the map holds every scan (scene.yaml lidar_holdout_every: 0): the scan check uses every " +
         std::to_string(o.every) +
-        "th scan, which the map also holds; rebuild it with `litgs-engine map "
-        "--force` to hold scans out");
-  verdict = judge_on_scans(planar, scans, o);
+        "th scan, which the map also holds, against the scene's map, built through the odometry; rebuild it "
+        "with `litgs-engine map --force` to hold scans out");
   refine_report.notes.push_back(verdict.summary);
   if (!verdict.keep_refined) {
     refine_report.rejected_poses = poses;
     poses = priors;
     refine_report.outcome = "kept the priors";
     refine_report.status =
-        "kept the priors: the refined poses put the LiDAR scans farther from the map's planes "
+        "kept the priors: the refined poses put the held-out LiDAR scans farther from the other scans' "
+        "planes "
         "(mean " +
         std::to_string(verdict.refined_mean_m) + " m against " + std::to_string(verdict.prior_mean_m) +
         " m through the priors)";

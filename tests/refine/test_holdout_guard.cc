@@ -91,15 +91,43 @@ TEST(RefineScanCheck, AnEmptyScanCountsForNothingAndAShiftedPoseIsWorse) {
   scans[0].T_world_lidar_refined = shifted;
   scans[1].T_world_lidar_refined = shifted;
   for (int i = 5; i < 35; ++i) scans[1].points_lidar.push_back(Eigen::Vector3d(0.1 * i, 5.0, 0.95));
-  const ScanVerdict v = judge_on_scans(map, scans, {});
+  const ScanVerdict v = judge_on_scans(map, map, scans, {});
   EXPECT_EQ(v.scans, 1u);  // the empty one is skipped
   ASSERT_TRUE(v.measured);
   EXPECT_LT(v.prior_mean_m, 1e-6);
   EXPECT_NEAR(v.refined_mean_m, 0.05, 1e-6);
   EXPECT_FALSE(v.keep_refined);
-  const ScanVerdict none = judge_on_scans(map, {scans[0]}, {});
+  const ScanVerdict none = judge_on_scans(map, map, {scans[0]}, {});
   EXPECT_FALSE(none.measured);
   EXPECT_TRUE(none.keep_refined);
+}
+
+// The odometry built the scene's map, so a held-out scan placed through the odometry shares its error and
+// lands on it: judged against that one map, a correction would always look worse. Each trajectory against
+// the map it builds itself from the other scans: a consistent correction passes, and a refined pose that
+// puts its scan off the surfaces its own other scans measured still fails.
+TEST(RefineScanCheck, EachTrajectoryAgainstItsOwnMapDoesNotFavourTheOneThatBuiltTheScenesMap) {
+  const auto wall_at = [](double y) {
+    std::vector<Eigen::Vector3d> wall;
+    for (int i = 0; i < 40; ++i)
+      for (int j = 0; j < 20; ++j) wall.push_back(Eigen::Vector3d(0.1 * i, y, 0.1 * j));
+    return fit_planes(wall, {});
+  };
+  const PlanarMap through_priors = wall_at(5.05), through_refined = wall_at(5.0);  // priors 5 cm off
+  std::vector<CheckedScan> scans(1);
+  for (int i = 5; i < 35; ++i) scans[0].points_lidar.push_back(Eigen::Vector3d(0.1 * i, 5.0, 0.95));
+  scans[0].T_world_lidar_prior(1, 3) = 0.05;  // the priors' error, shared by their map
+  const ScanVerdict one_map = judge_on_scans(through_priors, through_priors, scans, {});
+  EXPECT_FALSE(one_map.keep_refined);  // the bias
+  const ScanVerdict own_maps = judge_on_scans(through_priors, through_refined, scans, {});
+  ASSERT_TRUE(own_maps.measured);
+  EXPECT_NEAR(own_maps.prior_mean_m, 0, 1e-6);
+  EXPECT_NEAR(own_maps.refined_mean_m, 0, 1e-6);
+  EXPECT_TRUE(own_maps.keep_refined);
+  scans[0].T_world_lidar_refined(1, 3) = -0.04;  // a refined pose that breaks with its own map
+  const ScanVerdict inconsistent = judge_on_scans(through_priors, through_refined, scans, {});
+  EXPECT_NEAR(inconsistent.refined_mean_m, 0.04, 1e-6);
+  EXPECT_FALSE(inconsistent.keep_refined);
 }
 
 }  // namespace
