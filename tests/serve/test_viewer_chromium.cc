@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "engine_cli.h"
 #include "io/image.h"
 #include "serve_fixture.h"
 
@@ -134,6 +135,50 @@ TEST_F(ViewerChromium, LegendAndRangeAreInTheDataUnitsOfLevelsJson) {
   // The default model has no levels.json: model units.
   const std::string plain = chromium(std::string(kViewCamera) + "&palette=gray", "--dump-dom");
   EXPECT_EQ(element_text(plain, "legend-unit"), "intensity (model units)") << plain;
+}
+
+// With --scene, the viewer opens at the scene's first camera (not at an orbit outside the model's bounds,
+// which saw a facade edge-on), lists every camera by its number and jumps to the one typed. The model is a
+// training of one iteration from the scene's LiDAR map, so it stands where the cameras look.
+class ViewerChromiumScene : public ViewerChromium {
+ public:
+  static void SetUpTestSuite() {
+    scene_ = fs::temp_directory_path() / ("litgs-viewer-scene-" + std::to_string(::getpid()));
+    fs::remove_all(scene_);
+    const CommandResult synth =
+        run_engine("synth --frames 12 --width 64 --height 48 --out " + (scene_ / "scene").string());
+    ASSERT_EQ(synth.status, 0) << synth.output;
+    const CommandResult train = run_engine("train " + (scene_ / "scene").string() + " --out " +
+                                           (scene_ / "run").string() + " --iterations 1");
+    ASSERT_EQ(train.status, 0) << train.output;
+    extra_args_ = {"--scene", (scene_ / "scene").string()};
+    ServeTest::SetUpTestSuite();
+    fs::copy_file(scene_ / "run/point_cloud.ply", dir() / "models/facade.ply");
+  }
+  static void TearDownTestSuite() {
+    ServeTest::TearDownTestSuite();
+    fs::remove_all(scene_);
+  }
+  static inline fs::path scene_;
+};
+
+TEST_F(ViewerChromiumScene, OpensAtTheFirstCameraWithTheModelFillingTheViewAndJumpsByNumber) {
+  const auto load =
+      client()->Post("/models/load", R"({"name": "facade", "path": "facade.ply"})", "application/json");
+  ASSERT_TRUE(load);
+  ASSERT_EQ(load->status, 200) << load->body;
+  const std::vector<int> first =
+      canvas_region(screenshot("model=facade&palette=gray&range=0,1", "first.png"), 64, 48);
+  size_t lit = 0;
+  for (const int v : first) lit += v > 20;
+  EXPECT_GT(lit, first.size() * 6 / 10) << "the first view shows the model across most of the canvas";
+  // The same view as asking for camera 0 by number.
+  const std::vector<int> camera0 =
+      canvas_region(screenshot("model=facade&palette=gray&range=0,1&camera=0", "camera0.png"), 64, 48);
+  EXPECT_EQ(first, camera0);
+  const std::string dom = chromium("model=facade&palette=gray&range=0,1", "--dump-dom");
+  EXPECT_EQ(element_text(dom, "camera-11").rfind("11: ", 0), 0u) << dom;  // two digits, not clipped
+  EXPECT_NE(dom.find("id=\"camera-index\""), std::string::npos) << dom;
 }
 
 }  // namespace

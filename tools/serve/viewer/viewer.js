@@ -2,7 +2,8 @@
 // navigates, and shows values. URL parameters (all optional):
 //   q=w,x,y,z t=x,y,z   start camera, world-to-camera (T_cam_world), in the server's pose frame
 //   fx= fy= cx= cy=     intrinsics in pixels (default: 60 degree vertical field of view)
-//   w= h=               render size (default 640x512)   camera=I   start at scene camera I
+//   w= h=               render size (default 640x512)   camera=I   start at scene camera I (default: the
+//                       scene's first camera where there is a scene, else a view of the model's bounds)
 //   show=image|depth|alpha  palette=gray|ironbow  range=lo,hi  mode=orbit|fly  up=x,y,z  model=NAME
 //   nav=orbit:DX,DY | fly:DX,DY | move:F   one navigation step (as a drag of DX,DY pixels, or F metres
 //   forward) applied before the first render
@@ -304,16 +305,28 @@ async function start() {
   else if (cameras.length) {  // the scene cameras' mean "up" (-y in camera axes)
     state.up = unit(cameras.map((c) => scale(quatToRows(c.pose.T_cam_world.q)[1], -1)).reduce(add, [0, 0, 0]));
   }
-  cameras.forEach((c) => {
+  // Numbered in the text, so that every number shows (a list's own markers clip past two digits) and the
+  // box above jumps to it.
+  cameras.forEach((c, i) => {
     const li = document.createElement('li');
-    li.textContent = `${c.image} (t = ${c.t_s.toFixed(3)} s)`;
+    li.id = `camera-${i}`;
+    li.textContent = `${i}: ${c.image} (t = ${c.t_s.toFixed(3)} s)`;
     li.addEventListener('click', () => { useSceneCamera(c); request(); });
     $('cameras').appendChild(li);
+  });
+  $('camera-index').max = Math.max(cameras.length - 1, 0);
+  $('camera-index').addEventListener('change', () => {
+    const c = cameras[Number($('camera-index').value)];
+    if (!c) return reportError(`camera: no scene camera ${$('camera-index').value} (0 to ${cameras.length - 1})`);
+    useSceneCamera(c);
+    request();
   });
   if (params.get('camera') !== null && cameras[Number(params.get('camera'))]) {
     useSceneCamera(cameras[Number(params.get('camera'))]);
   } else if (params.get('q') && params.get('t')) {
     setPose(numbers(params.get('q')), numbers(params.get('t')));
+  } else if (cameras.length) {  // where the recording started: the model as its first frame saw it
+    useSceneCamera(cameras[0]);
   } else {  // looking at the model from outside its bounds
     const eye = add(mid, [1.2 * extent, 0.3 * extent, 0.5 * extent]);
     const z = unit(sub(mid, eye)), x = unit(cross(z, state.up));
