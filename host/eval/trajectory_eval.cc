@@ -57,6 +57,23 @@ void principal_plane(const std::vector<io::TumPose>& poses, Eigen::Vector3d& cen
   axes.col(1) = eig.eigenvectors().col(1);
 }
 
+// The positions' principal axes about their centroid, largest first: the top view is the plane of the first
+// two, the side view that of the first and the last (for a ground or facade survey, along the path and up).
+struct ViewPlanes {
+  Eigen::Vector3d centre;
+  Eigen::Matrix<double, 3, 2> top, side;
+};
+ViewPlanes principal_planes(const std::vector<io::TumPose>& poses) {
+  ViewPlanes v;
+  Eigen::Matrix<double, 3, 2> axes;
+  principal_plane(poses, v.centre, axes);
+  v.top = axes;
+  v.side.col(0) = axes.col(0);
+  v.side.col(1) = axes.col(0).cross(axes.col(1)).normalized();
+  if (v.side.col(1).z() < 0) v.side.col(1) = -v.side.col(1);  // up, where the world's z is up
+  return v;
+}
+
 // How far refinement moved each frame (both trajectories at the same times, in one frame).
 void moved(const std::vector<io::TumPose>& prior, const std::vector<io::TumPose>& refined,
            TrajectoryEvaluation& r) {
@@ -85,11 +102,11 @@ TrajectoryEvaluation without_truth(const std::vector<io::TumPose>& prior,
   TrajectoryEvaluation r;
   r.has_truth = false;
   r.estimate.pairs = refined.size();
-  Eigen::Vector3d centre;
-  Eigen::Matrix<double, 3, 2> axes;
-  principal_plane(prior, centre, axes);
-  r.prior_top = top_view(prior, {}, centre, axes);
-  r.estimate_top = top_view(refined, {}, centre, axes);
+  const ViewPlanes v = principal_planes(prior);
+  r.prior_top = top_view(prior, {}, v.centre, v.top);
+  r.estimate_top = top_view(refined, {}, v.centre, v.top);
+  r.prior_side = top_view(prior, {}, v.centre, v.side);
+  r.estimate_side = top_view(refined, {}, v.centre, v.side);
   moved(prior, refined, r);
   return r;
 }
@@ -132,13 +149,14 @@ std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, s
   }
   // The top view: the plane of the truth's two largest principal axes (for a ground or facade survey, the
   // horizontal plane).
-  Eigen::Vector3d centre;
-  Eigen::Matrix<double, 3, 2> axes;
-  principal_plane(truth, centre, axes);
-  r.truth_top = top_view(truth, {}, centre, axes);
-  r.estimate_top = top_view(estimate, r.estimate.alignment, centre, axes);
+  const ViewPlanes v = principal_planes(truth);
+  r.truth_top = top_view(truth, {}, v.centre, v.top);
+  r.estimate_top = top_view(estimate, r.estimate.alignment, v.centre, v.top);
+  r.truth_side = top_view(truth, {}, v.centre, v.side);
+  r.estimate_side = top_view(estimate, r.estimate.alignment, v.centre, v.side);
   if (r.prior) {
-    r.prior_top = top_view(prior, r.prior->alignment, centre, axes);
+    r.prior_top = top_view(prior, r.prior->alignment, v.centre, v.top);
+    r.prior_side = top_view(prior, r.prior->alignment, v.centre, v.side);
     if (!trained_on_truth) moved(prior, estimate, r);
   }
   return r;
@@ -165,7 +183,11 @@ nlohmann::json to_json(const TrajectoryEvaluation& t) {
           {"top_view",
            {{"truth", points(t.truth_top)},
             {"prior", points(t.prior_top)},
-            {"estimate", points(t.estimate_top)}}}};
+            {"estimate", points(t.estimate_top)}}},
+          {"side_view",
+           {{"truth", points(t.truth_side)},
+            {"prior", points(t.prior_side)},
+            {"estimate", points(t.estimate_side)}}}};
 }
 
 nlohmann::json trajectory_json_or_reason(const std::filesystem::path& scene_dir, bool trained_on_truth) {

@@ -30,6 +30,9 @@ struct TrajectoryEvaluation {
   // largest principal axes, about its centroid; metres. Without truth: the prior and refined positions as
   // they are, in the plane of the prior's axes.
   std::vector<Eigen::Vector2d> truth_top, prior_top, estimate_top;
+  // Side view: the same positions in the plane of that first principal axis and the direction normal to the
+  // top view's plane (for a ground survey, along the path and up), where height errors show.
+  std::vector<Eigen::Vector2d> truth_side, prior_side, estimate_side;
 };
 
 // nullopt when the scene has neither gt/poses.txt nor poses_prior.txt (with the reason in *why_not).
@@ -46,7 +49,7 @@ nlohmann::json trajectory_json_or_reason(const std::filesystem::path& scene_dir,
                                          bool trained_on_truth = false);
 
 // {"ate_m" (null without truth), "ate_prior_m" (or null), "moved_mean_m", "moved_max_m" (or null), "pairs",
-// "alignment": "SE(3) Umeyama", "top_view": {"truth", "prior", "estimate"}: [[x, y], ...]}.
+// "alignment": "SE(3) Umeyama", "top_view" and "side_view": {"truth", "prior", "estimate"}: [[x, y], ...]}.
 nlohmann::json to_json(const TrajectoryEvaluation& t);
 
 }  // namespace litgs::host

@@ -210,8 +210,10 @@ const char* kChartsScript = R"(
   make('gaussians', [line('Gaussians', d.trace.map(p => ({x:p.iteration, y:p.gaussians})), '#2ca02c')],
        'iteration', 'Gaussians');
   let drawn = 3;
-  if (d.trajectory) {  // top view, the same metres per pixel on both axes (about: the chart area is near square)
-    const t = d.trajectory.top_view, all = t.truth.concat(t.prior, t.estimate);
+  // The trajectories seen from above and from the side, the same metres per pixel on both axes of each
+  // (about: the chart areas are near square).
+  const view = (id, t, label) => {
+    const all = t.truth.concat(t.prior, t.estimate);
     const lo = k => Math.min(...all.map(p => p[k])), hi = k => Math.max(...all.map(p => p[k]));
     const half = 0.55 * Math.max(hi(0) - lo(0), hi(1) - lo(1), 1e-6);
     const mid = k => (lo(k) + hi(k)) / 2, xy = v => v.map(p => ({x:p[0], y:p[1]}));
@@ -220,11 +222,15 @@ const char* kChartsScript = R"(
     if (t.prior.length) sets.push(Object.assign(line('prior', xy(t.prior), '#ff7f0e'), {pointRadius:2, order:2}));
     sets.push(Object.assign(line(t.prior.length ? 'refined' : 'estimate', xy(t.estimate), '#17becf'),
                             {pointRadius:2, order:1}));
-    const scales = {x: Object.assign(axis('m (top view)'), {min:mid(0) - half, max:mid(0) + half}),
+    const scales = {x: Object.assign(axis('m (' + label + ')'), {min:mid(0) - half, max:mid(0) + half}),
                     y: Object.assign(axis('m'), {min:mid(1) - half, max:mid(1) + half})};
-    new Chart(document.getElementById('trajectory'), {type:'line', data:{datasets:sets},
+    new Chart(document.getElementById(id), {type:'line', data:{datasets:sets},
       options:Object.assign({scales:scales}, common)});
-    drawn = 4;
+    ++drawn;
+  };
+  if (d.trajectory) {
+    view('trajectory', d.trajectory.top_view, 'top view');
+    if (d.trajectory.side_view) view('trajectory_side', d.trajectory.side_view, 'side view');
   }
   document.body.setAttribute('data-charts', String(drawn));
 })();
@@ -334,7 +340,8 @@ std::string report_html(const fs::path& run_dir, unsigned max_views) {
   h += "<div id=charts><div class=chart><canvas id=psnr_iter></canvas></div><div class=chart><canvas "
        "id=psnr_time></canvas></div><div class=chart><canvas id=gaussians></canvas></div>";
   h += trajectory.is_object()
-           ? "<div class=chart><canvas id=trajectory></canvas></div>"
+           ? "<div class=chart><canvas id=trajectory></canvas></div><div class=chart><canvas "
+             "id=trajectory_side></canvas></div>"
            : "<div class='chart none'>trajectories: " +
                  escape_html(trajectory.is_string() ? trajectory.get<std::string>() : "not available") +
                  "</div>";

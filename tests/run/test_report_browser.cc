@@ -105,7 +105,7 @@ TEST_F(RunReport, LoadsWithoutConsoleMessagesAndDrawsItsCharts) {
   const Browser b = chromium(report_, "--dump-dom");
   ASSERT_EQ(b.status, 0) << b.err;
   EXPECT_EQ(console_lines(b.err), std::vector<std::string>{}) << "console messages while loading the report";
-  EXPECT_NE(b.out.find("data-charts=\"4\""), std::string::npos)
+  EXPECT_NE(b.out.find("data-charts=\"5\""), std::string::npos)
       << "the chart script did not finish (or drew no trajectories)";
   // Self-contained: no address outside the file.
   const std::string html = slurp(report_);

@@ -69,6 +69,7 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
   EXPECT_NEAR(eval["trajectory"]["ate_m"].get<double>(), refined["ate_after_m"].get<double>(), 1e-12);
   EXPECT_NEAR(eval["trajectory"]["ate_prior_m"].get<double>(), refined["ate_before_m"].get<double>(), 1e-12);
   EXPECT_EQ(eval["trajectory"]["top_view"]["truth"].size(), 16u);
+  EXPECT_EQ(eval["trajectory"]["side_view"]["truth"].size(), 16u);
   EXPECT_NE(r.output.find("run: ATE "), std::string::npos) << r.output;
   EXPECT_EQ(eval["views"].size(), eval["heldout_views"].get<size_t>());
   // The synthetic scene has true depth: each view's covisible share and its PSNR there, where every pixel
