@@ -848,7 +848,10 @@ class BagReader {
       begin = 0;
       end = unpacked->size();
     }
+    // Entries are kept only once the whole chunk has parsed: a chunk that fails part-way (the scan stops
+    // there) must leave no entry pointing at it.
     const auto chunk = static_cast<uint32_t>(chunks_.size());
+    std::vector<Entry> in_chunk;
     for (uint64_t at = begin; at < end;) {
       const Record m = read_record(*src, at, end);
       if (m.op == kOpConnection) {
@@ -857,14 +860,15 @@ class BagReader {
         const std::string& time = field(*src, m, "time");
         if (time.size() != 8) src->fail(m.pos, "message time of " + std::to_string(time.size()) + " bytes");
         const auto* t = reinterpret_cast<const uint8_t*>(time.data());
-        found.push_back({{le32(t), le32(t + 4)},
-                         chunk,
-                         static_cast<uint32_t>(m.pos - begin),
-                         field_int<uint32_t>(*src, m, "conn")});
+        in_chunk.push_back({{le32(t), le32(t + 4)},
+                            chunk,
+                            static_cast<uint32_t>(m.pos - begin),
+                            field_int<uint32_t>(*src, m, "conn")});
       }
       at = m.end();
     }
     chunks_.push_back(c);
+    found.insert(found.end(), in_chunk.begin(), in_chunk.end());
   }
 
   FileBytes file_;
