@@ -667,17 +667,7 @@ class BagReader {
                             std::to_string(header.end()) + ".." + std::to_string(index_pos) + ")");
       const Record r = read_record(file_, chunk_pos, index_pos);
       expect_op(file_, r, kOpChunk, "chunk");
-      Chunk c;
-      c.pos = chunk_pos;
-      c.compression = field(file_, r, "compression");
-      c.size = field_int<uint32_t>(file_, r, "size");
-      c.data_pos = r.data_pos;
-      c.data_len = r.data_len;
-      if (c.compression == "none" && c.size != c.data_len)
-        file_.fail(c.pos, "uncompressed chunk of " + std::to_string(c.data_len) + " bytes says its size is " +
-                              std::to_string(c.size));
-      if (c.size > kMaxChunkBytes)
-        file_.fail(c.pos, "chunk of " + std::to_string(c.size) + " bytes (corrupt)");
+      const Chunk c = checked_chunk(r);
       const auto chunk = static_cast<uint32_t>(chunks_.size());
       chunks_.push_back(c);
       uint64_t at = r.end();
@@ -800,6 +790,22 @@ class BagReader {
     return header;
   }
 
+  // The chunk record `r`'s fields, checked: an uncompressed chunk's size is its data's, and no chunk claims
+  // more than kMaxChunkBytes.
+  Chunk checked_chunk(const Record& r) {
+    Chunk c;
+    c.pos = r.pos;
+    c.compression = field(file_, r, "compression");
+    c.size = field_int<uint32_t>(file_, r, "size");
+    c.data_pos = r.data_pos;
+    c.data_len = r.data_len;
+    if (c.compression == "none" && c.size != c.data_len)
+      file_.fail(c.pos, "uncompressed chunk of " + std::to_string(c.data_len) + " bytes says its size is " +
+                            std::to_string(c.size));
+    if (c.size > kMaxChunkBytes) file_.fail(c.pos, "chunk of " + std::to_string(c.size) + " bytes (corrupt)");
+    return c;
+  }
+
   // A connection record's id, topic, type and definition MD5.
   static std::pair<uint32_t, Connection> parse_connection(Bytes& src, const Record& r) {
     const uint32_t id = field_int<uint32_t>(src, r, "conn");
@@ -828,16 +834,7 @@ class BagReader {
 
   // The chunk record `r` (complete in the file): its connections and message-data records.
   void scan_chunk(const Record& r, std::vector<Entry>& found) {
-    Chunk c;
-    c.pos = r.pos;
-    c.compression = field(file_, r, "compression");
-    c.size = field_int<uint32_t>(file_, r, "size");
-    c.data_pos = r.data_pos;
-    c.data_len = r.data_len;
-    if (c.compression == "none" && c.size != c.data_len)
-      file_.fail(c.pos, "uncompressed chunk of " + std::to_string(c.data_len) + " bytes says its size is " +
-                            std::to_string(c.size));
-    if (c.size > kMaxChunkBytes) file_.fail(c.pos, "chunk of " + std::to_string(c.size) + " bytes (corrupt)");
+    const Chunk c = checked_chunk(r);
     InFileChunk in_file(file_, c.pos);
     std::optional<ChunkBytes> unpacked;
     Bytes* src = &in_file;

@@ -37,7 +37,8 @@ std::vector<io::TumPose> at_times(const std::vector<io::TumPose>& poses, const s
   return out;
 }
 
-std::vector<Eigen::Vector2d> top_view(const std::vector<io::TumPose>& poses, const refine::Similarity& align,
+// Positions (after `align`) in the plane of `axes` about `centre`.
+std::vector<Eigen::Vector2d> in_plane(const std::vector<io::TumPose>& poses, const refine::Similarity& align,
                                       const Eigen::Vector3d& centre,
                                       const Eigen::Matrix<double, 3, 2>& axes) {
   std::vector<Eigen::Vector2d> out;
@@ -103,10 +104,10 @@ TrajectoryEvaluation without_truth(const std::vector<io::TumPose>& prior,
   r.has_truth = false;
   r.estimate.pairs = refined.size();
   const ViewPlanes v = principal_planes(prior);
-  r.prior_top = top_view(prior, {}, v.centre, v.top);
-  r.estimate_top = top_view(refined, {}, v.centre, v.top);
-  r.prior_side = top_view(prior, {}, v.centre, v.side);
-  r.estimate_side = top_view(refined, {}, v.centre, v.side);
+  r.prior_top = in_plane(prior, {}, v.centre, v.top);
+  r.estimate_top = in_plane(refined, {}, v.centre, v.top);
+  r.prior_side = in_plane(prior, {}, v.centre, v.side);
+  r.estimate_side = in_plane(refined, {}, v.centre, v.side);
   moved(prior, refined, r);
   return r;
 }
@@ -150,13 +151,13 @@ std::optional<TrajectoryEvaluation> evaluate_trajectories(const fs::path& dir, s
   // The top view: the plane of the truth's two largest principal axes (for a ground or facade survey, the
   // horizontal plane).
   const ViewPlanes v = principal_planes(truth);
-  r.truth_top = top_view(truth, {}, v.centre, v.top);
-  r.estimate_top = top_view(estimate, r.estimate.alignment, v.centre, v.top);
-  r.truth_side = top_view(truth, {}, v.centre, v.side);
-  r.estimate_side = top_view(estimate, r.estimate.alignment, v.centre, v.side);
+  r.truth_top = in_plane(truth, {}, v.centre, v.top);
+  r.estimate_top = in_plane(estimate, r.estimate.alignment, v.centre, v.top);
+  r.truth_side = in_plane(truth, {}, v.centre, v.side);
+  r.estimate_side = in_plane(estimate, r.estimate.alignment, v.centre, v.side);
   if (r.prior) {
-    r.prior_top = top_view(prior, r.prior->alignment, v.centre, v.top);
-    r.prior_side = top_view(prior, r.prior->alignment, v.centre, v.side);
+    r.prior_top = in_plane(prior, r.prior->alignment, v.centre, v.top);
+    r.prior_side = in_plane(prior, r.prior->alignment, v.centre, v.side);
     if (!trained_on_truth) moved(prior, estimate, r);
   }
   return r;
