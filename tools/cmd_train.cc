@@ -34,7 +34,7 @@ struct TrainCliOptions {
   host::InitialModelOptions initial;  // --init and its options (seed and SH degree from `train`)
   DataFlags data_flags;               // --intensity, --poses
   std::string trace;                  // JSON lines appended at every progress report (the report's curves)
-  std::string max_gaussians = "2000000";  // a count, auto, search or grow (host/train/budget_flag.h)
+  std::string max_gaussians = host::train_defaults::kMaxGaussians;
   host::BudgetSearchOptions budget_search;
   std::vector<std::string> search_options_given;  // the --budget-* options on the command line
   host::TrainingDataOptions data;

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "host/train/train_defaults.h"
+
 namespace litgs::host::run {
 
 // The defaults; each option is documented once, in for_each_field below (run --print-config prints it).
@@ -52,18 +54,19 @@ struct RunConfig {
     std::vector<std::string> extra_args;
   } refine;
   struct Train {
-    uint32_t iterations = 2000;
+    // train's own defaults (host/train/train_defaults.h); ablate fixes the budget instead of searching it.
+    uint32_t iterations = train_defaults::kIterations;
     double downscale = 1.0;
-    std::string strategy = "mcmc";
-    // Grown on validation views (docs/budget.md); ablate fixes it instead.
-    std::string max_gaussians = "search";
-    double mcmc_growth = 0.3;
-    double lambda_geo = 0.6;
+    std::string strategy = train_defaults::kStrategy;
+    std::string max_gaussians = train_defaults::kMaxGaussians;
+    double mcmc_growth = train_defaults::kMcmcGrowth;
+    double lambda_geo = train_defaults::kLambdaGeo;
     std::string init = "auto";
     uint32_t holdout_every = 8;
     std::string intensity = "auto";
     std::string poses = "estimated";
     uint32_t seed = 0;
+    // Unlike train's (0: at the end, none): the report draws the PSNR curve, and a stage resumes.
     uint32_t eval_every = 250;
     uint32_t checkpoint_every = 250;
     uint32_t progress_every = 50;

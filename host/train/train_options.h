@@ -1,11 +1,12 @@
-// Every option of a training run, with the 3DGS defaults where they apply; the CLI maps onto it field by
-// field.
+// Every option of a training run, with the 3DGS defaults where they apply and train_defaults.h where `train`
+// and `run` share them; the CLI maps onto it field by field.
 #pragma once
 
 #include <algorithm>
 #include <cstdint>
 #include <string>
 
+#include "host/train/train_defaults.h"
 #include "kernels/mcmc/mcmc.h"
 
 namespace litgs::host {
@@ -30,9 +31,9 @@ struct BudgetGrowthOptions {
 };
 
 struct TrainOptions {
-  uint32_t iterations = 7000;
-  double lambda_geo = 0.6;   // L = (1 - lambda_geo) L_pho + lambda_geo L_geo (0: photometric only)
-  double lambda_ssim = 0.2;  // L_pho = (1 - lambda_ssim) L1 + lambda_ssim (1 - SSIM)
+  uint32_t iterations = train_defaults::kIterations;
+  double lambda_geo = train_defaults::kLambdaGeo;  // 0: photometric only
+  double lambda_ssim = 0.2;                        // L_pho = (1 - lambda_ssim) L1 + lambda_ssim (1 - SSIM)
   // Scale s of the Cauchy kernel on the point-to-plane residual (kernels/loss/geometric_loss.h), metres; 0:
   // the plain square. Residuals well below s are squared as the method states; the ~1% of LiDAR targets that
   // are not the surface a pixel sees (up to ~1 m off on the synthetic facade, yet half the squared loss's
@@ -61,8 +62,8 @@ struct TrainOptions {
   // Densification strategy: "adc" (3DGS adaptive density control: clone, split, prune, opacity resets) or
   // "mcmc" (3DGS-MCMC: a fixed budget, relocation of dead Gaussians, position noise, regularizers; the same
   // window and cadence).
-  std::string strategy = "adc";
-  float mcmc_growth = 0.05f;   // MCMC: rows added per refinement, as a fraction of the model
+  std::string strategy = train_defaults::kStrategy;
+  float mcmc_growth = static_cast<float>(train_defaults::kMcmcGrowth);
   float mcmc_noise_lr = 5e5f;  // MCMC: position noise, times the means' learning rate
   float mcmc_opacity_reg =
       0.01f;  // MCMC: L1 weights, relative to the photometric loss (photometric_weight())

@@ -85,6 +85,7 @@ class OutputFrameTest : public testing::SmallTrainingSceneTest {
   // at 20, the last checkpoint at 30: the model the trainer evaluated at the end.
   static host::TrainOptions options() {
     host::TrainOptions o;
+    o.strategy = "adc";  // written for ADC, train's default before it became MCMC
     o.iterations = 30;
     o.sh_degree = 1;
     o.sh_degree_every = 20;

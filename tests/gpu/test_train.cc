@@ -41,6 +41,8 @@ class TrainTest : public testing::SmallTrainingSceneTest {
 
   static host::TrainOptions small_run(uint32_t iterations) {
     host::TrainOptions o;
+    o.strategy = "adc";     // written for ADC, train's default before it became MCMC
+    o.mcmc_growth = 0.05f;  // the MCMC tests' growth, from before the default became 0.3
     o.iterations = iterations;
     o.sh_degree = 1;
     o.sh_degree_every = 20;

@@ -41,6 +41,7 @@ class TrainLevelTest : public testing::SmallTrainingSceneTest {
 
   static host::TrainOptions options(const std::string& level, uint32_t iterations) {
     host::TrainOptions o;
+    o.strategy = "adc";  // written for ADC, train's default before it became MCMC
     o.iterations = iterations;
     o.sh_degree = 1;
     o.sh_degree_every = 100;

@@ -56,6 +56,7 @@ class TrainResumeTest : public testing::SmallTrainingSceneTest {
   // 40 iterations, a checkpoint and an evaluation every 10, refinement at 20 and 30.
   static host::TrainOptions options() {
     host::TrainOptions o;
+    o.strategy = "adc";  // written for ADC, train's default before it became MCMC
     o.iterations = 40;
     o.sh_degree = 1;
     o.sh_degree_every = 20;

@@ -148,8 +148,9 @@ class ViewerChromiumScene : public ViewerChromium {
     const CommandResult synth =
         run_engine("synth --frames 12 --width 64 --height 48 --out " + (scene_ / "scene").string());
     ASSERT_EQ(synth.status, 0) << synth.output;
-    const CommandResult train = run_engine("train " + (scene_ / "scene").string() + " --out " +
-                                           (scene_ / "run").string() + " --iterations 1");
+    const CommandResult train =
+        run_engine("train " + (scene_ / "scene").string() + " --out " + (scene_ / "run").string() +
+                   " --iterations 1 --max-gaussians 2000");
     ASSERT_EQ(train.status, 0) << train.output;
     extra_args_ = {"--scene", (scene_ / "scene").string()};
     ServeTest::SetUpTestSuite();
