@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <set>
+#include <sstream>
 
 #include "io/atomic_file.h"
 #include "io/error.h"
@@ -222,24 +223,28 @@ SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
 
 }  // namespace
 
+std::string camera_yaml_block(const CameraIntrinsics& k) {
+  std::ostringstream out;
+  out << "camera:\n"
+      << "  model: " << (k.model == CameraModel::kPinhole ? "pinhole" : "equidistant")
+      << "  # pinhole | equidistant (fisheye)\n"
+      << "  width: " << k.width << "\n  height: " << k.height << "\n"
+      << "  fx: " << format_double(k.fx) << "\n  fy: " << format_double(k.fy) << "\n"
+      << "  cx: " << format_double(k.cx) << "  # pixels; the centre of the top-left pixel is (0, 0)\n"
+      << "  cy: " << format_double(k.cy) << "\n  distortion: [";
+  for (size_t i = 0; i < k.distortion.size(); ++i) out << (i ? ", " : "") << format_double(k.distortion[i]);
+  out << "]  # pinhole: k1 k2 p1 p2 [k3] (OpenCV); equidistant: k1 k2 k3 k4\n"
+      << "  bit_depth: " << k.bit_depth << "  # of the thermal images\n";
+  return out.str();
+}
+
 void write_scene_yaml(const std::filesystem::path& path, const SceneConfig& c) {
   const std::string problem = check_scene_config(c);
   if (!problem.empty()) throw std::invalid_argument("write_scene_yaml: " + problem);
-  const CameraIntrinsics& k = c.camera;
   write_file_atomic(path, [&](std::ostream& out) {
     out << "# LIT-GS scene description: see docs/scene-format.md\n"
         << "format: litgs-scene\nversion: 1\nunits: {length: m, time: s, angle: rad}\n"
-        << "camera:\n"
-        << "  model: " << (k.model == CameraModel::kPinhole ? "pinhole" : "equidistant")
-        << "  # pinhole | equidistant (fisheye)\n"
-        << "  width: " << k.width << "\n  height: " << k.height << "\n"
-        << "  fx: " << format_double(k.fx) << "\n  fy: " << format_double(k.fy) << "\n"
-        << "  cx: " << format_double(k.cx) << "  # pixels; the centre of the top-left pixel is (0, 0)\n"
-        << "  cy: " << format_double(k.cy) << "\n  distortion: [";
-    for (size_t i = 0; i < k.distortion.size(); ++i) out << (i ? ", " : "") << format_double(k.distortion[i]);
-    out << "]  # pinhole: k1 k2 p1 p2 [k3] (OpenCV); equidistant: k1 k2 k3 k4\n"
-        << "  bit_depth: " << k.bit_depth << "  # of the thermal images\n"
-        << "T_cam_lidar:  # maps LiDAR points into the camera frame\n";
+        << camera_yaml_block(c.camera) << "T_cam_lidar:  # maps LiDAR points into the camera frame\n";
     for (int r = 0; r < 4; ++r) out << "  - " << row_text(c.T_cam_lidar, r) << "\n";
     out << "T_imu_lidar:  # maps LiDAR points into the IMU frame\n";
     for (int r = 0; r < 4; ++r) out << "  - " << row_text(c.T_imu_lidar, r) << "\n";

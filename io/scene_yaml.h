@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 
 #include "io/scene_types.h"
 
@@ -15,6 +16,9 @@ namespace litgs::io {
 SceneConfig read_scene_yaml(const std::filesystem::path& path);
 // Throws std::invalid_argument naming the field on the same checks; writes atomically.
 void write_scene_yaml(const std::filesystem::path& path, const SceneConfig& config);
+
+// scene.yaml's `camera:` block, as write_scene_yaml writes it (`calib intrinsics` writes it alone).
+std::string camera_yaml_block(const CameraIntrinsics& camera);
 
 // The checks shared by reader and writer: empty if valid, else "FIELD: problem".
 std::string check_scene_config(const SceneConfig& config);

@@ -27,6 +27,7 @@ enum class Stream : uint64_t {
   kNuc,
   kTexture,
   kRig,
+  kCalibration,
 };
 
 class Rng {

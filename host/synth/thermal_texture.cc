@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "host/synth/rng.h"
 
@@ -63,10 +64,30 @@ double halo_heat(const WarmHalo& h, double u, double v) {
 
 }  // namespace
 
+namespace {
+
+// The share of a pixel footprint around (u, v) inside the nearest circle of the grid: a linear ramp across
+// the edge over the footprint, so that the rendered circles are anti-aliased and their centres unbiased.
+double circle_coverage(const CircleGridPattern& g, double u, double v, double footprint_m) {
+  const double x = (u - g.origin_u_m) / g.spacing_m, y = (v - g.origin_v_m) / g.spacing_m;
+  double nearest = std::numeric_limits<double>::infinity();
+  const int row = static_cast<int>(std::lround(y));
+  for (int i = std::max(0, row - 1); i <= std::min(g.rows - 1, row + 1); ++i) {
+    const int j = std::clamp(static_cast<int>(std::lround((x - i % 2) / 2)), 0, g.cols - 1);
+    nearest = std::min(nearest, std::hypot(x - (2 * j + i % 2), y - i) * g.spacing_m);
+  }
+  const double width = std::max(footprint_m, 1e-9);
+  return std::clamp((g.radius_m - nearest) / width + 0.5, 0.0, 1.0);
+}
+
+}  // namespace
+
 double thermal_radiance(const ThermalTexture& t, double u, double v, double footprint_m) {
   double raw = t.base_raw + t.gradient_v_raw_per_m * v;
   raw += t.noise_raw * value_noise(u / t.noise_scale_m, v / t.noise_scale_m, t.seed);
-  if (t.pattern != ThermalPattern::kUniform) {
+  if (t.pattern == ThermalPattern::kCircleGrid) {
+    raw += t.circles.raw * circle_coverage(t.circles, u, v, footprint_m);
+  } else if (t.pattern != ThermalPattern::kUniform) {
     const double row = std::floor(v / t.cell_v_m);
     // Running bond: every other brick row is shifted by half a brick.
     const double shift =

@@ -11,6 +11,18 @@ enum class ThermalPattern {
   kUniform,  // smooth value noise only: large areas of almost no thermal gradient
   kBrick,    // running-bond bricks: cooler mortar joints, per-brick offsets
   kPanel,    // rectangular cladding panels (or floor tiles): cooler seams, per-panel offsets
+  // A calibration board: OpenCV's asymmetric circle grid (CircleGridPattern) of another temperature.
+  kCircleGrid,
+};
+
+// The circles of a kCircleGrid board: circle (row i, column j) centred at (u, v) = (origin_u_m + (2j + i mod
+// 2) spacing_m, origin_v_m + i spacing_m), radius radius_m, `raw` counts above the board (below: colder).
+struct CircleGridPattern {
+  int cols = 4, rows = 11;
+  double spacing_m = 0.05;
+  double radius_m = 0.02;
+  double origin_u_m = 0, origin_v_m = 0;
+  double raw = 300;
 };
 
 // Warm air leaking around an opening (a window, a door): heat bleeding into the wall around the rectangle
@@ -44,7 +56,8 @@ struct ThermalTexture {
   int detail_octaves = 0;     // 0: no weathering
   double streak_raw = 0;      // rain runoff: vertical streaks (narrow along u, long along v), counts
   std::vector<WarmHalo> halos;
-  uint64_t seed = 0;  // varies the noise and per-cell offsets between surfaces
+  CircleGridPattern circles;  // kCircleGrid only
+  uint64_t seed = 0;          // varies the noise and per-cell offsets between surfaces
 };
 
 // Radiance in raw counts at (u, v). `footprint_m` is the pixel's footprint on the surface: joints are box-

@@ -1,0 +1,125 @@
+#include "calib/circle_grid.h"
+
+#include <algorithm>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace litgs::calib {
+namespace {
+
+cv::Mat to_8bit(const io::Image& image) {
+  if (image.channels != 1) throw std::invalid_argument("circle grid: a one-channel (gray) image is needed");
+  cv::Mat out(image.height, image.width, CV_8U);
+  if (image.bit_depth == 8) {
+    for (size_t k = 0; k < image.data.size(); ++k) out.data[k] = static_cast<uint8_t>(image.data[k]);
+    return out;
+  }
+  std::vector<uint16_t> sorted = image.data;
+  const auto at = [&](double q) {
+    const size_t k = std::min(sorted.size() - 1, static_cast<size_t>(q * static_cast<double>(sorted.size())));
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(k), sorted.end());
+    return static_cast<double>(sorted[k]);
+  };
+  const double lo = at(0.005), hi = std::max(at(0.995), lo + 1);
+  for (size_t k = 0; k < image.data.size(); ++k)
+    out.data[k] =
+        static_cast<uint8_t>(std::clamp((image.data[k] - lo) / (hi - lo) * 255.0 + 0.5, 0.0, 255.0));
+  return out;
+}
+
+// Blobs from a few pixels wide up to a tenth of the image: thermal frames are small.
+cv::Ptr<cv::FeatureDetector> blob_detector(const cv::Mat& image) {
+  cv::SimpleBlobDetector::Params p;
+  p.minThreshold = 10;
+  p.maxThreshold = 245;
+  p.thresholdStep = 5;
+  p.minRepeatability = 4;  // a blob must stand 20 levels out of the board: not the background's texture
+  p.filterByColor = true;
+  p.blobColor = 0;  // dark blobs: cold circles, or hot ones after inversion
+  p.filterByArea = true;
+  p.minArea = 6;
+  p.maxArea = static_cast<float>(image.total()) / 10;
+  // A circle seen up to about 60 degrees off its normal stays a convex ellipse with axes at least half
+  // apart; the background's blotches are not.
+  p.filterByCircularity = true;
+  p.minCircularity = 0.6f;
+  p.filterByConvexity = true;
+  p.minConvexity = 0.85f;
+  p.filterByInertia = true;
+  p.minInertiaRatio = 0.4f;
+  return cv::SimpleBlobDetector::create(p);
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> CircleGrid::board_points() const {
+  std::vector<Eigen::Vector3d> out;
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) out.emplace_back((2 * j + i % 2) * spacing_m, i * spacing_m, 0.0);
+  return out;
+}
+
+void CircleGrid::check() const {
+  if (cols < 2 || rows < 3)
+    throw std::invalid_argument("--grid: at least 2 columns and 3 rows, got " + std::to_string(cols) + "x" +
+                                std::to_string(rows));
+  if (!(spacing_m > 0)) throw std::invalid_argument("--spacing must be > 0 (metres)");
+}
+
+CircleGrid parse_circle_grid(const std::string& text, double spacing_m) {
+  CircleGrid g;
+  const size_t x = text.find('x');
+  try {
+    size_t used = 0;
+    if (x == std::string::npos) throw std::invalid_argument("no x");
+    g.cols = std::stoi(text.substr(0, x), &used);
+    if (used != x) throw std::invalid_argument("cols");
+    g.rows = std::stoi(text.substr(x + 1), &used);
+    if (used != text.size() - x - 1) throw std::invalid_argument("rows");
+  } catch (const std::exception&) {
+    throw std::invalid_argument("--grid: COLSxROWS (e.g. 4x11), not '" + text + "'");
+  }
+  g.spacing_m = spacing_m;
+  g.check();
+  return g;
+}
+
+Polarity parse_polarity(const std::string& name) {
+  if (name == "auto") return Polarity::kAuto;
+  if (name == "hot") return Polarity::kHot;
+  if (name == "cold") return Polarity::kCold;
+  throw std::invalid_argument("--polarity: auto, hot or cold, not '" + name + "'");
+}
+
+GridDetection detect_circle_grid(const io::Image& image, const CircleGrid& grid, Polarity polarity,
+                                 bool clahe) {
+  grid.check();
+  GridDetection out;
+  cv::Mat gray = to_8bit(image);
+  if (clahe) cv::createCLAHE(2.0, cv::Size(8, 8))->apply(gray, gray);
+  std::vector<std::string> tried;
+  for (const Polarity p : {Polarity::kHot, Polarity::kCold}) {
+    if (polarity != Polarity::kAuto && polarity != p) continue;
+    const cv::Mat view = p == Polarity::kHot ? cv::Mat(255 - gray) : gray;
+    const cv::Ptr<cv::FeatureDetector> detector = blob_detector(view);
+    std::vector<cv::Point2f> centres;
+    if (cv::findCirclesGrid(view, cv::Size(grid.cols, grid.rows), centres,
+                            cv::CALIB_CB_ASYMMETRIC_GRID | cv::CALIB_CB_CLUSTERING, detector)) {
+      out.found = true;
+      out.polarity = p == Polarity::kHot ? "hot" : "cold";
+      for (const auto& c : centres) out.centres.emplace_back(c.x, c.y);
+      return out;
+    }
+    std::vector<cv::KeyPoint> blobs;
+    detector->detect(view, blobs);
+    tried.push_back(std::to_string(blobs.size()) + (p == Polarity::kHot ? " hot" : " cold") + " blobs");
+  }
+  out.why_not = "no " + std::to_string(grid.cols) + "x" + std::to_string(grid.rows) + " grid found (";
+  for (size_t k = 0; k < tried.size(); ++k) out.why_not += (k ? ", " : "") + tried[k];
+  out.why_not += "; the grid needs " + std::to_string(grid.cols * grid.rows) + ")";
+  return out;
+}
+
+}  // namespace litgs::calib

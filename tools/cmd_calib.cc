@@ -1,0 +1,114 @@
+// `litgs-engine calib intrinsics --images DIR --grid COLSxROWS --spacing S ...`: thermal intrinsics from an
+// asymmetric circle grid (calib/). Parses, reads the images, calls calib/, prints and writes.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "calib/calibration_files.h"
+#include "calib/circle_grid.h"
+#include "calib/intrinsics.h"
+#include "io/image.h"
+#include "tools/commands.h"
+
+namespace litgs::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct IntrinsicsCli {
+  fs::path images, out;
+  std::string grid = "4x11", polarity = "auto", model = "pinhole";
+  double spacing_m = 0;
+  bool clahe = false, json = false;
+};
+
+void run_intrinsics(const IntrinsicsCli& o) {
+  const calib::CircleGrid grid = calib::parse_circle_grid(o.grid, o.spacing_m);
+  const calib::Polarity polarity = calib::parse_polarity(o.polarity);
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(o.images)) {
+    const std::string ext = e.path().extension().string();
+    if (e.is_regular_file() && (ext == ".png" || ext == ".tif" || ext == ".tiff")) files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw std::invalid_argument(o.images.string() + ": no .png or .tif images");
+  std::vector<calib::CalibrationView> views;
+  for (const fs::path& f : files) {
+    const io::Image image = io::read_image(f);  // names the file when it is unreadable
+    calib::CalibrationView v{f.filename().string(), image.width, image.height, {}};
+    v.detection = calib::detect_circle_grid(image, grid, polarity, o.clahe);
+    if (!o.json)
+      std::cout << "  " << v.name << ": "
+                << (v.detection.found ? "grid found (" + v.detection.polarity + " circles)"
+                                      : v.detection.why_not)
+                << "\n";
+    views.push_back(std::move(v));
+  }
+  calib::IntrinsicsOptions options;
+  options.model = o.model == "equidistant" ? io::CameraModel::kEquidistant : io::CameraModel::kPinhole;
+  const calib::IntrinsicsResult r = calib::calibrate_intrinsics(views, grid, options);
+  const fs::path info = calib::write_intrinsics_files(o.out, r);
+  if (o.json) {
+    std::cout << calib::intrinsics_json(r).dump(2) << "\n";
+    return;
+  }
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "calib intrinsics: %zu of %zu views used, RMS %.3f px, %.0f %% of the image covered\n",
+                r.views_used, views.size(), r.rms_px, 100 * r.coverage);
+  std::cout << line;
+  const auto param = [&](const char* name, double value, size_t k) {
+    std::snprintf(line, sizeof line, "  %-3s %.5g", name, value);
+    std::cout << line;
+    if (k < r.stddev.size()) {
+      std::snprintf(line, sizeof line, " +- %.2g", r.stddev[k]);
+      std::cout << line;
+    }
+    std::cout << "\n";
+  };
+  param("fx", r.camera.fx, 0);
+  param("fy", r.camera.fy, 1);
+  param("cx", r.camera.cx, 2);
+  param("cy", r.camera.cy, 3);
+  for (size_t k = 0; k < r.camera.distortion.size(); ++k)
+    param(("k" + std::to_string(k)).c_str(), r.camera.distortion[k], 4 + k);
+  for (const auto& v : r.views)
+    if (!v.used && v.rms_px >= 0) std::cout << "  left out " << v.name << ": " << v.note << "\n";
+  for (const auto& n : r.notes) std::cout << "  note: " << n << "\n";
+  std::cout << "  wrote " << o.out.string() << " and " << info.string() << "\n";
+}
+
+}  // namespace
+
+void add_calib_command(CLI::App& app) {
+  CLI::App* calib = app.add_subcommand("calib", "Calibrate the rig: thermal intrinsics from a circle grid");
+  calib->require_subcommand(1);
+  auto o = std::make_shared<IntrinsicsCli>();
+  CLI::App* in =
+      calib->add_subcommand("intrinsics", "Thermal intrinsics from views of an asymmetric circle grid");
+  in->add_option("--images", o->images, "Folder of the views (8- or 16-bit PNG or TIFF)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  in->add_option("--grid", o->grid, "COLSxROWS of OpenCV's asymmetric layout (4x11: 4 columns, 11 rows)")
+      ->capture_default_str();
+  in->add_option("--spacing", o->spacing_m,
+                 "Metres between neighbouring circles of a column (S in ((2j + i mod 2) S, i S))")
+      ->required();
+  in->add_option("--polarity", o->polarity, "Circles hot, cold or auto (both tried)")
+      ->check(CLI::IsMember({"auto", "hot", "cold"}))
+      ->capture_default_str();
+  in->add_option("--model", o->model, "pinhole (k1 k2 p1 p2) or equidistant (fisheye k1..k4)")
+      ->check(CLI::IsMember({"pinhole", "equidistant"}))
+      ->capture_default_str();
+  in->add_flag("--clahe", o->clahe, "CLAHE before the detection (low-contrast boards)");
+  in->add_option("--out", o->out,
+                 "camera.yaml to write (scene.yaml's camera block; ROS camera_info beside it)")
+      ->required();
+  in->add_flag("--json", o->json, "Print the result as one JSON object");
+  in->callback([o] { run_intrinsics(*o); });
+}
+
+}  // namespace litgs::tools
