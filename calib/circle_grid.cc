@@ -1,6 +1,8 @@
 #include "calib/circle_grid.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -50,6 +52,53 @@ cv::Ptr<cv::FeatureDetector> blob_detector(const cv::Mat& image) {
   p.filterByInertia = true;
   p.minInertiaRatio = 0.4f;
   return cv::SimpleBlobDetector::create(p);
+}
+
+// Each centre moved to its circle's intensity-weighted centroid in `dark` (circles dark on a brighter
+// board): weights are how far a pixel lies below the board's level (the median of the window's outer ring),
+// in a window of 0.45 times the distance to the nearest other centre, twice. The blob detector's centre is
+// the mean of thresholded shapes' centres, which was biased by up to a pixel on rendered hot circles; the
+// centroid of the frame's own values is not.
+void refine_centres(const cv::Mat& dark, std::vector<Eigen::Vector2d>& centres) {
+  const std::vector<Eigen::Vector2d> start = centres;
+  for (size_t k = 0; k < centres.size(); ++k) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t m = 0; m < start.size(); ++m)
+      if (m != k) nearest = std::min(nearest, (start[m] - start[k]).norm());
+    const double radius = 0.45 * nearest;
+    if (!(radius >= 2)) continue;
+    Eigen::Vector2d c = start[k];
+    for (int pass = 0; pass < 2; ++pass) {
+      const int x0 = static_cast<int>(std::floor(c.x() - radius)),
+                x1 = static_cast<int>(std::ceil(c.x() + radius));
+      const int y0 = static_cast<int>(std::floor(c.y() - radius)),
+                y1 = static_cast<int>(std::ceil(c.y() + radius));
+      if (x0 < 0 || y0 < 0 || x1 >= dark.cols || y1 >= dark.rows) break;
+      std::vector<uint8_t> ring;
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+          const double d = std::hypot(x - c.x(), y - c.y());
+          if (d > 0.8 * radius && d <= radius) ring.push_back(dark.at<uint8_t>(y, x));
+        }
+      if (ring.empty()) break;
+      std::nth_element(ring.begin(), ring.begin() + static_cast<std::ptrdiff_t>(ring.size() / 2), ring.end());
+      const double level = ring[ring.size() / 2];
+      double w = 0, sx = 0, sy = 0;
+      for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+          if (std::hypot(x - c.x(), y - c.y()) > radius) continue;
+          const double weight = std::max(0.0, level - dark.at<uint8_t>(y, x));
+          w += weight;
+          sx += weight * x;
+          sy += weight * y;
+        }
+      if (!(w > 0)) break;
+      const Eigen::Vector2d next(sx / w, sy / w);
+      if ((next - start[k]).norm() > 0.5 * radius) break;  // wandered off: keep the detector's
+      c = next;
+    }
+    centres[k] = c;
+  }
 }
 
 }  // namespace
@@ -110,6 +159,7 @@ GridDetection detect_circle_grid(const io::Image& image, const CircleGrid& grid,
       out.found = true;
       out.polarity = p == Polarity::kHot ? "hot" : "cold";
       for (const auto& c : centres) out.centres.emplace_back(c.x, c.y);
+      refine_centres(view, out.centres);
       return out;
     }
     std::vector<cv::KeyPoint> blobs;
