@@ -8,6 +8,8 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "host/frontend/intensity.h"
+
 namespace litgs::calib {
 namespace {
 
@@ -18,16 +20,12 @@ cv::Mat to_8bit(const io::Image& image) {
     for (size_t k = 0; k < image.data.size(); ++k) out.data[k] = static_cast<uint8_t>(image.data[k]);
     return out;
   }
-  std::vector<uint16_t> sorted = image.data;
-  const auto at = [&](double q) {
-    const size_t k = std::min(sorted.size() - 1, static_cast<size_t>(q * static_cast<double>(sorted.size())));
-    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(k), sorted.end());
-    return static_cast<double>(sorted[k]);
-  };
-  const double lo = at(0.005), hi = std::max(at(0.995), lo + 1);
+  // The front end's stretch, so that a board is seen as the matcher sees the frames.
+  host::frontend::Histogram histogram = host::frontend::empty_histogram();
+  host::frontend::add_to_histogram(histogram, image.data);
+  const host::frontend::Stretch stretch = host::frontend::percentile_stretch(histogram, 0.5, 99.5);
   for (size_t k = 0; k < image.data.size(); ++k)
-    out.data[k] =
-        static_cast<uint8_t>(std::clamp((image.data[k] - lo) / (hi - lo) * 255.0 + 0.5, 0.0, 255.0));
+    out.data[k] = static_cast<uint8_t>(stretch.unit(image.data[k]) * 255.0 + 0.5);
   return out;
 }
 
@@ -146,8 +144,14 @@ GridDetection detect_circle_grid(const io::Image& image, const CircleGrid& grid,
                                  bool clahe) {
   grid.check();
   GridDetection out;
-  cv::Mat gray = to_8bit(image);
-  if (clahe) cv::createCLAHE(2.0, cv::Size(8, 8))->apply(gray, gray);
+  const cv::Mat plain = to_8bit(image);
+  // CLAHE helps the detection only: its local contrast moves each circle's intensity-weighted centroid, so
+  // the centres are refined on the plain stretch (a new buffer: `plain` stays as it is).
+  cv::Mat gray = plain;
+  if (clahe) {
+    gray = cv::Mat();
+    cv::createCLAHE(2.0, cv::Size(8, 8))->apply(plain, gray);
+  }
   std::vector<std::string> tried;
   for (const Polarity p : {Polarity::kHot, Polarity::kCold}) {
     if (polarity != Polarity::kAuto && polarity != p) continue;
@@ -159,7 +163,7 @@ GridDetection detect_circle_grid(const io::Image& image, const CircleGrid& grid,
       out.found = true;
       out.polarity = p == Polarity::kHot ? "hot" : "cold";
       for (const auto& c : centres) out.centres.emplace_back(c.x, c.y);
-      refine_centres(view, out.centres);
+      refine_centres(p == Polarity::kHot ? cv::Mat(255 - plain) : plain, out.centres);
       return out;
     }
     std::vector<cv::KeyPoint> blobs;

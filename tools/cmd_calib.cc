@@ -73,8 +73,14 @@ void run_intrinsics(const IntrinsicsCli& o) {
   param("fy", r.camera.fy, 1);
   param("cx", r.camera.cx, 2);
   param("cy", r.camera.cy, 3);
-  for (size_t k = 0; k < r.camera.distortion.size(); ++k)
-    param(("k" + std::to_string(k)).c_str(), r.camera.distortion[k], 4 + k);
+  // OpenCV's order: k1 k2 p1 p2 (k3) for the pinhole model, k1..k4 for the equidistant one.
+  const bool fisheye = r.camera.model == io::CameraModel::kEquidistant;
+  const char* const pinhole_names[] = {"k1", "k2", "p1", "p2", "k3"};
+  const char* const fisheye_names[] = {"k1", "k2", "k3", "k4"};
+  for (size_t k = 0; k < r.camera.distortion.size() && k < (fisheye ? 4u : 5u); ++k)
+    param(fisheye ? fisheye_names[k] : pinhole_names[k], r.camera.distortion[k], 4 + k);
+  if (r.stddev.empty())
+    std::cout << "  (cv::fisheye gives no standard deviations for the equidistant model)\n";
   for (const auto& v : r.views)
     if (!v.used && v.rms_px >= 0) std::cout << "  left out " << v.name << ": " << v.note << "\n";
   for (const auto& n : r.notes) std::cout << "  note: " << n << "\n";

@@ -2,39 +2,15 @@
 // H]
 // [--force] [--drift]`: a synthetic scene directory with exact ground truth (docs/scene-format.md). CPU only.
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <thread>
 
-#include "host/synth/circle_grid_views.h"
+#include "host/synth/calibration_set.h"
 #include "host/synth/synth.h"
 #include "tools/commands.h"
 
 namespace litgs::tools {
-namespace {
-
-// `--preset circle-grid`: a calibration set for `calib intrinsics` instead of a scene (--frames views, 40 by
-// default; OpenCV's asymmetric 4x11 grid, 5 cm spacing).
-void write_calibration_set(const host::synth::SynthOptions& o, const std::string& polarity) {
-  host::synth::CircleGridViewOptions c;
-  c.camera.width = o.width.value_or(320);
-  c.camera.height = o.height.value_or(256);
-  c.camera.blur_px = 0.5;
-  c.views = o.frames.value_or(40);
-  c.seed = o.seed;
-  c.hot_circles = polarity == "hot";
-  const int threads =
-      o.threads > 0 ? o.threads : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 8);
-  host::synth::write_circle_grid_set(o.out, c, threads);
-  std::cout << "synth circle-grid: " << c.views << " views of a " << c.grid.cols << "x" << c.grid.rows
-            << " asymmetric circle grid (" << polarity << " circles, spacing " << c.grid.spacing_m
-            << " m) at " << c.camera.width << "x" << c.camera.height << "; written to " << o.out.string()
-            << "/images, the truth to truth.json\n";
-}
-
-}  // namespace
 
 void add_synth_command(CLI::App& app) {
   CLI::App* synth = app.add_subcommand(
@@ -45,7 +21,9 @@ void add_synth_command(CLI::App& app) {
   auto height = std::make_shared<int>(0);
   synth
       ->add_option("--preset", o->preset,
-                   "facade | street | corridor, or circle-grid (a calibration set for `calib intrinsics`)")
+                   "facade | street | corridor, or circle-grid (a calibration set for `calib intrinsics`; "
+                   "--rig renders it "
+                   "through the rig's lens)")
       ->capture_default_str();
   synth->add_option("--out", o->out, "Scene directory to write")->required();
   synth->add_option("--seed", o->seed, "Random seed: the same seed gives the same bytes")
@@ -94,7 +72,15 @@ void add_synth_command(CLI::App& app) {
     if (rate_option->count()) o->frame_rate_hz = *rate;
     if (w->count()) o->width = *width;
     if (h->count()) o->height = *height;
-    if (o->preset == "circle-grid") return write_calibration_set(*o, *polarity);
+    if (o->preset == host::synth::kCircleGridPreset) {
+      const host::synth::CalibrationSetReport r =
+          host::synth::generate_calibration_set(*o, *polarity == "hot");
+      std::cout << "synth circle-grid: " << r.views << " views of a " << r.grid.cols << "x" << r.grid.rows
+                << " asymmetric circle grid (" << *polarity << " circles, spacing " << r.grid.spacing_m
+                << " m) at " << r.width << "x" << r.height << (r.distorted ? " through --rig's lens" : "")
+                << "; written to " << o->out.string() << "/images, the truth to truth.json\n";
+      return;
+    }
     const host::synth::SynthReport r = host::synth::generate_synthetic_scene(*o);
     std::cout << std::fixed << std::setprecision(2) << "synth " << r.preset << ": " << r.frames
               << " thermal frames (" << r.frozen_frames << " frozen by NUC), " << r.frames

@@ -8,6 +8,7 @@
 #include "host/synth/rng.h"
 #include "io/atomic_file.h"
 #include "io/image.h"
+#include "io/lens_distortion.h"
 
 namespace litgs::host::synth {
 namespace {
@@ -113,7 +114,8 @@ std::vector<CircleGridView> render_circle_grid_views(const CircleGridViewOptions
     for (const auto& c : centres) {
       const Eigen::Vector3d p = T_cam_world * c;
       const double edge = 2 * g.radius_m * K.fx / p.z();
-      const double u = K.fx * p.x() / p.z() + K.cx, v = K.fy * p.y() / p.z() + K.cy;
+      const Eigen::Vector2d d = io::distort_normalized(K, {p.x() / p.z(), p.y() / p.z()});
+      const double u = K.fx * d.x() + K.cx, v = K.fy * d.y() + K.cy;
       inside &= p.z() > 0 && u > edge && v > edge && u < K.width - 1 - edge && v < K.height - 1 - edge;
     }
     if (!inside) continue;

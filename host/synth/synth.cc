@@ -100,6 +100,10 @@ std::string SynthOptions::check() const {
   return "";
 }
 
+int resolve_synth_threads(int requested) {
+  return requested > 0 ? requested : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 8);
+}
+
 SynthReport generate_synthetic_scene(const SynthOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (const std::string problem = options.check(); !problem.empty())
@@ -134,9 +138,7 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
                                       {"nuc", p.nuc.check()},
                                       {"trajectory", p.trajectory.check()}})
     if (!problem.empty()) throw std::invalid_argument(std::string("synth: preset ") + what + "." + problem);
-  const int threads = options.threads > 0
-                          ? options.threads
-                          : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 8);
+  const int threads = resolve_synth_threads(options.threads);
   prepare_output(options.out, options.force);
 
   const Trajectory trajectory(p.trajectory);

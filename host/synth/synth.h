@@ -59,4 +59,7 @@ struct SynthReport {
 // `out` without `force`; io::IoError on file errors. Files are written atomically, scene.yaml last.
 SynthReport generate_synthetic_scene(const SynthOptions& options);
 
+// SynthOptions::threads as a count: 0 gives the hardware's, at most 8.
+int resolve_synth_threads(int requested);
+
 }  // namespace litgs::host::synth

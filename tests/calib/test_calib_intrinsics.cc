@@ -117,6 +117,48 @@ TEST(CalibIntrinsics, RenderedThermalViewsAreDetectedAndRecoverTheCamera) {
   }
 }
 
+TEST(CalibIntrinsics, TheEquidistantModelRecoversAFisheyeCamera) {
+  io::CameraIntrinsics k = true_camera();
+  k.model = io::CameraModel::kEquidistant;
+  k.distortion = {0.05, -0.02, 0.004, 0};
+  const CircleGrid grid = parse_circle_grid("4x11", 0.05);
+  IntrinsicsOptions options;
+  options.model = io::CameraModel::kEquidistant;
+  const IntrinsicsResult r = calibrate_intrinsics(projected_views(k, grid, 40, 0.3, 13), grid, options);
+  std::printf("  fx %.3f (true %.1f), cx %.3f (%.1f), cy %.3f (%.1f), k1 %.4f (%.2f), RMS %.3f px\n",
+              r.camera.fx, k.fx, r.camera.cx, k.cx, r.camera.cy, k.cy, r.camera.distortion.at(0),
+              k.distortion[0], r.rms_px);
+  EXPECT_EQ(r.camera.model, io::CameraModel::kEquidistant);
+  EXPECT_GE(r.views_used, 38u);  // at 3 MADs, pure noise may leave a view out
+  EXPECT_LT(std::abs(r.camera.fx / k.fx - 1), 0.003);
+  EXPECT_LT(std::hypot(r.camera.cx - k.cx, r.camera.cy - k.cy), 1.5);
+  ASSERT_EQ(r.camera.distortion.size(), 4u);
+  EXPECT_NEAR(r.camera.distortion[0], k.distortion[0], 0.02);
+  EXPECT_NEAR(r.rms_px, 0.3 * std::sqrt(2.0), 0.1);
+  EXPECT_TRUE(r.stddev.empty()) << "cv::fisheye states no uncertainty; none is made up";
+}
+
+TEST(CalibIntrinsics, ClaheBeforeDetectionFindsTheRenderedGridsAndTheSameCamera) {
+  host::synth::CircleGridViewOptions o;
+  o.camera.blur_px = 0.5;
+  o.views = 20;
+  const auto rendered = host::synth::render_circle_grid_views(o, 2);
+  const io::CameraIntrinsics k = o.camera.intrinsics();
+  const CircleGrid grid = parse_circle_grid("4x11", o.grid.spacing_m);
+  std::vector<CalibrationView> views;
+  for (size_t i = 0; i < rendered.size(); ++i)
+    views.push_back({"view" + std::to_string(i), rendered[i].raw.width, rendered[i].raw.height,
+                     detect_circle_grid(rendered[i].raw, grid, Polarity::kAuto, true)});
+  size_t found = 0;
+  for (const auto& v : views) found += v.detection.found;
+  const IntrinsicsResult r = calibrate_intrinsics(views, grid, {});
+  std::printf("  CLAHE: %zu of 20 views found; fx %.3f (true %.3f), RMS %.3f px\n", found, r.camera.fx, k.fx,
+              r.rms_px);
+  EXPECT_GE(found, 12u);
+  EXPECT_LT(std::abs(r.camera.fx / k.fx - 1), 0.003);
+  EXPECT_LT(std::hypot(r.camera.cx - k.cx, r.camera.cy - k.cy), 1.5);
+}
+
 TEST(CalibIntrinsicsBadInput, ColdCirclesAreFoundWithAutoAndNotWithHot) {
   host::synth::CircleGridViewOptions o;
   o.views = 3;

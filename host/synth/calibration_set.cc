@@ -1,0 +1,81 @@
+#include "host/synth/calibration_set.h"
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "host/synth/m2dgr_rig.h"
+#include "host/synth/presets.h"
+
+namespace litgs::host::synth {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A calibration set's files: --force removes these, nothing else.
+void prepare_output(const fs::path& out, bool force) {
+  if (fs::exists(out) && !fs::is_directory(out))
+    throw std::invalid_argument("synth: --out " + out.string() + " exists and is not a directory");
+  if (fs::is_directory(out) && !fs::is_empty(out)) {
+    if (!force)
+      throw std::invalid_argument("synth: --out " + out.string() +
+                                  " exists and is not empty (use --force to replace images/ and truth.json)");
+    fs::remove_all(out / "images");
+    fs::remove(out / "truth.json");
+  }
+  fs::create_directories(out);
+}
+
+// The scene options a board seen from still poses has no use for: refused rather than ignored.
+void refuse_scene_options(const SynthOptions& o) {
+  const SynthOptions defaults;
+  const auto refuse = [](const std::string& flag) {
+    throw std::invalid_argument("synth: " + flag + " does not apply to --preset circle-grid (a calibration set)");
+  };
+  if (o.drift) refuse("--drift");
+  if (o.frame_rate_hz) refuse("--frame-rate");
+  if (o.appearance != defaults.appearance) refuse("--appearance");
+  if (o.lidar_holdout_every != defaults.lidar_holdout_every) refuse("--lidar-holdout-every");
+}
+
+}  // namespace
+
+CalibrationSetReport generate_calibration_set(const SynthOptions& o, bool hot_circles) {
+  if (o.preset != kCircleGridPreset)
+    throw std::invalid_argument("synth: generate_calibration_set needs preset circle-grid, got " + o.preset);
+  refuse_scene_options(o);
+  // The shared checks, asked of a scene preset so that only the preset's name differs.
+  SynthOptions shared = o;
+  shared.preset = preset_names().front();
+  if (const std::string problem = shared.check(); !problem.empty())
+    throw std::invalid_argument("synth: " + problem);
+
+  CircleGridViewOptions c;
+  if (!o.rig.empty()) {
+    Preset p = make_preset(preset_names().front(), o.seed, Appearance::kTextured);
+    apply_m2dgr_rig({o.rig, o.rig_camera_block, o.rig_imu_block}, o.width, o.height, p);
+    // The board held nearer a wider lens, so that it fills about as much of the image as with the default.
+    ThermalCameraOptions reference;
+    reference.width = p.camera.width;
+    reference.height = p.camera.height;
+    const double nearer = p.camera.calibrated->fx / reference.intrinsics().fx;
+    c.min_distance_m *= nearer;
+    c.max_distance_m *= nearer;
+    c.camera.calibrated = p.camera.calibrated;
+    c.camera.width = p.camera.width;
+    c.camera.height = p.camera.height;
+  } else {
+    c.camera.width = o.width.value_or(320);
+    c.camera.height = o.height.value_or(256);
+  }
+  c.camera.blur_px = 0.5;  // the optics' blur of the scene presets' textured appearance
+  c.views = o.frames.value_or(40);
+  c.seed = o.seed;
+  c.hot_circles = hot_circles;
+  if (const std::string problem = c.check(); !problem.empty())
+    throw std::invalid_argument("synth: circle grid: " + problem);
+  prepare_output(o.out, o.force);
+  write_circle_grid_set(o.out, c, resolve_synth_threads(o.threads));
+  return {c.views, c.grid, c.camera.intrinsics().width, c.camera.intrinsics().height, !o.rig.empty()};
+}
+
+}  // namespace litgs::host::synth
