@@ -37,6 +37,7 @@ struct TrainCliOptions {
   std::string max_gaussians = host::train_defaults::kMaxGaussians;
   host::BudgetSearchOptions budget_search;
   std::vector<std::string> search_options_given;  // the --budget-* options on the command line
+  std::vector<std::string> growth_options_given;  // the --growth-* options on the command line
   host::TrainingDataOptions data;
   host::TrainOptions train;
 };
@@ -88,6 +89,9 @@ void run_train(TrainCliOptions o) {
   if (!o.search_options_given.empty() && o.max_gaussians != "search")
     throw std::invalid_argument(o.search_options_given.front() +
                                 " applies to --max-gaussians search only, not '" + o.max_gaussians + "'");
+  if (!o.growth_options_given.empty() && o.max_gaussians != "grow")
+    throw std::invalid_argument(o.growth_options_given.front() +
+                                " applies to --max-gaussians grow only, not '" + o.max_gaussians + "'");
   const bool asked_to_resume = o.train.resume;
   const bool reuse_finished_trials = host::restart_cut_short_search(o.max_gaussians, o.train.resume, o.out);
   if (reuse_finished_trials)
@@ -304,6 +308,29 @@ void add_train_command(CLI::App& app) {
          "training views (8: every training view validates once; each fold costs one training)")
       ->check(CLI::Range(1, 8))
       ->capture_default_str();
+  host::BudgetGrowthOptions& growth = o->train.growth;
+  cmd->add_option("--growth-start", growth.start,
+                  "With --max-gaussians grow: the first budget (raised to the initialization's size)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--growth-validation-every", growth.validation_every,
+                  "With --max-gaussians grow: every Nth training view validates (held back while it grows)")
+      ->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  cmd->add_option("--growth-min-gain", growth.min_gain_db,
+                  "With --max-gaussians grow: dB of validation PSNR a doubling must add to grow again")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--growth-noise-multiple", growth.noise_multiple,
+                  "With --max-gaussians grow: standard errors of the paired gain it must also exceed (0: "
+                  "the mean decides)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--growth-min-transfer", growth.min_transfer,
+                  "With --max-gaussians grow: the validation gain must be at least this share of the "
+                  "training views' (0: not asked)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--strategy", o->train.strategy,
                   "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")
       ->check(CLI::IsMember({"adc", "mcmc"}))
@@ -354,6 +381,9 @@ void add_train_command(CLI::App& app) {
   cmd->callback([cmd, o] {
     for (const char* name : {"--budget-parsimony", "--budget-min-gain", "--budget-folds"})
       if (cmd->count(name) > 0) o->search_options_given.push_back(name);
+    for (const char* name : {"--growth-start", "--growth-validation-every", "--growth-min-gain",
+                             "--growth-noise-multiple", "--growth-min-transfer"})
+      if (cmd->count(name) > 0) o->growth_options_given.push_back(name);
     run_train(*o);
   });
 }

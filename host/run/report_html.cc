@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "host/run/report_budget.h"
+#include "host/run/report_growth.h"
 #include "io/error.h"
 
 // Chart.js (MIT, Debian libjs-chart.js), embedded at build time by cmake/EmbedFile.cmake.
@@ -168,7 +169,7 @@ const char* kStyle = R"(
 body{font:14px sans-serif;margin:0;padding:0 16px;background:#fff;color:#222;width:1200px}
 h1{font-size:20px;height:28px;margin:8px 0}
 h2{font-size:16px;margin:18px 0 6px}
-#charts{display:flex;gap:12px;height:300px}
+#charts,.charts{display:flex;gap:12px;height:300px}
 .chart{width:291px;height:300px;position:relative}
 .none{display:flex;align-items:center;justify-content:center;color:#666;border:1px solid #ccc}
 .view{display:flex;gap:8px;height:196px;align-items:flex-start}
@@ -210,6 +211,15 @@ const char* kChartsScript = R"(
   make('gaussians', [line('Gaussians', d.trace.map(p => ({x:p.iteration, y:p.gaussians})), '#2ca02c')],
        'iteration', 'Gaussians');
   let drawn = 3;
+  // A budget grown inside the training: validation PSNR against its size and against time, the phase that
+  // stopped the growth drawn larger.
+  if (d.growth) {
+    const grown = (x) => Object.assign(line('validation PSNR (dB)', d.growth.map(p => ({x:p[x], y:p.psnr_db})), '#8c564b'),
+        {pointRadius: d.growth.map(p => p.stop ? 7 : 3)});
+    make('growth_gaussians', [grown('gaussians')], 'Gaussians', 'validation PSNR (dB)');
+    make('growth_time', [grown('seconds')], 'training time (s)', 'validation PSNR (dB)');
+    drawn += 2;
+  }
   // The trajectories seen from above and from the side, the same metres per pixel on both axes of each
   // (about: the chart areas are near square).
   const view = (id, t, label) => {
@@ -326,8 +336,10 @@ std::string report_html(const fs::path& run_dir, unsigned max_views) {
   for (const json& e : metrics.value("evaluations", json::array()))
     evaluations.push_back({{"iteration", e.at("iteration")}, {"psnr_db", e.at("psnr_db")}});
   const json trajectory = eval.value("trajectory", json());
+  const json growth = metrics.value("budget_growth", json());
   const json data = {{"trace", trace},
                      {"evaluations", evaluations},
+                     {"growth", growth.is_null() ? json() : growth_chart_json(growth)},
                      {"trajectory", trajectory.is_object() ? trajectory : json(nullptr)}};
 
   std::string h =
@@ -352,7 +364,9 @@ std::string report_html(const fs::path& run_dir, unsigned max_views) {
   json budget;  // null: no record, a fixed budget
   if (fs::exists(budget_file))
     budget = json::parse(read_text(budget_file), nullptr, false);  // discarded if bad
-  h += "<h2>Budget</h2>\n" + budget_section_html(budget, metrics.value("gaussians", uint64_t{0}));
+  h += "<h2>Budget</h2>\n" + (budget.is_null() && !growth.is_null()
+                                  ? growth_section_html(growth)
+                                  : budget_section_html(budget, metrics.value("gaussians", uint64_t{0})));
   h += "<h2>Stages</h2>\n" + stages_table(run);
   h += "<h2>Held-out views, per view</h2>\n" + per_view_table(eval);
   h += "<script type=\"application/json\" id=data>" + script_json(data) + "</script>\n<script>";

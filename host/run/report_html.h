@@ -3,7 +3,8 @@
 // against iterations and seconds, Gaussians over training, the trajectories' top view with truth, prior and
 // refined poses where the scene has ground truth), the held-out views (render beside the real
 // frame, error map, false colour, rendered depth), the summary of metrics, how the budget was chosen
-// (report_budget.h), the stages, the per-view table.
+// (report_budget.h; a budget grown inside the training, with its two charts: report_growth.h), the stages,
+// the per-view table.
 #pragma once
 
 #include <filesystem>

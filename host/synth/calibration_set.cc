@@ -29,7 +29,8 @@ void prepare_output(const fs::path& out, bool force) {
 void refuse_scene_options(const SynthOptions& o) {
   const SynthOptions defaults;
   const auto refuse = [](const std::string& flag) {
-    throw std::invalid_argument("synth: " + flag + " does not apply to --preset circle-grid (a calibration set)");
+    throw std::invalid_argument("synth: " + flag +
+                                " does not apply to --preset circle-grid (a calibration set)");
   };
   if (o.drift) refuse("--drift");
   if (o.frame_rate_hz) refuse("--frame-rate");

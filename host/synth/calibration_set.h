@@ -22,8 +22,8 @@ struct CalibrationSetReport {
 // Writes OUT/images and OUT/truth.json for `options` (preset circle-grid): `frames` views (default 40) at
 // width x height (default 320x256), or through --rig's thermal camera (its intrinsics and distortion, scaled
 // to width x height if given), with hot or cold circles. std::invalid_argument for an option a calibration
-// set has no use for (--drift, --frame-rate, --appearance, --lidar-holdout-every), a bad value, or a non-empty
-// OUT without --force (--force replaces images/ and truth.json only).
+// set has no use for (--drift, --frame-rate, --appearance, --lidar-holdout-every), a bad value, or a
+// non-empty OUT without --force (--force replaces images/ and truth.json only).
 CalibrationSetReport generate_calibration_set(const SynthOptions& options, bool hot_circles);
 
 }  // namespace litgs::host::synth

@@ -103,14 +103,17 @@ TEST(CalibrationSet, RenderedThroughTheM2dgrLensCalibRecoversItsDistortion) {
   size_t found = 0;
   for (const auto& v : views) found += v.detection.found;
   const calib::IntrinsicsResult c = calib::calibrate_intrinsics(views, grid, {});
-  std::printf("  %zu found, %zu of %d views used; fx %.3f (true %.3f), cx %.3f (%.3f), cy %.3f (%.3f), k1 %.4f (%.4f), "
-              "k2 %.4f (%.4f), RMS %.3f px\n",
-              found, c.views_used, r.views, c.camera.fx, truth["fx"].get<double>(), c.camera.cx,
-              truth["cx"].get<double>(), c.camera.cy, truth["cy"].get<double>(), c.camera.distortion.at(0),
-              true_distortion[0], c.camera.distortion.at(1), true_distortion[1], c.rms_px);
+  std::printf(
+      "  %zu found, %zu of %d views used; fx %.3f (true %.3f), cx %.3f (%.3f), cy %.3f (%.3f), k1 %.4f "
+      "(%.4f), "
+      "k2 %.4f (%.4f), RMS %.3f px\n",
+      found, c.views_used, r.views, c.camera.fx, truth["fx"].get<double>(), c.camera.cx,
+      truth["cx"].get<double>(), c.camera.cy, truth["cy"].get<double>(), c.camera.distortion.at(0),
+      true_distortion[0], c.camera.distortion.at(1), true_distortion[1], c.rms_px);
   EXPECT_GE(c.views_used, 25u);
   EXPECT_LT(std::abs(c.camera.fx / truth["fx"].get<double>() - 1), 0.005);
-  EXPECT_LT(std::hypot(c.camera.cx - truth["cx"].get<double>(), c.camera.cy - truth["cy"].get<double>()), 1.5);
+  EXPECT_LT(std::hypot(c.camera.cx - truth["cx"].get<double>(), c.camera.cy - truth["cy"].get<double>()),
+            1.5);
   EXPECT_NEAR(c.camera.distortion[0], true_distortion[0], 0.05);
   fs::remove_all(out);
 }

@@ -10,6 +10,7 @@
 #include "host/run/content_hash.h"
 #include "host/run/input_kind.h"
 #include "host/run/report_budget.h"
+#include "host/run/report_growth.h"
 #include "host/run/report_html.h"
 #include "host/run/run_config.h"
 #include "io/error.h"
@@ -202,6 +203,61 @@ TEST(Report, BudgetSectionOfAFixedOrDerivedBudget) {
             std::string::npos)
       << html;
   EXPECT_NE(html.find("173.0 m<sup>2</sup>"), std::string::npos) << html;
+}
+
+// metrics.json's budget_growth as BudgetGrowth::to_json writes it: a phase that waited, two that grew, the
+// one that stopped.
+const char* const kGrowth = R"json({
+  "budget": 20000, "ceiling": 8000000, "stop_reason": "stop: validation gained -0.210 dB (standard error 0.040 dB)",
+  "phases": [
+    {"iteration": 600, "budget": 5000, "gaussians": 4729, "validation_psnr_db": null, "gain_db": null,
+     "gain_se_db": null, "training_psnr_db": null, "training_gain_db": null, "wall_s": 20.5,
+     "decision": "wait: the model has not filled its budget"},
+    {"iteration": 900, "budget": 5000, "gaussians": 5000, "validation_psnr_db": 21.35, "gain_db": null,
+     "gain_se_db": null, "training_psnr_db": 22.0, "training_gain_db": null, "wall_s": 31.0,
+     "decision": "grow: first score; budget 10000"},
+    {"iteration": 1200, "budget": 10000, "gaussians": 10000, "validation_psnr_db": 21.53, "gain_db": 0.18,
+     "gain_se_db": 0.28, "training_psnr_db": 22.9, "training_gain_db": 0.91, "wall_s": 45.0,
+     "decision": "grow: validation gained 0.180 dB; budget 20000"},
+    {"iteration": 1500, "budget": 20000, "gaussians": 20000, "validation_psnr_db": 21.32, "gain_db": -0.21,
+     "gain_se_db": 0.04, "training_psnr_db": 23.4, "training_gain_db": 0.5, "wall_s": 61.0,
+     "decision": "stop: validation gained -0.210 dB (standard error 0.040 dB)"}],
+  "last_scored_view_psnr_db": [21.0, 21.6], "last_scored_training_psnr_db": [23.0, 23.8]
+})json";
+
+TEST(Report, GrowthSectionShowsEachPhaseWhereItStoppedAndWhy) {
+  const nlohmann::json growth = nlohmann::json::parse(kGrowth);
+  const std::string html = growth_section_html(growth);
+  EXPECT_NE(html.find("from a budget of 5000 to <b>20000</b> (ceiling 8000000)"), std::string::npos) << html;
+  EXPECT_NE(html.find("Stopped: validation gained -0.210 dB (standard error 0.040 dB)."), std::string::npos)
+      << html;
+  EXPECT_NE(html.find("id=growth_gaussians"), std::string::npos);
+  EXPECT_NE(html.find("id=growth_time"), std::string::npos);
+  const std::string waited = table_row(html, "600"), grew = table_row(html, "1200"),
+                    stopped = table_row(html, "1500");
+  EXPECT_NE(waited.find("<td>&ndash;</td>"), std::string::npos) << waited;  // not scored
+  EXPECT_NE(grew.find("<td>0.18 &plusmn; 0.28</td><td>0.91</td>"), std::string::npos) << grew;
+  EXPECT_EQ(grew.find("class=kept"), std::string::npos) << grew;
+  EXPECT_NE(stopped.find("class=kept"), std::string::npos) << stopped;
+
+  const nlohmann::json chart = growth_chart_json(growth);
+  ASSERT_EQ(chart.size(), 3u) << chart.dump();  // the scored phases only
+  EXPECT_EQ(chart[0]["gaussians"], 5000);
+  EXPECT_DOUBLE_EQ(chart[1]["seconds"].get<double>(), 45.0);
+  EXPECT_FALSE(chart[1]["stop"].get<bool>());
+  EXPECT_TRUE(chart[2]["stop"].get<bool>());
+}
+
+TEST(Report, GrowthThatNeverScoredHasNoChartsAndADamagedRecordSaysSo) {
+  nlohmann::json growth = nlohmann::json::parse(kGrowth);
+  growth["phases"] = nlohmann::json::array({growth["phases"][0]});
+  growth["stop_reason"] = "1 validation view(s) cannot measure the noise of a gain";
+  const std::string html = growth_section_html(growth);
+  EXPECT_TRUE(growth_chart_json(growth).is_null());
+  EXPECT_EQ(html.find("growth_gaussians"), std::string::npos) << html;
+  EXPECT_NE(html.find("Stopped: 1 validation view(s) cannot measure"), std::string::npos) << html;
+  const std::string damaged = growth_section_html({{"budget", "<many>"}, {"phases", 3}});
+  EXPECT_NE(damaged.find("is not a growth record"), std::string::npos) << damaged;
 }
 
 TEST(Report, ADamagedBudgetRecordSaysSoInItsSection) {

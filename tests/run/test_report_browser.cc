@@ -2,7 +2,7 @@
 // four charts (the fourth: the trajectories' top view), and the screenshot's pixels show the charts (their
 // line colours in the chart band) and the pictures (false-colour and gray pixels in the views band). Controls
 // show each check can fail: a page with a script error is caught, and the report without its charts has no
-// chart pixels.
+// chart pixels. A run whose budget grew inside the training draws the two growth charts as well.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "io/image.h"
@@ -118,6 +119,40 @@ TEST_F(RunReport, LoadsWithoutConsoleMessagesAndDrawsItsCharts) {
   const Browser c = chromium(bad, "--dump-dom");
   ASSERT_EQ(console_lines(c.err).size(), 1u) << c.err;
   EXPECT_NE(console_lines(c.err)[0].find("Uncaught ReferenceError"), std::string::npos);
+}
+
+// The same run as if its budget had grown inside the training (metrics.json's budget_growth, as
+// BudgetGrowth::to_json writes it): the Budget section's two growth charts are drawn too.
+TEST_F(RunReport, AGrownBudgetDrawsItsTwoGrowthCharts) {
+  const fs::path grown = kRoot / "e2e-grown";
+  fs::remove_all(grown);
+  fs::create_directories(grown / "train");
+  for (const char* part : {"run.json", "train/metrics.json", "train/trace.jsonl"})
+    fs::copy_file(report_.parent_path() / part, grown / part);
+  fs::copy(report_.parent_path() / "eval", grown / "eval", fs::copy_options::recursive);
+  nlohmann::json metrics = nlohmann::json::parse(slurp(grown / "train/metrics.json"));
+  metrics["budget_growth"] = nlohmann::json::parse(R"json({"budget": 20000, "ceiling": 8000000,
+    "stop_reason": "stop: validation gained 0.010 dB", "last_scored_view_psnr_db": [],
+    "last_scored_training_psnr_db": [], "phases": [
+    {"iteration": 600, "budget": 5000, "gaussians": 5000, "validation_psnr_db": 30.1, "gain_db": null,
+     "gain_se_db": null, "training_psnr_db": 31.0, "training_gain_db": null, "wall_s": 10.0,
+     "decision": "grow: first score; budget 10000"},
+    {"iteration": 900, "budget": 10000, "gaussians": 10000, "validation_psnr_db": 30.9, "gain_db": 0.8,
+     "gain_se_db": 0.1, "training_psnr_db": 32.0, "training_gain_db": 1.0, "wall_s": 16.0,
+     "decision": "grow: validation gained 0.800 dB; budget 20000"},
+    {"iteration": 1200, "budget": 20000, "gaussians": 20000, "validation_psnr_db": 30.91, "gain_db": 0.01,
+     "gain_se_db": 0.1, "training_psnr_db": 32.5, "training_gain_db": 0.5, "wall_s": 25.0,
+     "decision": "stop: validation gained 0.010 dB"}]})json");
+  write_text(grown / "train/metrics.json", metrics.dump());
+  const std::string cmd = std::string(LITGS_ENGINE_BINARY) + " report --run " + grown.string() + " > " +
+                          (grown / "report.log").string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(grown / "report.log");
+  const Browser b = chromium(grown / "report.html", "--dump-dom");
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_EQ(console_lines(b.err), std::vector<std::string>{}) << "console messages while loading the report";
+  EXPECT_NE(b.out.find("data-charts=\"7\""), std::string::npos)
+      << "the growth charts were not drawn beside the five of the run";
+  EXPECT_NE(b.out.find("Grown inside the training"), std::string::npos);
 }
 
 TEST_F(RunReport, ScreenshotShowsChartsAndPictures) {
