@@ -331,6 +331,10 @@ void add_train_command(CLI::App& app) {
                   "training views' (0: not asked)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_flag(
+      "--growth-no-roll-back", [o](int64_t) { o->train.growth.roll_back = false; },
+      "With --max-gaussians grow: keep the doubling that did not pay instead of returning to the "
+      "last budget that did");
   cmd->add_option("--strategy", o->train.strategy,
                   "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")
       ->check(CLI::IsMember({"adc", "mcmc"}))
@@ -382,7 +386,7 @@ void add_train_command(CLI::App& app) {
     for (const char* name : {"--budget-parsimony", "--budget-min-gain", "--budget-folds"})
       if (cmd->count(name) > 0) o->search_options_given.push_back(name);
     for (const char* name : {"--growth-start", "--growth-validation-every", "--growth-min-gain",
-                             "--growth-noise-multiple", "--growth-min-transfer"})
+                             "--growth-noise-multiple", "--growth-min-transfer", "--growth-no-roll-back"})
       if (cmd->count(name) > 0) o->growth_options_given.push_back(name);
     run_train(*o);
   });

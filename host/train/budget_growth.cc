@@ -99,11 +99,18 @@ void BudgetGrowth::end_phase(uint32_t step, uint32_t gaussians, const std::vecto
     }
     gained = why_not.empty();
   }
+  const uint32_t previous_budget = last_scored_budget_;
   last_scored_ = views;
   last_training_ = training;
+  last_scored_budget_ = budget_;
   const uint64_t next = static_cast<uint64_t>(std::ceil(budget_ * options_.factor));
   if (!gained) {
     p.decision = "stop: " + why_not;
+    if (options_.roll_back && previous_budget > 0 && previous_budget < budget_) {
+      p.decision +=
+          "; back to the budget of " + std::to_string(previous_budget) + ", its most opaque Gaussians kept";
+      budget_ = previous_budget;
+    }
   } else if (next > ceiling_) {
     p.decision = "stop: the next budget, " + std::to_string(next) + ", is above the ceiling of " +
                  std::to_string(ceiling_);
@@ -139,6 +146,7 @@ nlohmann::json BudgetGrowth::to_json() const {
           {"ceiling", ceiling_},
           {"stop_reason", stop_reason_},
           {"phases", phases},
+          {"last_scored_budget", last_scored_budget_},
           {"last_scored_view_psnr_db", last_scored_},
           {"last_scored_training_psnr_db", last_training_}};
 }
@@ -154,6 +162,7 @@ BudgetGrowth BudgetGrowth::from_json(const BudgetGrowthOptions& options, const n
                          number(p.at("gain_db")), number(p.at("gain_se_db")),
                          number(p.at("training_psnr_db")), number(p.at("training_gain_db")),
                          p.at("wall_s").get<double>(), p.at("decision").get<std::string>()});
+  g.last_scored_budget_ = j.value("last_scored_budget", 0u);  // absent before roll-backs: none
   g.last_scored_ = j.at("last_scored_view_psnr_db").get<std::vector<double>>();
   g.last_training_ = j.at("last_scored_training_psnr_db").get<std::vector<double>>();
   return g;

@@ -2,8 +2,9 @@
 // per budget tried (`search`, host/train/budget_search.h). The model starts at a small budget; at the end of
 // each phase (BudgetGrowthOptions), once MCMC's growth has filled the budget, the validation views are
 // scored, and the budget rises by `factor` while the validation PSNR, paired view by view with the last
-// measurement, still gains more than min_gain_db and noise_multiple standard errors. Then it stops, the
-// validation views rejoin the training views, and the remaining iterations train at that size. The gain
+// measurement, still gains more than min_gain_db and noise_multiple standard errors. Then it stops (with
+// roll_back, back at the last budget that paid: the caller shrinks the model to budget()), the validation
+// views rejoin the training views, and the remaining iterations train at that size. The gain
 // between two phases also holds the phase's training progress at a fixed size, so the rule leans towards
 // growing; the margin is there for that. The state is a small JSON document that checkpoints carry, so a
 // training interrupted during growth resumes with the same budget, views and decisions.
@@ -66,6 +67,7 @@ class BudgetGrowth {
   std::string stop_reason_;
   std::vector<GrowthPhase> phases_;
   std::vector<double> last_scored_, last_training_;  // the last scored phase's per-view PSNR
+  uint32_t last_scored_budget_ = 0;                  // that phase's budget: where a roll-back returns
 };
 
 // The validation views of a growing training: every validation_every-th of `train_views`, from the middle

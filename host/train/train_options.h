@@ -17,7 +17,9 @@ namespace litgs::host {
 // training while the budget grows) are scored, and the budget is multiplied by `factor` while the paired
 // per-view PSNR gain over the last measurement is above `min_gain_db` and `noise_multiple` standard errors,
 // and at least `min_transfer` times the gain of as many training views over the same phase (a larger model
-// that gains on the views it trains on but not on the others is fitting them, not the scene).
+// that gains on the views it trains on but not on the others is fitting them, not the scene). With
+// `roll_back`, a doubling that did not pay is undone: the model returns to the last budget that did, keeping
+// its most opaque Gaussians (early stopping that restores the best, applied to the size).
 struct BudgetGrowthOptions {
   bool enabled = false;
   uint32_t start = 5000;  // the first budget (raised to the initialization's size where larger)
@@ -27,6 +29,7 @@ struct BudgetGrowthOptions {
   double min_gain_db = 0.05;
   double noise_multiple = 2.0;
   double min_transfer = 0.5;
+  bool roll_back = true;
   void check() const;  // throws std::invalid_argument naming the bad field
 };
 

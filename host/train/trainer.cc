@@ -19,6 +19,7 @@
 #include "host/train/metrics_json.h"
 #include "host/train/output_frame.h"
 #include "host/train/run_options.h"
+#include "host/train/shrink_model.h"
 #include "host/train/training_step.h"
 #include "host/train/view_sampler.h"
 #include "io/gaussian_ply.h"
@@ -332,6 +333,8 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
       growth->end_phase(step, static_cast<uint32_t>(model.size()), scores(*validator), scores(*probe),
                         growth->another_phase_fits(step, o), secs);
       density_control.set_budget(growth->budget());
+      if (model.size() > growth->budget())  // a doubling rolled back
+        model.load_state(keep_most_opaque(model.download_state(), growth->budget()));
       notice("budget growth at iteration " + std::to_string(step) + ": " + growth->phases().back().decision);
       if (!growth->growing()) sampler.set_pool(train_views);
       record.growth = growth->to_json();

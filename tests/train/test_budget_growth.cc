@@ -1,8 +1,8 @@
 // The rule of `--max-gaussians grow` (host/train/budget_growth.h) on made-up scores: when it grows, waits and
 // stops, and the named hard cases: validation noise larger than the gain, a larger model that fits only the
 // views it trains on, a budget above what the device holds, a scene whose validation set is one view, an
-// initialization that already fills the ceiling; and a resume from its JSON state deciding as the
-// uninterrupted run.
+// initialization that already fills the ceiling or covers the scene (the doubling rolled back); and a resume
+// from its JSON state deciding as the uninterrupted run.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -48,8 +48,9 @@ TEST(BudgetGrowth, GrowsWhileValidationGainsAndStopsWhenItNoLongerDoes) {
   EXPECT_TRUE(g.growing());
   g.end_phase(1200, 80000, shifted(kViews, 0.82), shifted(kViews, 2.85), true, 3);  // +0.02 dB: no gain
   EXPECT_FALSE(g.growing());
-  EXPECT_EQ(g.budget(), 80000u);
+  EXPECT_EQ(g.budget(), 40000u) << "the doubling that did not pay is rolled back";
   EXPECT_NE(g.stop_reason().find("validation gained 0.020 dB"), std::string::npos) << g.stop_reason();
+  EXPECT_NE(g.stop_reason().find("back to the budget of 40000"), std::string::npos) << g.stop_reason();
   g.end_phase(1500, 80000, shifted(kViews, 5), shifted(kViews, 5), true, 4);  // ignored once stopped
   EXPECT_EQ(g.phases().size(), 3u);
 }
@@ -62,7 +63,7 @@ TEST(BudgetGrowth, ValidationNoiseLargerThanTheGainStopsIt) {
   for (size_t i = 0; i < noisy.size(); ++i) noisy[i] += 0.3 + kNoise[i];  // mean +0.36, standard error ~0.39
   g.end_phase(900, 20000, noisy, shifted(kViews, 0.3), true, 2);
   EXPECT_FALSE(g.growing());
-  EXPECT_EQ(g.budget(), 20000u);
+  EXPECT_EQ(g.budget(), 10000u);
   EXPECT_GT(g.phases().back().gain_db, o.min_gain_db);  // it did gain on average, within its noise
 }
 
@@ -73,6 +74,27 @@ TEST(BudgetGrowth, ALargerModelThatFitsOnlyTheViewsItTrainsOnStops) {
   g.end_phase(900, 20000, shifted(kViews, 0.3), shifted(kViews, 1.0), true, 2);  // 0.3 < 0.5 x 1.0
   EXPECT_FALSE(g.growing());
   EXPECT_NE(g.stop_reason().find("fits the views it trains on"), std::string::npos) << g.stop_reason();
+}
+
+TEST(BudgetGrowth, AnInitializationThatAlreadyCoversTheSceneStopsAtItsFirstDoublingAndReturnsToIt) {
+  BudgetGrowthOptions o;
+  BudgetGrowth g(o, 20000, 4000000, kViews.size());
+  g.end_phase(600, 20000, kViews, shifted(kViews, 0.5), true, 1);
+  EXPECT_EQ(g.budget(), 40000u);  // the first score only sets the baseline
+  g.end_phase(900, 40000, shifted(kViews, -0.01), shifted(kViews, 0.4), true, 2);
+  EXPECT_FALSE(g.growing());
+  EXPECT_EQ(g.budget(), 20000u);
+}
+
+TEST(BudgetGrowth, WithoutRollBackTheLastDoublingStays) {
+  BudgetGrowthOptions o;
+  o.roll_back = false;
+  BudgetGrowth g(o, 20000, 4000000, kViews.size());
+  g.end_phase(600, 20000, kViews, kViews, true, 1);
+  g.end_phase(900, 40000, shifted(kViews, -0.01), shifted(kViews, 0.4), true, 2);
+  EXPECT_FALSE(g.growing());
+  EXPECT_EQ(g.budget(), 40000u);
+  EXPECT_EQ(g.stop_reason().find("back to"), std::string::npos) << g.stop_reason();
 }
 
 TEST(BudgetGrowth, WaitsUntilTheModelFillsItsBudgetButNotPastTheWindow) {
@@ -125,7 +147,7 @@ TEST(BudgetGrowth, ResumedFromItsJsonItDecidesAsTheUninterruptedRun) {
   }
   EXPECT_EQ(resumed.to_json().dump(), whole.to_json().dump());  // as text: NaN never equals itself
   EXPECT_FALSE(whole.growing());
-  EXPECT_EQ(whole.budget(), 40000u);
+  EXPECT_EQ(whole.budget(), 20000u);  // 40k gained 0.05 dB over 20k: rolled back
 }
 
 }  // namespace
