@@ -313,6 +313,18 @@ void add_train_command(CLI::App& app) {
                   "With --max-gaussians grow: the first budget (raised to the initialization's size)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  cmd->add_option(
+         "--growth-phase", growth.phase_refinements,
+         "With --max-gaussians grow: refinements per phase (MCMC's growth is raised while it grows so "
+         "that a doubled budget fills within one)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  cmd->add_option(
+         "--growth-until", growth.until_fraction,
+         "With --max-gaussians grow: decisions end by this share of --iterations (the rest trains at "
+         "the final size on every training view)")
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str();
   cmd->add_option("--growth-validation-every", growth.validation_every,
                   "With --max-gaussians grow: every Nth training view validates (held back while it grows)")
       ->check(CLI::Range(2, 1000))
@@ -385,8 +397,9 @@ void add_train_command(CLI::App& app) {
   cmd->callback([cmd, o] {
     for (const char* name : {"--budget-parsimony", "--budget-min-gain", "--budget-folds"})
       if (cmd->count(name) > 0) o->search_options_given.push_back(name);
-    for (const char* name : {"--growth-start", "--growth-validation-every", "--growth-min-gain",
-                             "--growth-noise-multiple", "--growth-min-transfer", "--growth-no-roll-back"})
+    for (const char* name :
+         {"--growth-start", "--growth-phase", "--growth-until", "--growth-validation-every",
+          "--growth-min-gain", "--growth-noise-multiple", "--growth-min-transfer", "--growth-no-roll-back"})
       if (cmd->count(name) > 0) o->growth_options_given.push_back(name);
     run_train(*o);
   });

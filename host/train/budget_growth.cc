@@ -1,6 +1,7 @@
 #include "host/train/budget_growth.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
@@ -28,6 +29,7 @@ void BudgetGrowthOptions::check() const {
   if (!(min_gain_db >= 0) || !std::isfinite(min_gain_db)) bad("min_gain_db must be finite and >= 0");
   if (!(noise_multiple >= 0) || !std::isfinite(noise_multiple)) bad("noise_multiple must be finite and >= 0");
   if (!(min_transfer >= 0) || !std::isfinite(min_transfer)) bad("min_transfer must be finite and >= 0");
+  if (!(until_fraction > 0 && until_fraction <= 1)) bad("until_fraction must be in (0, 1]");
 }
 
 BudgetGrowth::BudgetGrowth(const BudgetGrowthOptions& o, uint32_t initial_gaussians, uint32_t ceiling,
@@ -42,13 +44,24 @@ BudgetGrowth::BudgetGrowth(const BudgetGrowthOptions& o, uint32_t initial_gaussi
     stop_reason_ = "the initialization already fills the ceiling of " + std::to_string(ceiling);
 }
 
+uint32_t BudgetGrowth::decisions_until(const TrainOptions& t) const {
+  const auto share = static_cast<uint32_t>(std::floor(options_.until_fraction * t.iterations));
+  return std::min(t.refine_until(), share + 1);  // a phase may end at the share's step itself
+}
+
+double BudgetGrowth::mcmc_growth_while_growing(double mcmc_growth) const {
+  // Filled means kFilled of the budget: (1 + g)^phase >= factor * kFilled, with a 1 % margin.
+  const double fill = std::pow(options_.factor * kFilled, 1.0 / options_.phase_refinements) * 1.01 - 1;
+  return std::max(mcmc_growth, fill);
+}
+
 bool BudgetGrowth::phase_ends_at(uint32_t step, const TrainOptions& t) const {
-  if (!(step > t.densify_from && step < t.refine_until() && step % t.densify_every == 0)) return false;
+  if (!(step > t.densify_from && step < decisions_until(t) && step % t.densify_every == 0)) return false;
   return (step / t.densify_every) % options_.phase_refinements == 0;
 }
 
 bool BudgetGrowth::another_phase_fits(uint32_t step, const TrainOptions& t) const {
-  return uint64_t{step} + uint64_t{options_.phase_refinements} * t.densify_every < t.refine_until();
+  return uint64_t{step} + uint64_t{options_.phase_refinements} * t.densify_every < decisions_until(t);
 }
 
 void BudgetGrowth::end_phase(uint32_t step, uint32_t gaussians, const std::vector<double>& views,

@@ -2,11 +2,10 @@
 // per budget tried (`search`, host/train/budget_search.h). The model starts at a small budget; at the end of
 // each phase (BudgetGrowthOptions), once MCMC's growth has filled the budget, the validation views are
 // scored, and the budget rises by `factor` while the validation PSNR, paired view by view with the last
-// measurement, still gains more than min_gain_db and noise_multiple standard errors. Then it stops (with
-// roll_back, back at the last budget that paid: the caller shrinks the model to budget()), the validation
-// views rejoin the training views, and the remaining iterations train at that size. The gain
-// between two phases also holds the phase's training progress at a fixed size, so the rule leans towards
-// growing; the margin is there for that. The state is a small JSON document that checkpoints carry, so a
+// measurement, still gains more than min_gain_db (and, if asked, noise_multiple standard errors). Then it
+// stops (with roll_back, back at the last budget that paid: the caller shrinks the model to budget()), the
+// validation views rejoin the training views, and the remaining iterations train at that size. Decisions end
+// by until_fraction of the iterations. The state is a small JSON document that checkpoints carry, so a
 // training interrupted during growth resumes with the same budget, views and decisions.
 #pragma once
 
@@ -45,8 +44,8 @@ class BudgetGrowth {
   const std::vector<GrowthPhase>& phases() const { return phases_; }
 
   // Whether `step` (1-based, before its refinement) ends a phase: every phase_refinements-th refinement step
-  // of `train` (the densification window and cadence). `another_phase_fits`: whether a phase after it
-  // would still end inside the window.
+  // of `train` (the densification window and cadence) up to until_fraction of the iterations.
+  // `another_phase_fits`: whether a phase after it would still end inside that window.
   bool phase_ends_at(uint32_t step, const TrainOptions& train) const;
   bool another_phase_fits(uint32_t step, const TrainOptions& train) const;
 
@@ -56,6 +55,12 @@ class BudgetGrowth {
                  const std::vector<double>& training_psnr_db, bool another_phase_fits, double wall_s);
   // Stops growing for a reason found outside the rule (the device's limits).
   void stop(const std::string& reason);
+  // MCMC's growth per refinement while it grows: at least `mcmc_growth`, and enough that a budget raised by
+  // `factor` fills within a phase's refinements.
+  double mcmc_growth_while_growing(double mcmc_growth) const;
+  // The first step at which no phase ends any more: the densification window's end or until_fraction of the
+  // iterations, whichever comes first.
+  uint32_t decisions_until(const TrainOptions& train) const;
 
   // The checkpoint's and metrics.json's form; from_json throws nlohmann::json::exception on a bad document.
   nlohmann::json to_json() const;

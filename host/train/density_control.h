@@ -34,6 +34,9 @@ class DensityControl {
     densify_.max_gaussians = max_gaussians;
     mcmc_.max_gaussians = max_gaussians;
   }
+  // MCMC's rows added per refinement from now on, as a fraction of the model (a growing budget fills each
+  // doubling within its phase).
+  void set_mcmc_growth(float growth) { mcmc_.growth = growth; }
 
  private:
   engine::Context* context_;

@@ -161,6 +161,7 @@ json run_options_json(const TrainOptions& o, const TrainingData& data) {
     train["growth"] = {{"start", o.growth.start},
                        {"factor", o.growth.factor},
                        {"phase_refinements", o.growth.phase_refinements},
+                       {"until_fraction", o.growth.until_fraction},
                        {"validation_every", o.growth.validation_every},
                        {"min_gain_db", o.growth.min_gain_db},
                        {"noise_multiple", o.growth.noise_multiple},

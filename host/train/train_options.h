@@ -15,20 +15,26 @@ namespace litgs::host {
 // (host/train/budget_growth.h). Phases of `phase_refinements` refinements; at each phase's end, once the
 // model fills its budget, the validation views (every `validation_every`-th training view, held back from
 // training while the budget grows) are scored, and the budget is multiplied by `factor` while the paired
-// per-view PSNR gain over the last measurement is above `min_gain_db` and `noise_multiple` standard errors,
-// and at least `min_transfer` times the gain of as many training views over the same phase (a larger model
-// that gains on the views it trains on but not on the others is fitting them, not the scene). With
+// per-view PSNR gain over the last measurement is above `min_gain_db` (the mean decides; with
+// `noise_multiple` > 0 also that many standard errors, and with `min_transfer` > 0 at least that share of the
+// gain of as many training views over the same phase: docs/cli/train.md says why both are off). With
 // `roll_back`, a doubling that did not pay is undone: the model returns to the last budget that did, keeping
 // its most opaque Gaussians (early stopping that restores the best, applied to the size).
 struct BudgetGrowthOptions {
   bool enabled = false;
-  uint32_t start = 5000;  // the first budget (raised to the initialization's size where larger)
+  // The first budget (raised to the initialization's size where larger): a floor, so that a sparse
+  // initialization (a front end's few thousand points) does not spend its doublings below any budget measured
+  // best on a real or synthetic scene (docs/budget.md).
+  uint32_t start = 10000;
   double factor = 2.0;
   uint32_t phase_refinements = 3;
+  // Decisions end by this share of the iterations, so that the model trains its last stretch at its final
+  // size on every training view (the validation views rejoin when it stops).
+  double until_fraction = 0.6;
   uint32_t validation_every = 8;
   double min_gain_db = 0.05;
-  double noise_multiple = 2.0;
-  double min_transfer = 0.5;
+  double noise_multiple = 0.0;
+  double min_transfer = 0.0;
   bool roll_back = true;
   void check() const;  // throws std::invalid_argument naming the bad field
 };

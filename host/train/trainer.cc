@@ -278,6 +278,8 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
   DensityControl density_control(ctx, o, planes, static_cast<float>(data.scene_extent_m));
   if (growth) {
     density_control.set_budget(growth->budget());
+    if (growth->growing())
+      density_control.set_mcmc_growth(static_cast<float>(growth->mcmc_growth_while_growing(o.mcmc_growth)));
     record.growth = growth->to_json();
     if (start == 0 && !growth->growing()) notice("budget growth: " + growth->stop_reason());
   }
@@ -336,7 +338,10 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
       if (model.size() > growth->budget())  // a doubling rolled back
         model.load_state(keep_most_opaque(model.download_state(), growth->budget()));
       notice("budget growth at iteration " + std::to_string(step) + ": " + growth->phases().back().decision);
-      if (!growth->growing()) sampler.set_pool(train_views);
+      if (!growth->growing()) {
+        sampler.set_pool(train_views);
+        density_control.set_mcmc_growth(o.mcmc_growth);
+      }
       record.growth = growth->to_json();
     }
     density_control.after_step(model, mcmc.get(), step, record.counters);
