@@ -344,6 +344,10 @@ void add_train_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_flag(
+      "--growth-no-last-doubling", [o](int64_t) { o->train.growth.last_doubling = false; },
+      "With --max-gaussians grow: at the decisions' window's end, no unjudged doubling even when the "
+      "extrapolated gain would pay");
+  cmd->add_flag(
       "--growth-no-roll-back", [o](int64_t) { o->train.growth.roll_back = false; },
       "With --max-gaussians grow: keep the doubling that did not pay instead of returning to the "
       "last budget that did");
@@ -397,9 +401,9 @@ void add_train_command(CLI::App& app) {
   cmd->callback([cmd, o] {
     for (const char* name : {"--budget-parsimony", "--budget-min-gain", "--budget-folds"})
       if (cmd->count(name) > 0) o->search_options_given.push_back(name);
-    for (const char* name :
-         {"--growth-start", "--growth-phase", "--growth-until", "--growth-validation-every",
-          "--growth-min-gain", "--growth-noise-multiple", "--growth-min-transfer", "--growth-no-roll-back"})
+    for (const char* name : {"--growth-start", "--growth-phase", "--growth-until",
+                             "--growth-validation-every", "--growth-min-gain", "--growth-noise-multiple",
+                             "--growth-min-transfer", "--growth-no-roll-back", "--growth-no-last-doubling"})
       if (cmd->count(name) > 0) o->growth_options_given.push_back(name);
     run_train(*o);
   });

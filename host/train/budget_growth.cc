@@ -128,7 +128,16 @@ void BudgetGrowth::end_phase(uint32_t step, uint32_t gaussians, const std::vecto
     p.decision = "stop: the next budget, " + std::to_string(next) + ", is above the ceiling of " +
                  std::to_string(ceiling_);
   } else if (!another_fits) {
-    p.decision = "stop: the densification window ends before a larger budget could fill";
+    // The last judgement: one more doubling, unjudged, when the next one's gain, extrapolated from the last
+    // two (a doubling gains less than the one before, by their ratio), would still pay.
+    const double next_gain = extrapolated_gain(p.gain_db);
+    if (options_.last_doubling && std::isfinite(next_gain) && next_gain > options_.min_gain_db) {
+      p.decision = "stop: the decisions' window ends; one more doubling, to " + std::to_string(next) +
+                   ", whose gain extrapolates to " + db(next_gain);
+      budget_ = static_cast<uint32_t>(next);
+    } else {
+      p.decision = "stop: the decisions' window ends before a larger budget could fill";
+    }
   } else {
     p.decision = std::string(first ? "grow: first score" : "grow: validation gained " + db(p.gain_db)) +
                  "; budget " + std::to_string(next);
@@ -136,6 +145,18 @@ void BudgetGrowth::end_phase(uint32_t step, uint32_t gaussians, const std::vecto
   }
   if (p.decision.rfind("stop", 0) == 0) stop_reason_ = p.decision;
   phases_.push_back(p);
+}
+
+double BudgetGrowth::extrapolated_gain(double last_gain) const {
+  if (!(last_gain > 0)) return NAN;
+  double before = NAN;  // the gain of the scored phase before the last
+  for (auto it = phases_.rbegin(); it != phases_.rend(); ++it)
+    if (std::isfinite(it->gain_db)) {
+      before = it->gain_db;
+      break;
+    }
+  const double ratio = before > last_gain ? last_gain / before : 0.5;
+  return last_gain * ratio;
 }
 
 void BudgetGrowth::stop(const std::string& reason) {

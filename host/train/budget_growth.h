@@ -67,6 +67,10 @@ class BudgetGrowth {
   static BudgetGrowth from_json(const BudgetGrowthOptions& options, const nlohmann::json& j);
 
  private:
+  // The next doubling's gain from the last one (not yet in phases_) and the one before: last * (last /
+  // before) when the gains fall, else half the last; NaN unless the last gained.
+  double extrapolated_gain(double last_gain) const;
+
   BudgetGrowthOptions options_;
   uint32_t budget_ = 0, ceiling_ = 0;
   std::string stop_reason_;

@@ -166,7 +166,8 @@ json run_options_json(const TrainOptions& o, const TrainingData& data) {
                        {"min_gain_db", o.growth.min_gain_db},
                        {"noise_multiple", o.growth.noise_multiple},
                        {"min_transfer", o.growth.min_transfer},
-                       {"roll_back", o.growth.roll_back}};
+                       {"roll_back", o.growth.roll_back},
+                       {"last_doubling", o.growth.last_doubling}};
   const TrainingDataOptions& d = data.options;
   json data_options = {{"downscale", d.downscale},
                        {"holdout_every", d.holdout_every},

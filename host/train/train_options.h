@@ -36,6 +36,9 @@ struct BudgetGrowthOptions {
   double noise_multiple = 0.0;
   double min_transfer = 0.0;
   bool roll_back = true;
+  // At the decisions' window's end, a growth that still gained takes one more doubling, unjudged, when the
+  // next gain extrapolated from the last two is above min_gain_db.
+  bool last_doubling = true;
   void check() const;  // throws std::invalid_argument naming the bad field
 };
 

@@ -125,6 +125,30 @@ TEST(BudgetGrowth, WithoutRollBackTheLastDoublingStays) {
   EXPECT_EQ(g.stop_reason().find("back to"), std::string::npos) << g.stop_reason();
 }
 
+TEST(BudgetGrowth, TheLastJudgementTakesOneMoreDoublingWhenTheExtrapolatedGainPays) {
+  BudgetGrowthOptions o;
+  BudgetGrowth g(o, 20000, 4000000, kViews.size());
+  g.end_phase(600, 20000, kViews, kViews, true, 1);
+  g.end_phase(900, 40000, shifted(kViews, 2.0), kViews, true, 2);
+  g.end_phase(1200, 80000, shifted(kViews, 2.8), kViews, false, 3);  // +0.8 after +2.0: next ~ +0.32
+  EXPECT_FALSE(g.growing());
+  EXPECT_EQ(g.budget(), 160000u);
+  EXPECT_NE(g.stop_reason().find("gain extrapolates to 0.320 dB"), std::string::npos) << g.stop_reason();
+
+  BudgetGrowth flat(o, 20000, 4000000, kViews.size());
+  flat.end_phase(600, 20000, kViews, kViews, true, 1);
+  flat.end_phase(900, 40000, shifted(kViews, 0.8), kViews, true, 2);
+  flat.end_phase(1200, 80000, shifted(kViews, 0.9), kViews, false, 3);  // +0.1 after +0.8: next ~ +0.0125
+  EXPECT_EQ(flat.budget(), 80000u);
+  EXPECT_NE(flat.stop_reason().find("window ends before"), std::string::npos) << flat.stop_reason();
+
+  o.last_doubling = false;
+  BudgetGrowth off(o, 20000, 4000000, kViews.size());
+  off.end_phase(600, 20000, kViews, kViews, true, 1);
+  off.end_phase(900, 40000, shifted(kViews, 2.0), kViews, false, 2);
+  EXPECT_EQ(off.budget(), 40000u);
+}
+
 TEST(BudgetGrowth, WaitsUntilTheModelFillsItsBudgetButNotPastTheWindow) {
   BudgetGrowthOptions o;
   BudgetGrowth g(o, 10000, 4000000, kViews.size());
