@@ -283,13 +283,12 @@ void add_train_command(CLI::App& app) {
       "Write point_cloud.ply in the scene's recentred frame (poses.txt's) instead of the original world "
       "frame (scene + world_offset_m)");
   cmd->add_option("--max-gaussians", o->max_gaussians,
-                  "Cap of the model size (the MCMC budget): a count, auto (derived from the surface the "
-                  "training views see at their resolution: the LiDAR map, else the initialization's points), "
-                  "or search (two trainings per doubling budget, each on the training views less its own "
-                  "validation eighth, while their mean validation PSNR still rises, looking one doubling "
-                  "past a plateau; then the final training at the budget found), or grow (mcmc: doubled "
-                  "inside one training while every 8th training view, held back meanwhile, still gains "
-                  "beyond its noise)")
+                  "Cap of the model size (the MCMC budget): grow (mcmc: doubled inside one training while "
+                  "every 8th training view, held back meanwhile, still gains), a count, auto (derived from "
+                  "the surface the training views see at their resolution: the LiDAR map, else the "
+                  "initialization's points), or search (two trainings per doubling budget, each on the "
+                  "training views less its own validation eighth, while their mean validation PSNR still "
+                  "rises, looking one doubling past a plateau; then the final training at the budget found)")
       ->capture_default_str();
   cmd->add_option("--budget-parsimony", o->budget_search.parsimony_se,
                   "With --max-gaussians search: keep the smallest budget whose validation PSNR, paired per "

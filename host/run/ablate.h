@@ -41,9 +41,8 @@ struct AblationStudy {
 std::vector<AblationStudy> ablation_studies(const std::string& names, const RunConfig& base);
 
 // The settings every variant starts from: run's defaults, but a fixed budget of 40k Gaussians (run's default
-// searches it). Each variant then differs from the others in its studied option only, where a search per
-// variant would let the budget move with it, and costs one training, not the search's two per budget tried
-// (docs/results.md, "The Gaussian budget").
+// grows it). Each variant then differs from the others in its studied option only, where a budget grown (or
+// searched) per variant would move with the studied option and be a second difference between the rows.
 RunConfig ablation_base_config();
 
 struct AblateOptions {

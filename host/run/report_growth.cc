@@ -9,14 +9,6 @@ namespace {
 
 using nlohmann::json;
 
-json field(const json& j, const char* key) {
-  return j.value(key, json());
-}
-
-std::string cell(const std::string& s) {
-  return "<td>" + s + "</td>";
-}
-
 bool stopped_here(const json& phase) {
   return phase.value("decision", std::string()).rfind("stop", 0) == 0;
 }
@@ -26,9 +18,10 @@ bool scored(const json& phase) {
 }
 
 std::string gain_text(const json& phase) {
-  if (!field(phase, "gain_db").is_number()) return "&ndash;";
-  std::string text = number(field(phase, "gain_db"), 2);
-  if (field(phase, "gain_se_db").is_number()) text += " &plusmn; " + number(field(phase, "gain_se_db"), 2);
+  if (!json_field(phase, "gain_db").is_number()) return "&ndash;";
+  std::string text = number(json_field(phase, "gain_db"), 2);
+  if (json_field(phase, "gain_se_db").is_number())
+    text += " &plusmn; " + number(json_field(phase, "gain_se_db"), 2);
   return text;
 }
 
@@ -42,10 +35,12 @@ std::string growth_html(const json& g) {
       break;
     }
   const std::string reason = g.value("stop_reason", std::string());
+  const std::string last = std::to_string(g.at("budget").get<uint64_t>());
   std::string h =
-      "<p>Grown inside the training (<code>max_gaussians: grow</code>): from a budget of " + first +
-      " to <b>" + std::to_string(g.at("budget").get<uint64_t>()) + "</b> (ceiling " +
-      std::to_string(g.value("ceiling", uint64_t{0})) + "). " +
+      "<p>Grown inside the training (<code>max_gaussians: grow</code>): " +
+      (phases.empty() ? "kept at its start, <b>" + last + "</b>"
+                      : "from a budget of " + first + " to <b>" + last + "</b>") +
+      " (ceiling " + std::to_string(g.value("ceiling", uint64_t{0})) + "). " +
       (reason.empty()
            ? std::string("Still growing when the training ended.")
            : "Stopped: " + escape_html(reason.rfind("stop: ", 0) == 0 ? reason.substr(6) : reason) + ".") +
@@ -58,10 +53,12 @@ std::string growth_html(const json& g) {
        "dB</th><th>gain dB</th><th>training views' gain dB</th><th>seconds</th><th>decision</th></tr>\n";
   for (const json& p : phases) {
     h += "<tr" + std::string(stopped_here(p) ? " class=kept" : "") + ">" +
-         cell(std::to_string(p.value("iteration", 0))) + cell(std::to_string(p.value("budget", 0))) +
-         cell(std::to_string(p.value("gaussians", 0))) + cell(number(field(p, "validation_psnr_db"), 2)) +
-         cell(gain_text(p)) + cell(number(field(p, "training_gain_db"), 2)) +
-         cell(number(field(p, "wall_s"), 1)) + "<td class=note>" +
+         html_cell(std::to_string(p.value("iteration", 0))) +
+         html_cell(std::to_string(p.value("budget", 0))) +
+         html_cell(std::to_string(p.value("gaussians", 0))) +
+         html_cell(number(json_field(p, "validation_psnr_db"), 2)) + html_cell(gain_text(p)) +
+         html_cell(number(json_field(p, "training_gain_db"), 2)) +
+         html_cell(number(json_field(p, "wall_s"), 1)) + "<td class=note>" +
          escape_html(p.value("decision", std::string())) + "</td></tr>\n";
   }
   return h + "</table>\n";

@@ -265,6 +265,14 @@ std::string escape_html(const std::string& s) {
   return out;
 }
 
+json json_field(const json& j, const char* key) {
+  return j.value(key, json());
+}
+
+std::string html_cell(const std::string& html) {
+  return "<td>" + html + "</td>";
+}
+
 std::string number(const json& v, int digits, const std::string& unit) {
   if (!v.is_number()) return "&ndash;";
   std::ostringstream s;

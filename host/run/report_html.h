@@ -27,6 +27,12 @@ std::string trace_curve_json(const std::string& trace_jsonl_text);
 // A JSON number with `digits` decimals and `unit` appended; an en dash (&ndash;) where it is not a number.
 std::string number(const nlohmann::json& v, int digits, const std::string& unit = "");
 
+// A field or null (a const json's operator[] on a missing key is undefined).
+nlohmann::json json_field(const nlohmann::json& j, const char* key);
+
+// One table cell: <td>html</td>.
+std::string html_cell(const std::string& html);
+
 // Text for HTML content and attribute values: < > & " escaped.
 std::string escape_html(const std::string& s);
 

@@ -54,7 +54,7 @@ struct RunConfig {
     std::vector<std::string> extra_args;
   } refine;
   struct Train {
-    // train's own defaults (host/train/train_defaults.h); ablate fixes the budget instead of searching it.
+    // train's own defaults (host/train/train_defaults.h); ablate fixes the budget instead of growing it.
     uint32_t iterations = train_defaults::kIterations;
     double downscale = 1.0;
     std::string strategy = train_defaults::kStrategy;
@@ -131,11 +131,10 @@ void for_each_field(Config& c, F&& f) {
     "mcmc (a fixed budget; the default, ahead of capped adc on the real DUNR facade: docs/results.md) | adc "
     "(3DGS's densification, capped by max_gaussians)");
   f("train", "max_gaussians", c.train.max_gaussians,
-    "MCMC budget (adc: cap): search (the default: doubled while the validation PSNR of trainings on the "
-    "training views less a validation eighth still rises, two trainings per budget; a cut-short search "
-    "continues on rerun; docs/budget.md), a count (40000 for a quick run), auto (from the surface the "
-    "training views see) or grow (doubled inside one training while held-back views still gain: "
-    "docs/cli/train.md)");
+    "MCMC budget (adc: cap): grow (the default: doubled inside one training while every 8th training view, "
+    "held back meanwhile, still gains; docs/cli/train.md), a count (40000 for a fixed one), auto (from the "
+    "surface the training views see) or search (one training per doubled budget and fold, while their "
+    "validation PSNR still rises: slower, the reference grow was measured against; docs/budget.md)");
   f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
   f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
   f("train", "init", c.train.init,

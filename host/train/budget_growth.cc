@@ -60,6 +60,12 @@ bool BudgetGrowth::phase_ends_at(uint32_t step, const TrainOptions& t) const {
   return (step / t.densify_every) % options_.phase_refinements == 0;
 }
 
+bool BudgetGrowth::any_phase(const TrainOptions& t) const {
+  for (uint32_t step = t.densify_from + 1; step < decisions_until(t); ++step)
+    if (phase_ends_at(step, t)) return true;
+  return false;
+}
+
 bool BudgetGrowth::another_phase_fits(uint32_t step, const TrainOptions& t) const {
   return uint64_t{step} + uint64_t{options_.phase_refinements} * t.densify_every < decisions_until(t);
 }

@@ -48,6 +48,8 @@ class BudgetGrowth {
   // `another_phase_fits`: whether a phase after it would still end inside that window.
   bool phase_ends_at(uint32_t step, const TrainOptions& train) const;
   bool another_phase_fits(uint32_t step, const TrainOptions& train) const;
+  // Whether any phase ends inside the decisions' window (a short training has none: its budget stays).
+  bool any_phase(const TrainOptions& train) const;
 
   // The decision at a phase's end: the validation views' and the training views' PSNR, each in the same
   // view order every time.

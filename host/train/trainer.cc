@@ -248,6 +248,10 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
     const std::vector<uint32_t> validation = growth_validation_views(train_views, o.growth.validation_every);
     growth.emplace(o.growth, static_cast<uint32_t>(initial.size()),
                    std::min<uint64_t>(o.max_gaussians, device_row_limit(ctx, initial)), validation.size());
+    if (growth->growing() && !growth->any_phase(o))
+      growth->stop("no phase ends before iteration " + std::to_string(growth->decisions_until(o)) +
+                   " (the decisions' window of " + std::to_string(o.iterations) +
+                   " iterations): the budget stays at its start");
     if (growth->growing()) {
       std::erase_if(growth_pool,
                     [&](uint32_t v) { return std::count(validation.begin(), validation.end(), v); });

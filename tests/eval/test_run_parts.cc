@@ -66,10 +66,10 @@ TEST_F(RunParts, ConfigKeysMayBeLeftOut) {
   EXPECT_EQ(to_json(read_run_config(write("empty.yaml", ""))), to_json(RunConfig()));
 }
 
-// ablate starts from run's defaults with a fixed budget (a search per variant would move the budget with the
+// ablate starts from run's defaults with a fixed budget (a budget grown per variant would move with the
 // studied option); keys its run.yaml leaves out keep that base, keys it gives override it.
-TEST_F(RunParts, AblationBaseFixesTheBudgetThatRunSearches) {
-  EXPECT_EQ(RunConfig().train.max_gaussians, "search");
+TEST_F(RunParts, AblationBaseFixesTheBudgetThatRunGrows) {
+  EXPECT_EQ(RunConfig().train.max_gaussians, "grow");
   const RunConfig base = ablation_base_config();
   EXPECT_EQ(base.train.max_gaussians, "40000");
   const RunConfig partial = read_run_config(write("ablate-partial.yaml", "train:\n  iterations: 50\n"), base);
@@ -256,6 +256,8 @@ TEST(Report, GrowthThatNeverScoredHasNoChartsAndADamagedRecordSaysSo) {
   EXPECT_TRUE(growth_chart_json(growth).is_null());
   EXPECT_EQ(html.find("growth_gaussians"), std::string::npos) << html;
   EXPECT_NE(html.find("Stopped: 1 validation view(s) cannot measure"), std::string::npos) << html;
+  growth["phases"] = nlohmann::json::array();  // a training too short for any phase
+  EXPECT_NE(growth_section_html(growth).find("kept at its start, <b>20000</b>"), std::string::npos);
   const std::string damaged = growth_section_html({{"budget", "<many>"}, {"phases", 3}});
   EXPECT_NE(damaged.find("is not a growth record"), std::string::npos) << damaged;
 }

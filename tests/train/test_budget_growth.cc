@@ -149,6 +149,16 @@ TEST(BudgetGrowth, TheLastJudgementTakesOneMoreDoublingWhenTheExtrapolatedGainPa
   EXPECT_EQ(off.budget(), 40000u);
 }
 
+TEST(BudgetGrowth, AShortTrainingHasNoPhaseAndSaysSo) {
+  TrainOptions t;
+  t.iterations = 300;  // ci/demo's: the decisions' window ends at 181, before densification starts at 500
+  BudgetGrowthOptions o;
+  const BudgetGrowth g(o, 20000, 4000000, kViews.size());
+  EXPECT_FALSE(g.any_phase(t));
+  t.iterations = 2000;
+  EXPECT_TRUE(g.any_phase(t));
+}
+
 TEST(BudgetGrowth, WaitsUntilTheModelFillsItsBudgetButNotPastTheWindow) {
   BudgetGrowthOptions o;
   BudgetGrowth g(o, 10000, 4000000, kViews.size());
