@@ -1,6 +1,5 @@
 #include "host/synth/calibration_set.h"
 
-#include <filesystem>
 #include <stdexcept>
 
 #include "host/synth/m2dgr_rig.h"
@@ -8,22 +7,6 @@
 
 namespace litgs::host::synth {
 namespace {
-
-namespace fs = std::filesystem;
-
-// A calibration set's files: --force removes these, nothing else.
-void prepare_output(const fs::path& out, bool force) {
-  if (fs::exists(out) && !fs::is_directory(out))
-    throw std::invalid_argument("synth: --out " + out.string() + " exists and is not a directory");
-  if (fs::is_directory(out) && !fs::is_empty(out)) {
-    if (!force)
-      throw std::invalid_argument("synth: --out " + out.string() +
-                                  " exists and is not empty (use --force to replace images/ and truth.json)");
-    fs::remove_all(out / "images");
-    fs::remove(out / "truth.json");
-  }
-  fs::create_directories(out);
-}
 
 // The scene options a board seen from still poses has no use for: refused rather than ignored.
 void refuse_scene_options(const SynthOptions& o) {
@@ -74,7 +57,7 @@ CalibrationSetReport generate_calibration_set(const SynthOptions& o, bool hot_ci
   c.hot_circles = hot_circles;
   if (const std::string problem = c.check(); !problem.empty())
     throw std::invalid_argument("synth: circle grid: " + problem);
-  prepare_output(o.out, o.force);
+  prepare_synth_output(o.out, o.force, {"images", "truth.json"}, "images/ and truth.json");
   write_circle_grid_set(o.out, c, resolve_synth_threads(o.threads));
   return {c.views, c.grid, c.camera.intrinsics().width, c.camera.intrinsics().height, !o.rig.empty()};
 }

@@ -27,20 +27,8 @@ constexpr double kTimeOrigin_s = 1700000000.0;
 constexpr double kLeadIn_s = 0.5;
 
 // The files and folders a scene consists of: --force removes these, nothing else.
-const char* const kSceneEntries[] = {"scene.yaml", "thermal", "thermal8",    "poses.txt",
-                                     "lidar",      "imu.csv", "anchors.txt", "gt"};
-
-void prepare_output(const fs::path& out, bool force) {
-  if (fs::exists(out) && !fs::is_directory(out))
-    throw std::invalid_argument("synth: --out " + out.string() + " exists and is not a directory");
-  if (fs::is_directory(out) && !fs::is_empty(out)) {
-    if (!force)
-      throw std::invalid_argument("synth: --out " + out.string() +
-                                  " exists and is not empty (use --force to replace the scene files in it)");
-    for (const char* name : kSceneEntries) fs::remove_all(out / name);
-  }
-  fs::create_directories(out);
-}
+const std::vector<std::string> kSceneEntries = {"scene.yaml", "thermal", "thermal8",    "poses.txt",
+                                                "lidar",      "imu.csv", "anchors.txt", "gt"};
 
 // The frames that the NUC freezes: runs of 1..length_max frames, the first at [first_min, first_max], then
 // every [interval_min, interval_max] frames.
@@ -100,6 +88,20 @@ std::string SynthOptions::check() const {
   return "";
 }
 
+void prepare_synth_output(const fs::path& out, bool force, const std::vector<std::string>& entries,
+                          const std::string& what_force_replaces) {
+  if (fs::exists(out) && !fs::is_directory(out))
+    throw std::invalid_argument("synth: --out " + out.string() + " exists and is not a directory");
+  if (fs::is_directory(out) && !fs::is_empty(out)) {
+    if (!force)
+      throw std::invalid_argument("synth: --out " + out.string() +
+                                  " exists and is not empty (use --force to replace " + what_force_replaces +
+                                  ")");
+    for (const std::string& name : entries) fs::remove_all(out / name);
+  }
+  fs::create_directories(out);
+}
+
 int resolve_synth_threads(int requested) {
   return requested > 0 ? requested : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 8);
 }
@@ -139,7 +141,7 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
                                       {"trajectory", p.trajectory.check()}})
     if (!problem.empty()) throw std::invalid_argument(std::string("synth: preset ") + what + "." + problem);
   const int threads = resolve_synth_threads(options.threads);
-  prepare_output(options.out, options.force);
+  prepare_synth_output(options.out, options.force, kSceneEntries, "the scene files in it");
 
   const Trajectory trajectory(p.trajectory);
   const io::CameraIntrinsics K = p.camera.intrinsics();

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "io/scene_types.h"
 
@@ -58,6 +59,12 @@ struct SynthReport {
 // Generates and writes the scene. std::invalid_argument (naming the field) on bad options or a non-empty
 // `out` without `force`; io::IoError on file errors. Files are written atomically, scene.yaml last.
 SynthReport generate_synthetic_scene(const SynthOptions& options);
+
+// Makes `out` ready for a synthetic output: created if missing; if it is not empty, refused without `force`
+// (the message names what --force would replace), else `entries` (files or folders in it) are removed and
+// nothing else. std::invalid_argument when it is refused or `out` is a file.
+void prepare_synth_output(const std::filesystem::path& out, bool force,
+                          const std::vector<std::string>& entries, const std::string& what_force_replaces);
 
 // SynthOptions::threads as a count: 0 gives the hardware's, at most 8.
 int resolve_synth_threads(int requested);

@@ -59,6 +59,22 @@ std::vector<CalibrationView> projected_views(const io::CameraIntrinsics& k, cons
   return views;
 }
 
+// Each rendered view's detection (both polarities tried), named view0, view1, ...
+std::vector<CalibrationView> detected_views(const std::vector<host::synth::CircleGridView>& rendered,
+                                            const CircleGrid& grid, bool clahe) {
+  std::vector<CalibrationView> views;
+  for (size_t i = 0; i < rendered.size(); ++i)
+    views.push_back({"view" + std::to_string(i), rendered[i].raw.width, rendered[i].raw.height,
+                     detect_circle_grid(rendered[i].raw, grid, Polarity::kAuto, clahe)});
+  return views;
+}
+
+size_t found_count(const std::vector<CalibrationView>& views) {
+  size_t found = 0;
+  for (const auto& v : views) found += v.detection.found;
+  return found;
+}
+
 TEST(CalibIntrinsics, FortyViewsWithPointThreePixelNoiseRecoverTheCamera) {
   const io::CameraIntrinsics k = true_camera();
   const CircleGrid grid = parse_circle_grid("4x11", 0.05);
@@ -97,12 +113,8 @@ TEST(CalibIntrinsics, RenderedThermalViewsAreDetectedAndRecoverTheCamera) {
   const auto rendered = host::synth::render_circle_grid_views(o, 2);
   const io::CameraIntrinsics k = o.camera.intrinsics();
   const CircleGrid grid = parse_circle_grid("4x11", o.grid.spacing_m);
-  std::vector<CalibrationView> views;
-  for (size_t i = 0; i < rendered.size(); ++i)
-    views.push_back({"view" + std::to_string(i), rendered[i].raw.width, rendered[i].raw.height,
-                     detect_circle_grid(rendered[i].raw, grid, Polarity::kAuto, false)});
-  size_t found = 0;
-  for (const auto& v : views) found += v.detection.found;
+  const std::vector<CalibrationView> views = detected_views(rendered, grid, false);
+  const size_t found = found_count(views);
   const IntrinsicsResult r = calibrate_intrinsics(views, grid, {});
   std::printf(
       "  %zu of 40 views found, %zu used; fx %.3f (true %.3f), cx %.3f (%.1f), cy %.3f (%.1f), RMS %.3f px\n",
@@ -145,12 +157,8 @@ TEST(CalibIntrinsics, ClaheBeforeDetectionFindsTheRenderedGridsAndTheSameCamera)
   const auto rendered = host::synth::render_circle_grid_views(o, 2);
   const io::CameraIntrinsics k = o.camera.intrinsics();
   const CircleGrid grid = parse_circle_grid("4x11", o.grid.spacing_m);
-  std::vector<CalibrationView> views;
-  for (size_t i = 0; i < rendered.size(); ++i)
-    views.push_back({"view" + std::to_string(i), rendered[i].raw.width, rendered[i].raw.height,
-                     detect_circle_grid(rendered[i].raw, grid, Polarity::kAuto, true)});
-  size_t found = 0;
-  for (const auto& v : views) found += v.detection.found;
+  const std::vector<CalibrationView> views = detected_views(rendered, grid, true);
+  const size_t found = found_count(views);
   const IntrinsicsResult r = calibrate_intrinsics(views, grid, {});
   std::printf("  CLAHE: %zu of 20 views found; fx %.3f (true %.3f), RMS %.3f px\n", found, r.camera.fx, k.fx,
               r.rms_px);
