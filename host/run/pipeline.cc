@@ -11,6 +11,7 @@
 #include "host/run/child_process.h"
 #include "host/run/content_hash.h"
 #include "host/run/stage.h"
+#include "host/run/stage_estimate.h"
 #include "io/atomic_file.h"
 
 namespace litgs::host::run {
@@ -85,6 +86,13 @@ class Runner {
                {"status", "running"},
                {"stages", json::array()}};
     const auto start = std::chrono::steady_clock::now();
+    device_ = query_device(o_.engine);
+    try {
+      size_ = size_before_import(ctx_.kind, ctx_.input, o_.config);
+    } catch (const std::exception&) {
+      // A scene that cannot be read has no estimate: its import stage says what is wrong with it.
+    }
+    if (size_) print_estimates(from, until);
     for (size_t i = 0; i < table.size(); ++i) {
       const Stage& stage = table[i];
       json& entry = record_["stages"].emplace_back(json{{"name", stage.name}});
@@ -106,6 +114,15 @@ class Runner {
         throw StageFailed(stage.name, e.what());
       }
       write_json(record_path_, record_);
+      if (stage.name == "import" && !size_) {
+        // Only the import knows a recording's size: the stages after it are estimated now.
+        try {
+          size_ = size_of_scene(ctx_.scene());
+          print_estimates(i + 1, until);
+        } catch (const std::exception&) {
+          // No estimates: the next stage reads the scene and names what is wrong with it.
+        }
+      }
     }
     finish(start, "done");
     summary();
@@ -187,6 +204,10 @@ class Runner {
     if (resume) command.insert(command.end(), plan.resume_args.begin(), plan.resume_args.end());
     out_ << tag << ": " << stage.what << (resume ? " (resuming from " + continue_from + ")" : "")
          << (forced ? " (forced by --from)" : "") << "\n";
+    if (const auto e = estimate(stage.name); e && e->high_s > 0) {
+      entry["estimate_s"] = {e->low_s, e->high_s};
+      out_ << tag << ": estimate: " << estimate_text(*e) << " (" << e->basis << ")\n";
+    }
     for (const std::string& note : plan.notes) out_ << tag << ": note: " << note << "\n";
     out_ << std::flush;
     ChildResult child;
@@ -227,6 +248,30 @@ class Runner {
     out_ << tag << line;
   }
 
+  std::optional<StageEstimate> estimate(const std::string& stage) const {
+    if (!size_) return std::nullopt;
+    return estimate_stage(stage, ctx_.kind, *size_, o_.config, device_);
+  }
+
+  // One line before the stages from..until run: what each will cost, as far as the size is known.
+  void print_estimates(size_t from, size_t until) {
+    const auto& table = stage_table();
+    std::string line;
+    double low = 0, high = 0;
+    for (size_t i = from; i <= until && i < table.size(); ++i) {
+      std::string why;
+      const auto e = estimate_stage(table[i].name, ctx_.kind, *size_, o_.config, device_, &why);
+      if (e && e->high_s == 0) continue;  // nothing to do
+      line += (line.empty() ? "" : ", ") + table[i].name + " " + (e ? estimate_text(*e) : "? (" + why + ")");
+      if (e) low += e->low_s, high += e->high_s;
+    }
+    if (line.empty()) return;
+    out_ << "run: estimate (from the scene's size and the device; an estimate, not a promise): " << line
+         << "; stages that turn out up to date or skipped take less; in all "
+         << estimate_text({low, high, ""}) << "\n"
+         << std::flush;
+  }
+
   // The child's last line that says something: CLI11's "Run with --help" hint is skipped.
   static std::string last_line(const std::string& text) {
     std::istringstream in(text);
@@ -260,6 +305,8 @@ class Runner {
                       megabytes(s.value("peak_host_bytes", uint64_t{0})).c_str());
         out_ << line;
       }
+      if (s.contains("estimate_s"))
+        out_ << " (estimated " << estimate_text({s["estimate_s"][0], s["estimate_s"][1], ""}) << ")";
       out_ << "\n";
     }
     const json& results = ctx_.results;
@@ -307,6 +354,8 @@ class Runner {
   StageContext ctx_;
   json record_;
   fs::path record_path_;  // DIR/run.json
+  EstimateDevice device_;
+  std::optional<RunSize> size_;  // unknown before a recording's import
   std::map<std::string, std::string> hashes_;
 };
 

@@ -14,7 +14,8 @@ inline constexpr uint32_t kIterations = 2000;
 inline constexpr const char* kStrategy = "mcmc";
 // --max-gaussians: a count, auto, search or grow (host/train/budget_flag.h).
 inline constexpr const char* kMaxGaussians = "grow";
-inline constexpr double kMcmcGrowth = 0.3;  // rows added per refinement, as a fraction of the model
-inline constexpr double kLambdaGeo = 0.6;   // L = (1 - lambda_geo) L_pho + lambda_geo L_geo
+inline constexpr double kMcmcGrowth = 0.3;       // rows added per refinement, as a fraction of the model
+inline constexpr double kLambdaGeo = 0.6;        // L = (1 - lambda_geo) L_pho + lambda_geo L_geo
+inline constexpr uint32_t kGrowthStart = 10000;  // grow's first budget (BudgetGrowthOptions::start)
 
 }  // namespace litgs::host::train_defaults

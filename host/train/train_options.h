@@ -25,7 +25,7 @@ struct BudgetGrowthOptions {
   // The first budget (raised to the initialization's size where larger): a floor, so that a sparse
   // initialization (a front end's few thousand points) does not spend its doublings below any budget measured
   // best on a real or synthetic scene (docs/budget.md).
-  uint32_t start = 10000;
+  uint32_t start = train_defaults::kGrowthStart;
   double factor = 2.0;
   uint32_t phase_refinements = 3;
   // Decisions end by this share of the iterations, so that the model trains its last stretch at its final

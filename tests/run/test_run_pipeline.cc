@@ -60,7 +60,16 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
     if (s["status"] == "done") {
       EXPECT_GT(s["seconds"].get<double>(), 0.0) << s;
       EXPECT_GT(s["peak_host_bytes"].get<double>(), 1e6) << s;  // a real process's resident set
+      // Each stage that ran was estimated before it started (the synth scene's size is known up front).
+      ASSERT_TRUE(s.contains("estimate_s")) << s;
+      EXPECT_GT(s["estimate_s"][0].get<double>(), 0.0) << s;
+      EXPECT_GE(s["estimate_s"][1].get<double>(), s["estimate_s"][0].get<double>()) << s;
     }
+  // The whole run's estimate comes before the first stage starts.
+  const size_t estimate_line = r.output.find("run: estimate (");
+  ASSERT_NE(estimate_line, std::string::npos) << r.output;
+  EXPECT_LT(estimate_line, r.output.find("run: [1/7] import"));
+  EXPECT_NE(r.output.find("run: [5/7] train: estimate: about "), std::string::npos) << r.output;
   const nlohmann::json eval = read_json_file(dir / "eval" / "eval.json");
   EXPECT_GT(eval["psnr_db"].get<double>(), 5.0);
   // ATE before and after refinement: eval measures it with refine's Umeyama ATE at the same frames.
