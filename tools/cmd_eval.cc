@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 
+#include "host/eval/eval_option_names.h"
 #include "host/eval/evaluate_model.h"
 #include "host/eval/trajectory_eval.h"
 #include "host/eval/view_images.h"
@@ -137,6 +138,7 @@ void run_eval(const EvalCliOptions& cli) {
 }  // namespace
 
 void add_eval_command(CLI::App& app) {
+  namespace E = host::eval_option;
   auto o = std::make_shared<EvalCliOptions>();
   CLI::App* cmd = app.add_subcommand(
       "eval",
@@ -152,12 +154,10 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--views-out", o->views_out,
                   "Write each held-out view's render, frame, error map, false colour and depth as PNG here");
   add_data_flags(cmd, o->eval.data, o->data_flags);
-  cmd->add_option("--emd-samples", o->eval.emd.samples, "EMD: points drawn from each side")
-      ->capture_default_str();
-  cmd->add_option("--emd-rounds", o->eval.emd.rounds, "EMD: independent draws (mean and std reported)")
-      ->capture_default_str();
-  cmd->add_option("--seed", o->eval.emd.seed, "EMD: seed of the draws")->capture_default_str();
-  cmd->add_flag("!--no-geometry", o->eval.geometry, "Skip EMD and the plane residuals");
+  cmd->add_option(E::kEmdSamples.flag, o->eval.emd.samples, E::kEmdSamples.help)->capture_default_str();
+  cmd->add_option(E::kEmdRounds.flag, o->eval.emd.rounds, E::kEmdRounds.help)->capture_default_str();
+  cmd->add_option(E::kSeed.flag, o->eval.emd.seed, E::kSeed.help)->capture_default_str();
+  cmd->add_flag(E::kGeometry.flag, o->eval.geometry, E::kGeometry.help);
   cmd->add_flag("!--emd-uniform", o->eval.emd.weight_by_opacity,
                 "EMD: draw Gaussian centres uniformly instead of in proportion to opacity (a diagnostic)");
   cmd->callback([o] { run_eval(*o); });

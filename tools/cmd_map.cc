@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "host/lidar_map/map_builder.h"
+#include "host/lidar_map/map_option_names.h"
 #include "tools/commands.h"
 
 namespace litgs::tools {
@@ -28,11 +29,11 @@ void add_map_command(CLI::App& app) {
   auto force = std::make_shared<bool>(false);
   auto o = std::make_shared<host::LidarMapOptions>();
   c->add_option("scene", *scene, "Scene directory")->required()->check(CLI::ExistingDirectory);
-  c->add_option("--voxel", o->voxel_m, "Voxel edge in metres (points averaged per voxel)")
+  c->add_option(host::map_option::kVoxel.flag, o->voxel_m, host::map_option::kVoxel.help)
       ->capture_default_str();
   c->add_option("--out", *out, "Write the map here instead of lidar/map.pcd (scene.yaml untouched)");
   c->add_flag("--force", *force, "Replace an existing lidar/map.pcd");
-  c->add_flag("!--no-deskew", o->deskew, "Ignore the scans' per-point time field");
+  c->add_flag(host::map_option::kDeskew.flag, o->deskew, host::map_option::kDeskew.help);
   c->add_option(
        "--holdout-every", o->holdout_every,
        "Leave scans 0, N, 2N, ... out of the map, for eval's geometry and refine's scan check (0: none)")

@@ -5,39 +5,33 @@
 #include <iostream>
 #include <memory>
 
+#include "host/refine/refine_option_names.h"
 #include "host/refine/scene_refine.h"
 #include "tools/commands.h"
 
 namespace litgs::tools {
 
 void add_refine_command(CLI::App& app) {
+  namespace R = host::refine_option;
   CLI::App* c =
       app.add_subcommand("refine", "Refine the scene's poses: anchors, LiDAR planes, bundle adjustment");
   auto scene = std::make_shared<std::filesystem::path>();
   auto o = std::make_shared<host::refine::SceneRefineOptions>();
   auto planes = std::make_shared<bool>(true);
   c->add_option("scene", *scene, "Scene directory")->required()->check(CLI::ExistingDirectory);
-  c->add_option("--anchors", o->anchors,
-                "The estimator's anchors (weights and priors): auto (with oracle tracks only; on the front "
-                "end's tracks they made the poses worse) | on | off")
-      ->capture_default_str();
+  c->add_option(R::kAnchors.flag, o->anchors, R::kAnchors.help)->capture_default_str();
   auto no_anchors = std::make_shared<bool>(false);
   c->add_flag("--no-anchors", *no_anchors, "The same as --anchors off");
-  c->add_flag("!--no-planes", *planes, "No LiDAR point-to-plane term");
+  c->add_flag(R::kPlanes.flag, *planes, R::kPlanes.help);
   c->add_option("--alpha-min", o->refine.weights.alpha_min,
                 "Anchors' share of a frame's weight, slowest frames")
       ->capture_default_str();
   c->add_option("--alpha-max", o->refine.weights.alpha_max, "... and fastest frames")->capture_default_str();
-  c->add_option("--rounds", o->refine.rounds, "Rounds (association, solve, rejection)")
-      ->capture_default_str();
-  c->add_option("--threads", o->refine.threads, "Ceres threads")->capture_default_str();
+  c->add_option(R::kRounds.flag, o->refine.rounds, R::kRounds.help)->capture_default_str();
+  c->add_option(R::kThreads.flag, o->refine.threads, R::kThreads.help)->capture_default_str();
   c->add_option("--window", o->refine.window, "Frames per local window in round 1 (0: none)")
       ->capture_default_str();
-  c->add_option(
-       "--tracks", o->tracks,
-       "Track source: auto or sfm (the front end's SCENE/sfm/, from litgs-engine match), oracle (projected "
-       "from a synth scene's true poses: an experiment that separates the refinement from the front end)")
-      ->capture_default_str();
+  c->add_option(R::kTracks.flag, o->tracks, R::kTracks.help)->capture_default_str();
   c->add_option("--outliers", o->synthetic.outlier_fraction, "Oracle tracks: fraction of wrong matches")
       ->capture_default_str();
   c->add_option("--pixel-noise", o->synthetic.pixel_noise_px, "Oracle tracks: pixel noise (px)")
@@ -56,11 +50,7 @@ void add_refine_command(CLI::App& app) {
                 "priors are not kept (0: no guard)")
       ->capture_default_str();
   auto absolute = std::make_shared<bool>(false);
-  c->add_option(
-       "--priors", o->priors,
-       "auto (from scene.yaml's poses_origin: Metashape and COLMAP imports are absolute) | absolute (a "
-       "pose prior on every frame) | odometry (relative priors between neighbouring frames)")
-      ->capture_default_str();
+  c->add_option(R::kPriors.flag, o->priors, R::kPriors.help)->capture_default_str();
   c->add_option(
        "--odometry-rotation-sigma", o->refine.ba.odometry_sigma_r_rad,
        "Odometry priors: orientation prior on every frame, radians (plus 0.0005 per metre travelled; 0: "

@@ -19,6 +19,7 @@
 #include "host/train/initial_model.h"
 #include "host/train/lidar_planes.h"
 #include "host/train/scene_budget.h"
+#include "host/train/train_option_names.h"
 #include "host/train/trainer.h"
 #include "host/train/training_data.h"
 #include "host/train/true_planes.h"
@@ -230,6 +231,7 @@ void run_train(TrainCliOptions o) {
 }  // namespace
 
 void add_train_command(CLI::App& app) {
+  namespace T = host::train_option;
   auto o = std::make_shared<TrainCliOptions>();
   CLI::App* cmd = app.add_subcommand("train", "Train a Gaussian map of a scene directory on the device");
   cmd->add_option("scene", o->scene, "Scene directory (docs/scene-format.md)")
@@ -237,10 +239,9 @@ void add_train_command(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--out", o->out, "Output directory (point_cloud.ply, metrics.json, checkpoints/)")
       ->required();
-  cmd->add_option("--iterations", o->train.iterations, "Training iterations")->capture_default_str();
+  cmd->add_option(T::kIterations.flag, o->train.iterations, T::kIterations.help)->capture_default_str();
   add_data_flags(cmd, o->data, o->data_flags);
-  cmd->add_option("--lambda-geo", o->train.lambda_geo, "Weight of the LiDAR point-to-plane loss")
-      ->capture_default_str();
+  cmd->add_option(T::kLambdaGeo.flag, o->train.lambda_geo, T::kLambdaGeo.help)->capture_default_str();
   cmd->add_option("--geo-robust-scale", o->train.geo_robust_scale_m,
                   "Cauchy scale of the point-to-plane residual, metres (0: squared residuals)")
       ->capture_default_str();
@@ -248,12 +249,7 @@ void add_train_command(CLI::App& app) {
                 "The LiDAR term moves Gaussians but leaves their opacity to the image");
   cmd->add_option("--lambda-ssim", o->train.lambda_ssim, "Weight of D-SSIM in the photometric loss")
       ->capture_default_str();
-  cmd->add_option(
-         "--init", o->initial.init,
-         "auto (the LiDAR map, else the front end's points in SCENE/sfm/, else random), random, sfm (the "
-         "front end's points), or a "
-         ".ply/.pcd point file")
-      ->capture_default_str();
+  cmd->add_option(T::kInit.flag, o->initial.init, T::kInit.help)->capture_default_str();
   cmd->add_option_function<std::string>(
          "--init-frame", [o](const std::string& frame) { o->initial.init_in_scene_frame = frame == "scene"; },
          "--init FILE's frame: world (the original, scene + world_offset_m) or scene (recentred, as the "
@@ -271,9 +267,8 @@ void add_train_command(CLI::App& app) {
          "random subset; never more than --max-gaussians)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  cmd->add_option("--eval-every", o->train.eval_every,
-                  "Evaluate held-out views every K iterations (0: at the end)");
-  cmd->add_option("--checkpoint-every", o->train.checkpoint_every, "Checkpoint every K iterations (0: none)");
+  cmd->add_option(T::kEvalEvery.flag, o->train.eval_every, T::kEvalEvery.help);
+  cmd->add_option(T::kCheckpointEvery.flag, o->train.checkpoint_every, T::kCheckpointEvery.help);
   cmd->add_flag(
       "--resume", o->train.resume,
       "Continue from the newest checkpoint in --out, with its options (only --iterations, --eval-every, "
@@ -282,14 +277,7 @@ void add_train_command(CLI::App& app) {
       "--recentred-output", o->train.recentred_output,
       "Write point_cloud.ply in the scene's recentred frame (poses.txt's) instead of the original world "
       "frame (scene + world_offset_m)");
-  cmd->add_option("--max-gaussians", o->max_gaussians,
-                  "Cap of the model size (the MCMC budget): grow (mcmc: doubled inside one training while "
-                  "every 8th training view, held back meanwhile, still gains), a count, auto (derived from "
-                  "the surface the training views see at their resolution: the LiDAR map, else the "
-                  "initialization's points), or search (two trainings per doubling budget, each on the "
-                  "training views less its own validation eighth, while their mean validation PSNR still "
-                  "rises, looking one doubling past a plateau; then the final training at the budget found)")
-      ->capture_default_str();
+  cmd->add_option(T::kMaxGaussians.flag, o->max_gaussians, T::kMaxGaussians.help)->capture_default_str();
   cmd->add_option("--budget-parsimony", o->budget_search.parsimony_se,
                   "With --max-gaussians search: keep the smallest budget whose validation PSNR, paired per "
                   "view, lacks at most this many standard errors against the last budget that gained (1: the "
@@ -350,17 +338,15 @@ void add_train_command(CLI::App& app) {
       "--growth-no-roll-back", [o](int64_t) { o->train.growth.roll_back = false; },
       "With --max-gaussians grow: keep the doubling that did not pay instead of returning to the "
       "last budget that did");
-  cmd->add_option("--strategy", o->train.strategy,
-                  "Densification: adc (3DGS) or mcmc (fixed budget, 3DGS-MCMC)")
+  cmd->add_option(T::kStrategy.flag, o->train.strategy, T::kStrategy.help)
       ->check(CLI::IsMember({"adc", "mcmc"}))
       ->capture_default_str();
-  cmd->add_option("--mcmc-growth", o->train.mcmc_growth, "MCMC: growth per refinement (fraction)")
-      ->capture_default_str();
+  cmd->add_option(T::kMcmcGrowth.flag, o->train.mcmc_growth, T::kMcmcGrowth.help)->capture_default_str();
   cmd->add_option("--mcmc-noise-lr", o->train.mcmc_noise_lr, "MCMC: position noise x means learning rate")
       ->capture_default_str();
   cmd->add_flag("--deterministic", o->train.deterministic, "Bit-identical gradients (slower)");
   cmd->add_option("--sh-degree", o->train.sh_degree, "Final SH degree")->capture_default_str();
-  cmd->add_option("--seed", o->train.seed, "Seed of view order and densification")->capture_default_str();
+  cmd->add_option(T::kSeed.flag, o->train.seed, T::kSeed.help)->capture_default_str();
   cmd->add_option("--plane-prune-k", o->train.plane_prune_k,
                   "Prune Gaussians beyond median + k * 1.4826 * MAD of their LiDAR-plane distances (at least "
                   "10 cm; 0: off)")
@@ -378,7 +364,8 @@ void add_train_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--trace", o->trace,
                   "Append each progress report (iteration, seconds, loss, Gaussians) as a JSON line to FILE");
-  cmd->add_option("--progress-every", o->train.progress_every, "Progress cadence")->capture_default_str();
+  cmd->add_option(T::kProgressEvery.flag, o->train.progress_every, T::kProgressEvery.help)
+      ->capture_default_str();
   cmd->add_option("--level-model", o->train.level_model,
                   "Radiometric level per frame, learnt with the map: none, affine (gain and offset per "
                   "frame) or affine-vignetting (and a vignetting shared by all frames)")

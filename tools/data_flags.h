@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "host/train/train_option_names.h"
 #include "host/train/training_data.h"
 
 namespace litgs::tools {
@@ -17,13 +18,11 @@ struct DataFlags {
 
 // --downscale, --holdout-every, --intensity, --poses onto `data` and `flags`.
 inline void add_data_flags(CLI::App* cmd, host::TrainingDataOptions& data, DataFlags& flags) {
-  cmd->add_option("--downscale", data.downscale, "Divide image size and intrinsics by this")
-      ->capture_default_str();
-  cmd->add_option("--holdout-every", data.holdout_every, "Hold out every Nth frame (0: none)")
-      ->capture_default_str();
-  cmd->add_option("--intensity", flags.intensity, "auto | percentile | linear")->capture_default_str();
-  cmd->add_option("--poses", flags.poses, "estimated (poses.txt) or truth (gt/poses.txt of synthetic scenes)")
-      ->capture_default_str();
+  namespace T = host::train_option;
+  cmd->add_option(T::kDownscale.flag, data.downscale, T::kDownscale.help)->capture_default_str();
+  cmd->add_option(T::kHoldoutEvery.flag, data.holdout_every, T::kHoldoutEvery.help)->capture_default_str();
+  cmd->add_option(T::kIntensity.flag, flags.intensity, T::kIntensity.help)->capture_default_str();
+  cmd->add_option(T::kPoses.flag, flags.poses, T::kPoses.help)->capture_default_str();
 }
 
 // The string flags into `data`; std::invalid_argument naming a bad value.

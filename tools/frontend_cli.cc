@@ -5,13 +5,14 @@
 #include <iostream>
 #include <sstream>
 
+#include "host/frontend/match_option_names.h"
 namespace litgs::tools {
 
 host::frontend::FrontendOptions FrontendCli::resolved() const {
   host::frontend::FrontendOptions o = options;
   o.features.type = host::frontend::parse_feature_type(features);
   o.pairs = host::frontend::parse_pairs(pairs);
-  o.preprocess.clahe = !no_clahe;
+  o.preprocess.clahe = clahe;
   o.prior_epipolar = !no_prior_epipolar;
   if (poses != "estimated" && poses != "truth")
     throw std::invalid_argument("--poses " + poses + ": expected estimated or truth");
@@ -22,15 +23,13 @@ host::frontend::FrontendOptions FrontendCli::resolved() const {
 
 void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli) {
   host::frontend::FrontendOptions& o = cli->options;
-  cmd.add_option("--features", cli->features, "orb | sift | akaze")->capture_default_str();
-  cmd.add_flag("--no-clahe", cli->no_clahe, "No CLAHE before detection (default: on)");
-  cmd.add_option("--pairs", cli->pairs,
-                 "covisible[:N] (sequential:N first, then frusta that overlap at the scene depth) | "
-                 "sequential:N | exhaustive")
+  namespace M = host::match_option;
+  cmd.add_option(M::kFeatures.flag, cli->features, M::kFeatures.help)->capture_default_str();
+  cmd.add_flag(M::kClahe.flag, cli->clahe, M::kClahe.help);
+  cmd.add_option(M::kPairs.flag, cli->pairs, M::kPairs.help)->capture_default_str();
+  cmd.add_option(M::kMaxKeypoints.flag, o.features.max_keypoints, M::kMaxKeypoints.help)
       ->capture_default_str();
-  cmd.add_option("--max-keypoints", o.features.max_keypoints, "Keypoint budget per image")
-      ->capture_default_str();
-  cmd.add_option("--threads", o.threads, "Worker threads (0: all cores)")->capture_default_str();
+  cmd.add_option(M::kThreads.flag, o.threads, M::kThreads.help)->capture_default_str();
   cmd.add_option("--grid", o.features.grid_cols, "Grid bucketing: N x N cells (0: off)")
       ->capture_default_str()
       ->each([&o](const std::string&) { o.features.grid_rows = o.features.grid_cols; });

@@ -17,7 +17,7 @@ struct FrontendCli {
   host::frontend::FrontendOptions options;
   std::string features = "sift";
   std::string pairs = "covisible";
-  bool no_clahe = false;
+  bool clahe = true;
   bool no_prior_epipolar = false;
   std::string poses = "estimated";
   // Parses the text options into `options`; std::invalid_argument on a bad value.

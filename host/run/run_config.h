@@ -9,7 +9,12 @@
 #include <string>
 #include <vector>
 
+#include "host/eval/eval_option_names.h"
+#include "host/frontend/match_option_names.h"
+#include "host/lidar_map/map_option_names.h"
+#include "host/refine/refine_option_names.h"
 #include "host/train/train_defaults.h"
+#include "host/train/train_option_names.h"
 
 namespace litgs::host::run {
 
@@ -86,6 +91,10 @@ struct RunConfig {
 // Calls f(section, key, value&, comment) for every option, in the order run.yaml lists them.
 template <class Config, class F>
 void for_each_field(Config& c, F&& f) {
+  // An option its command shares: the key and the help from the command's table (host/option_name.h).
+  const auto named = [&f](const char* section, const OptionName& name, auto& value) {
+    f(section, name.key, value, name.help);
+  };
   f("import", "calib", c.import.calib, "ROS bag: M2DGR calibration_results.txt (or --calib)");
   f("import", "images", c.import.images,
     "Metashape/COLMAP: folder of the frames (default: images/ beside the XML or model)");
@@ -100,60 +109,46 @@ void for_each_field(Config& c, F&& f) {
     "more flags for `litgs-engine import KIND` (or synth), as is");
   f("map", "build", c.map.build,
     "auto (when the scene has scans and no map) | always (from the scans, replacing the map) | never");
-  f("map", "voxel", c.map.voxel, "voxel edge in metres (points averaged per voxel)");
-  f("map", "deskew", c.map.deskew, "deskew scans with their per-point time field");
+  named("map", map_option::kVoxel, c.map.voxel);
+  named("map", map_option::kDeskew, c.map.deskew);
   f("map", "extra_args", c.map.extra_args, "more flags for `litgs-engine map`, as is");
   f("match", "enabled", c.match.enabled, "run the thermal front end (writes the scene's sfm/)");
-  f("match", "features", c.match.features, "orb | sift | akaze");
-  f("match", "clahe", c.match.clahe, "CLAHE before detection");
-  f("match", "pairs", c.match.pairs,
-    "covisible[:N] | sequential:N | exhaustive (see `litgs-engine match --help`)");
-  f("match", "max_keypoints", c.match.max_keypoints, "keypoint budget per image");
-  f("match", "threads", c.match.threads, "worker threads (0: all cores)");
+  named("match", match_option::kFeatures, c.match.features);
+  named("match", match_option::kClahe, c.match.clahe);
+  named("match", match_option::kPairs, c.match.pairs);
+  named("match", match_option::kMaxKeypoints, c.match.max_keypoints);
+  named("match", match_option::kThreads, c.match.threads);
   f("match", "extra_args", c.match.extra_args, "more flags for `litgs-engine match`, as is");
   f("refine", "enabled", c.refine.enabled, "refine the poses (poses.txt; the input kept as poses_prior.txt)");
-  f("refine", "tracks", c.refine.tracks,
-    "track source, as `refine --tracks`: auto or sfm (the front end's sfm/, written by match) | oracle "
-    "(projected from a synth scene's true poses: an experiment, not the method)");
-  f("refine", "anchors", c.refine.anchors,
-    "anchor weights and priors, as `refine --anchors`: auto (with oracle tracks only: on the front end's "
-    "tracks they made the poses worse, docs/refinement.md) | on | off");
-  f("refine", "planes", c.refine.planes, "LiDAR point-to-plane term (off where the scene has no LiDAR map)");
-  f("refine", "rounds", c.refine.rounds, "rounds of association, solve and rejection");
+  named("refine", refine_option::kTracks, c.refine.tracks);
+  named("refine", refine_option::kAnchors, c.refine.anchors);
+  named("refine", refine_option::kPlanes, c.refine.planes);
+  named("refine", refine_option::kRounds, c.refine.rounds);
   f("refine", "absolute_priors", c.refine.absolute_priors,
     "auto (a pose prior on every frame when INPUT is a Metashape or COLMAP project: a global solution, not "
     "an odometry) | true | false");
-  f("refine", "threads", c.refine.threads, "Ceres threads");
+  named("refine", refine_option::kThreads, c.refine.threads);
   f("refine", "extra_args", c.refine.extra_args, "more flags for `litgs-engine refine`, as is");
-  f("train", "iterations", c.train.iterations, "training iterations");
-  f("train", "downscale", c.train.downscale, "divide image size and intrinsics by this");
-  f("train", "strategy", c.train.strategy,
-    "mcmc (a fixed budget; the default, ahead of capped adc on the real DUNR facade: docs/results.md) | adc "
-    "(3DGS's densification, capped by max_gaussians)");
-  f("train", "max_gaussians", c.train.max_gaussians,
-    "MCMC budget (adc: cap): grow (the default: doubled inside one training while every 8th training view, "
-    "held back meanwhile, still gains; docs/cli/train.md), a count (40000 for a fixed one), auto (from the "
-    "surface the training views see) or search (one training per doubled budget and fold, while their "
-    "validation PSNR still rises: slower, the reference grow was measured against; docs/budget.md)");
-  f("train", "mcmc_growth", c.train.mcmc_growth, "MCMC: growth per refinement (fraction)");
-  f("train", "lambda_geo", c.train.lambda_geo, "weight of the LiDAR point-to-plane loss");
-  f("train", "init", c.train.init,
-    "auto (LiDAR map, else match's points, else random) | random | sfm (match's points) | refined (refine's "
-    "points) | a .ply/.pcd "
-    "file");
-  f("train", "holdout_every", c.train.holdout_every, "hold out every Nth frame for evaluation");
-  f("train", "intensity", c.train.intensity, "auto | percentile | linear");
-  f("train", "poses", c.train.poses, "estimated (poses.txt) | truth (gt/poses.txt)");
-  f("train", "seed", c.train.seed, "view order and densification seed");
-  f("train", "eval_every", c.train.eval_every, "held-out evaluation cadence (the report's PSNR curve)");
-  f("train", "checkpoint_every", c.train.checkpoint_every,
-    "checkpoint cadence: an interrupted run resumes from the last one");
-  f("train", "progress_every", c.train.progress_every, "progress line cadence (the report's loss curve)");
+  namespace T = train_option;
+  named("train", T::kIterations, c.train.iterations);
+  named("train", T::kDownscale, c.train.downscale);
+  named("train", T::kStrategy, c.train.strategy);
+  named("train", T::kMaxGaussians, c.train.max_gaussians);
+  named("train", T::kMcmcGrowth, c.train.mcmc_growth);
+  named("train", T::kLambdaGeo, c.train.lambda_geo);
+  named("train", T::kInit, c.train.init);
+  named("train", T::kHoldoutEvery, c.train.holdout_every);
+  named("train", T::kIntensity, c.train.intensity);
+  named("train", T::kPoses, c.train.poses);
+  named("train", T::kSeed, c.train.seed);
+  named("train", T::kEvalEvery, c.train.eval_every);
+  named("train", T::kCheckpointEvery, c.train.checkpoint_every);
+  named("train", T::kProgressEvery, c.train.progress_every);
   f("train", "extra_args", c.train.extra_args, "more flags for `litgs-engine train`, as is");
-  f("eval", "emd_samples", c.eval.emd_samples, "EMD: points drawn from each side (exact assignment, O(N^3))");
-  f("eval", "emd_rounds", c.eval.emd_rounds, "EMD: independent draws (mean, std)");
-  f("eval", "seed", c.eval.seed, "EMD: seed");
-  f("eval", "geometry", c.eval.geometry, "EMD and plane residuals");
+  named("eval", eval_option::kEmdSamples, c.eval.emd_samples);
+  named("eval", eval_option::kEmdRounds, c.eval.emd_rounds);
+  named("eval", eval_option::kSeed, c.eval.seed);
+  named("eval", eval_option::kGeometry, c.eval.geometry);
   f("report", "max_views", c.report.max_views, "held-out views shown as pictures");
 }
 

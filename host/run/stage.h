@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "host/option_name.h"
 #include "host/run/input_kind.h"
 #include "host/run/run_config.h"
 
@@ -77,6 +78,8 @@ std::string number_arg(double value);
 // the flag and then each item; numbers keep every digit.
 std::vector<std::string> option_flags(const nlohmann::json& section,
                                       std::initializer_list<const char*> specs);
+// The same for options a command's table names (host/option_name.h): its key, then its flag.
+std::vector<std::string> option_flags(const nlohmann::json& section, std::initializer_list<OptionName> names);
 
 // A stage's JSON output (io::IoError naming the file when it is missing or malformed), and the listed keys
 // of an object that it has (a stage's metrics).

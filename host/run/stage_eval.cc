@@ -1,5 +1,7 @@
 // eval: the model against its scene (`litgs-engine eval`), with the training run's view of the data.
+#include "host/eval/eval_option_names.h"
 #include "host/run/stage.h"
+#include "host/train/train_option_names.h"
 
 namespace litgs::host::run {
 namespace {
@@ -25,9 +27,10 @@ StagePlan plan(const StageContext& c) {
                (dir / "eval.json").string(),
                "--views-out",
                (dir / "views").string()};
-  for (const auto& flags :
-       {option_flags(train, {"downscale", "holdout_every", "intensity", "poses"}),
-        option_flags(p.options, {"emd_samples", "emd_rounds", "seed", "geometry=!--no-geometry"})})
+  for (const auto& flags : {option_flags(train, {train_option::kDownscale, train_option::kHoldoutEvery,
+                                                 train_option::kIntensity, train_option::kPoses}),
+                            option_flags(p.options, {eval_option::kEmdSamples, eval_option::kEmdRounds,
+                                                     eval_option::kSeed, eval_option::kGeometry})})
     p.command.insert(p.command.end(), flags.begin(), flags.end());
   p.outputs = {c.stage_rel("eval") / "eval.json", c.stage_rel("eval") / "views"};
   return p;

@@ -2,6 +2,7 @@
 // only where the scene has scans and no map; map.build: always rebuilds an imported map from the scans.
 #include <stdexcept>
 
+#include "host/lidar_map/map_option_names.h"
 #include "host/run/stage.h"
 
 namespace litgs::host::run {
@@ -32,7 +33,8 @@ StagePlan plan(const StageContext& c) {
   if (!p.skip_reason.empty()) return p;
   // The map is rewritten (with --force), and read_scene wants it while scene.yaml says it is there.
   std::vector<std::string> flags = {"--force"};
-  for (const std::string& f : option_flags(p.options, {"voxel", "deskew=!--no-deskew"})) flags.push_back(f);
+  for (const std::string& f : option_flags(p.options, {map_option::kVoxel, map_option::kDeskew}))
+    flags.push_back(f);
   plan_on_scene_copy(c, "map", SceneCopy{scene, {"scene.yaml", "lidar/map.pcd"}, {}}, flags, o.extra_args, p);
   return p;
 }

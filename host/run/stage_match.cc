@@ -1,4 +1,5 @@
 // match: the thermal front end (`litgs-engine match`) on DIR/match/scene, which gets a fresh sfm/.
+#include "host/frontend/match_option_names.h"
 #include "host/run/stage.h"
 
 namespace litgs::host::run {
@@ -17,7 +18,8 @@ StagePlan plan(const StageContext& c) {
   }
   plan_on_scene_copy(
       c, "match", SceneCopy{scene, {}, {"sfm"}},
-      option_flags(p.options, {"features", "clahe=!--no-clahe", "pairs", "max_keypoints", "threads"}),
+      option_flags(p.options, {match_option::kFeatures, match_option::kClahe, match_option::kPairs,
+                               match_option::kMaxKeypoints, match_option::kThreads}),
       o.extra_args, p);
   return p;
 }

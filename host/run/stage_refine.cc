@@ -2,6 +2,7 @@
 // poses.txt becomes the refined trajectory (the input kept as poses_prior.txt) for train and eval.
 #include <stdexcept>
 
+#include "host/refine/refine_option_names.h"
 #include "host/run/stage.h"
 
 namespace litgs::host::run {
@@ -41,7 +42,8 @@ StagePlan plan(const StageContext& c) {
   }
   plan_on_scene_copy(
       c, "refine", SceneCopy{scene, {"poses.txt", "poses_prior.txt"}, {"refine", "refine.json"}},
-      option_flags(flags_from, {"tracks", "anchors", "planes=!--no-planes", "rounds", "threads", "priors"}),
+      option_flags(flags_from, {refine_option::kTracks, refine_option::kAnchors, refine_option::kPlanes,
+                                refine_option::kRounds, refine_option::kThreads, refine_option::kPriors}),
       o.extra_args, p);
   return p;
 }

@@ -67,6 +67,17 @@ std::vector<std::string> option_flags(const nlohmann::json& section,
   return args;
 }
 
+std::vector<std::string> option_flags(const nlohmann::json& section,
+                                      std::initializer_list<OptionName> names) {
+  std::vector<std::string> args;
+  for (const OptionName& name : names) {
+    const std::vector<std::string> one =
+        option_flags(section, {(std::string(name.key) + "=" + name.flag).c_str()});
+    args.insert(args.end(), one.begin(), one.end());
+  }
+  return args;
+}
+
 nlohmann::json read_stage_json(const fs::path& path) {
   std::ifstream in(path);
   if (!in) throw io::IoError(path, 0, "cannot open the stage's output");

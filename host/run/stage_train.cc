@@ -2,6 +2,7 @@
 #include <stdexcept>
 
 #include "host/run/stage.h"
+#include "host/train/train_option_names.h"
 
 namespace litgs::host::run {
 namespace {
@@ -26,6 +27,7 @@ std::vector<std::string> init_flags(const StageContext& c, std::vector<std::file
 }
 
 StagePlan plan(const StageContext& c) {
+  namespace T = train_option;
   const RunConfig::Train& o = c.config.train;
   const std::string scene = c.scene().string();
   const fs::path dir = c.stage_dir("train");
@@ -34,9 +36,9 @@ StagePlan plan(const StageContext& c) {
   p.options = section_json(c.config, "train");
   p.command = {"train", scene, "--out", dir.string()};
   for (const auto& flags :
-       {option_flags(p.options, {"iterations", "downscale", "strategy", "max_gaussians", "mcmc_growth",
-                                 "lambda_geo", "holdout_every", "intensity", "poses", "seed", "eval_every",
-                                 "checkpoint_every", "progress_every"}),
+       {option_flags(p.options, {T::kIterations, T::kDownscale, T::kStrategy, T::kMaxGaussians,
+                                 T::kMcmcGrowth, T::kLambdaGeo, T::kHoldoutEvery, T::kIntensity, T::kPoses,
+                                 T::kSeed, T::kEvalEvery, T::kCheckpointEvery, T::kProgressEvery}),
         init_flags(c, p.inputs), std::vector<std::string>{"--trace", (dir / "trace.jsonl").string()},
         o.extra_args})
     p.command.insert(p.command.end(), flags.begin(), flags.end());

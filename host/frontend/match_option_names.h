@@ -1,0 +1,17 @@
+// The options `litgs-engine match` shares with run.yaml's match section (host/option_name.h).
+#pragma once
+
+#include "host/option_name.h"
+
+namespace litgs::host::match_option {
+
+inline constexpr OptionName kFeatures{"features", "--features", "orb | sift | akaze"};
+inline constexpr OptionName kClahe{"clahe", "!--no-clahe", "CLAHE before detection (--no-clahe: none)"};
+inline constexpr OptionName kPairs{
+    "pairs", "--pairs",
+    "covisible[:N] (sequential:N first, then frusta that overlap at the scene depth) | sequential:N | "
+    "exhaustive"};
+inline constexpr OptionName kMaxKeypoints{"max_keypoints", "--max-keypoints", "Keypoint budget per image"};
+inline constexpr OptionName kThreads{"threads", "--threads", "Worker threads (0: all cores)"};
+
+}  // namespace litgs::host::match_option
