@@ -12,6 +12,7 @@ namespace litgs::kernels {
 void ConvShape::check() const {
   if (!in_channels || !in_height || !in_width || !out_channels || !kernel || !stride)
     throw std::invalid_argument("ConvShape: a zero size, kernel or stride");
+  if (activation > NN_ACTIVATION_SIGMOID) throw std::invalid_argument("ConvShape: unknown activation");
   if (in_height + 2 * pad < kernel || in_width + 2 * pad < kernel)
     throw std::invalid_argument("ConvShape: the kernel is larger than the padded input");
 }
@@ -46,7 +47,7 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
   p.kernel = c.kernel;
   p.stride = c.stride;
   p.pad = c.pad;
-  p.relu = c.relu ? 1u : 0u;
+  p.activation = c.activation;
   p.count = static_cast<uint32_t>(c.out_elements());
   s.dispatch(*kernel_, elementwise_groups(*context_, p.count, who),
              {{NN_CONV_BINDING_IN, &in, engine::Access::kRead},
@@ -54,6 +55,76 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
               {NN_CONV_BINDING_BIAS, &bias, engine::Access::kRead},
               {NN_CONV_BINDING_OUT, &out, engine::Access::kWrite}},
              p);
+}
+
+namespace {
+void need(const char* who, const char* name, const engine::Buffer& b, uint64_t floats) {
+  if (b.size_bytes() < floats * sizeof(float))
+    throw std::invalid_argument(std::string(who) + ": " + name + " holds " + std::to_string(b.size_bytes()) +
+                                " bytes, the shape needs " + std::to_string(floats * sizeof(float)));
+}
+}  // namespace
+
+MapKernel::MapKernel(engine::Context& context)
+    : context_(&context),
+      kernel_(make_kernel(context, "nn/nn_map", NN_MAP_BINDING_COUNT, sizeof(NnMapParams))) {}
+
+MapKernel::~MapKernel() = default;
+
+void MapKernel::dispatch(engine::Sequence& s, uint32_t op, const engine::Buffer& a, const engine::Buffer& b,
+                         const engine::Buffer& out, const MapShape& in, const MapShape& o, uint32_t k) const {
+  static const char* who = "MapKernel";
+  if (!in.elements() || !o.elements())
+    throw std::invalid_argument(std::string(who) + ": an empty feature map");
+  need(who, "a", a, in.elements());
+  need(who, "b", b, op == NN_MAP_ADD ? in.elements() : 0);
+  need(who, "out", out, o.elements());
+  NnMapParams p{};
+  p.op = op;
+  p.channels = in.channels;
+  p.in_height = in.height;
+  p.in_width = in.width;
+  p.out_channels = o.channels;
+  p.out_height = o.height;
+  p.out_width = o.width;
+  p.k = k;
+  p.count = static_cast<uint32_t>(o.elements());
+  s.dispatch(*kernel_, elementwise_groups(*context_, p.count, who),
+             {{NN_MAP_BINDING_A, &a, engine::Access::kRead},
+              {NN_MAP_BINDING_B, &b, engine::Access::kRead},
+              {NN_MAP_BINDING_OUT, &out, engine::Access::kWrite}},
+             p);
+}
+
+void MapKernel::add(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& b,
+                    const engine::Buffer& out, const MapShape& shape) const {
+  dispatch(s, NN_MAP_ADD, a, b, out, shape, shape, 1);
+}
+
+MapShape MapKernel::average_pool(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out,
+                                 const MapShape& in, uint32_t k) const {
+  if (!k || in.height < k || in.width < k)
+    throw std::invalid_argument("MapKernel::average_pool: window " + std::to_string(k));
+  const MapShape o{in.channels, in.height / k, in.width / k};
+  dispatch(s, NN_MAP_AVERAGE_POOL, a, a, out, in, o, k);
+  return o;
+}
+
+MapShape MapKernel::resize(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out,
+                           const MapShape& in, uint32_t height, uint32_t width) const {
+  const MapShape o{in.channels, height, width};
+  dispatch(s, NN_MAP_RESIZE, a, a, out, in, o, 1);
+  return o;
+}
+
+MapShape MapKernel::unfold(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out,
+                           const MapShape& in, uint32_t k) const {
+  if (in.channels != 1 || !k || in.height % k || in.width % k)
+    throw std::invalid_argument("MapKernel::unfold: a one-channel image whose sides are multiples of " +
+                                std::to_string(k));
+  const MapShape o{k * k, in.height / k, in.width / k};
+  dispatch(s, NN_MAP_UNFOLD, a, a, out, in, o, k);
+  return o;
 }
 
 }  // namespace litgs::kernels

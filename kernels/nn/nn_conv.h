@@ -1,5 +1,7 @@
 // Network convolutions on the device (nn_conv2d.comp): ONNX Conv with group 1, dilation 1 and zero padding,
-// optionally followed by ReLU. Its CPU double reference is kernels/nn/nn_reference.h's conv2d.
+// optionally followed by ReLU or a sigmoid; and the other operations of a network's feature maps
+// (nn_map.comp: add, average pool, bilinear resize, unfold). Its CPU double reference is
+// kernels/nn/nn_reference.h's conv2d.
 #pragma once
 
 #include <cstdint>
@@ -15,18 +17,48 @@ namespace litgs::kernels {
 struct ConvShape {
   uint32_t in_channels = 0, in_height = 0, in_width = 0;
   uint32_t out_channels = 0, kernel = 1, stride = 1, pad = 0;
-  bool relu = false;
+  uint32_t activation = 0;  // NN_ACTIVATION_NONE, _RELU or _SIGMOID (nn_shared.h)
   uint32_t out_height() const { return (in_height + 2 * pad - kernel) / stride + 1; }
   uint32_t out_width() const { return (in_width + 2 * pad - kernel) / stride + 1; }
   uint64_t out_elements() const { return uint64_t{out_channels} * out_height() * out_width(); }
   void check() const;  // std::invalid_argument naming the bad field
 };
 
+// A feature map's shape on the device: [channels][height][width] floats.
+struct MapShape {
+  uint32_t channels = 0, height = 0, width = 0;
+  uint64_t elements() const { return uint64_t{channels} * height * width; }
+};
+
+class MapKernel {
+ public:
+  explicit MapKernel(engine::Context& context);
+  ~MapKernel();
+  // out = a + b, both of `shape`.
+  void add(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& b, const engine::Buffer& out,
+           const MapShape& shape) const;
+  // out = k x k averages of a every k pixels; returns the output's shape.
+  MapShape average_pool(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out,
+                        const MapShape& in, uint32_t k) const;
+  // out = a resized to height x width (ONNX Resize, linear, half_pixel).
+  MapShape resize(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, const MapShape& in,
+                  uint32_t height, uint32_t width) const;
+  // A one-channel image's k x k blocks as k * k channels (XFeat's _unfold2d).
+  MapShape unfold(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, const MapShape& in,
+                  uint32_t k) const;
+
+ private:
+  void dispatch(engine::Sequence& s, uint32_t op, const engine::Buffer& a, const engine::Buffer& b,
+                const engine::Buffer& out, const MapShape& in, const MapShape& out_shape, uint32_t k) const;
+  engine::Context* context_;
+  std::unique_ptr<engine::Kernel> kernel_;
+};
+
 class Conv2dKernel {
  public:
   explicit Conv2dKernel(engine::Context& context);
   ~Conv2dKernel();
-  // Records out = conv(in) (+ ReLU). Buffers too small for the shape are std::invalid_argument.
+  // Records out = conv(in) (+ the activation). Buffers too small for the shape are std::invalid_argument.
   void record(engine::Sequence& sequence, const engine::Buffer& in, const engine::Buffer& weight,
               const engine::Buffer& bias, const engine::Buffer& out, const ConvShape& shape) const;
 

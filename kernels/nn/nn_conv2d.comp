@@ -1,6 +1,6 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
-// ONNX Conv (group 1, dilation 1, zero padding) with an optional ReLU, one output element per invocation,
+// ONNX Conv (group 1, dilation 1, zero padding) with an optional ReLU or sigmoid, one output element per invocation,
 // summed in the same order as kernels/nn/nn_reference.cc's conv2d: channel, kernel row, kernel column.
 #include "limits.h"
 #include "nn/nn_shared.h"
@@ -33,5 +33,7 @@ void main() {
       }
     }
   }
-  y[e] = p.relu != 0u ? max(sum, 0.0) : sum;
+  if (p.activation == NN_ACTIVATION_RELU) sum = max(sum, 0.0);
+  if (p.activation == NN_ACTIVATION_SIGMOID) sum = 1.0 / (1.0 + exp(-sum));
+  y[e] = sum;
 }

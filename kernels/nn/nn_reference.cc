@@ -7,19 +7,19 @@
 
 namespace litgs::kernels::nn {
 
-FeatureMap conv2d(const FeatureMap& in, const io::OnnxTensor& weight, const io::OnnxTensor& bias, int stride,
-                  int pad) {
-  if (weight.dims.size() != 4 || weight.dims[1] != in.channels || weight.dims[2] != weight.dims[3] ||
-      bias.elements() != static_cast<size_t>(weight.dims[0]) || stride < 1 || pad < 0)
-    throw std::invalid_argument("conv2d: weight '" + weight.name + "' does not fit an input of " +
-                                std::to_string(in.channels) + " channels");
-  const int out_c = static_cast<int>(weight.dims[0]), k = static_cast<int>(weight.dims[2]);
+FeatureMap conv2d(const FeatureMap& in, const ConvWeights& w) {
+  if (static_cast<int>(w.in_channels) != in.channels ||
+      w.weight.size() != size_t{w.out_channels} * w.in_channels * w.kernel * w.kernel ||
+      w.bias.size() != w.out_channels || w.stride < 1 || !w.kernel)
+    throw std::invalid_argument("conv2d: weights of " + std::to_string(w.in_channels) +
+                                " input channels do not fit an input of " + std::to_string(in.channels));
+  const int out_c = int(w.out_channels), k = int(w.kernel), stride = int(w.stride), pad = int(w.pad);
   const int out_h = (in.height + 2 * pad - k) / stride + 1, out_w = (in.width + 2 * pad - k) / stride + 1;
   FeatureMap out(out_c, out_h, out_w);
   for (int o = 0; o < out_c; ++o)
     for (int y = 0; y < out_h; ++y)
       for (int x = 0; x < out_w; ++x) {
-        double sum = bias.floats[o];
+        double sum = w.bias[o];
         for (int c = 0; c < in.channels; ++c)
           for (int ky = 0; ky < k; ++ky) {
             const int sy = y * stride - pad + ky;
@@ -27,8 +27,7 @@ FeatureMap conv2d(const FeatureMap& in, const io::OnnxTensor& weight, const io::
             for (int kx = 0; kx < k; ++kx) {
               const int sx = x * stride - pad + kx;
               if (sx < 0 || sx >= in.width) continue;
-              sum +=
-                  double(weight.floats[((size_t(o) * in.channels + c) * k + ky) * k + kx]) * in.at(c, sy, sx);
+              sum += double(w.weight[((size_t(o) * in.channels + c) * k + ky) * k + kx]) * in.at(c, sy, sx);
             }
           }
         out.at(o, y, x) = sum;

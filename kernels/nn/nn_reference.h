@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "io/onnx_model.h"
+#include "kernels/nn/nn_weights.h"
 
 namespace litgs::kernels::nn {
 
@@ -20,9 +20,8 @@ struct FeatureMap {
   double at(int c, int y, int x) const { return values[(size_t(c) * height + y) * width + x]; }
 };
 
-// ONNX Conv, group 1, dilation 1: weight [out, in, k, k], bias [out], zero padding `pad` on every side.
-FeatureMap conv2d(const FeatureMap& in, const io::OnnxTensor& weight, const io::OnnxTensor& bias, int stride,
-                  int pad);
+// ONNX Conv, group 1, dilation 1, with w's stride and zero padding on every side.
+FeatureMap conv2d(const FeatureMap& in, const ConvWeights& w);
 void relu(FeatureMap& m);
 void sigmoid(FeatureMap& m);
 // a + b, of one shape (std::invalid_argument otherwise).

@@ -16,11 +16,33 @@ using uint = uint32_t;
 #define NN_CONV_BINDING_OUT 3     // [C_out][H_out][W_out] (out)
 #define NN_CONV_BINDING_COUNT 4
 
+#define NN_ACTIVATION_NONE 0
+#define NN_ACTIVATION_RELU 1
+#define NN_ACTIVATION_SIGMOID 2
+
 struct NnConvParams {
   uint in_channels, in_height, in_width;
   uint out_channels, out_height, out_width;
   uint kernel, stride, pad;
-  uint relu;   // 1: max(0, x) on the output
+  uint activation;  // NN_ACTIVATION_* on the output
+  uint count;       // out_channels * out_height * out_width
+};
+
+// ---- nn_map.comp: one invocation per output element; p.op chooses what it computes ----
+#define NN_MAP_ADD 0           // out = a + b (same shape)
+#define NN_MAP_AVERAGE_POOL 1  // out = mean of a's k x k window every k pixels (no padding)
+#define NN_MAP_RESIZE 2        // out = a resized bilinearly, half-pixel centres, clamped (ONNX Resize linear)
+#define NN_MAP_UNFOLD 3  // out channel ky k + kx = a one-channel image's pixel (ky, kx) of each k x k block
+#define NN_MAP_BINDING_A 0
+#define NN_MAP_BINDING_B 1  // NN_MAP_ADD's second operand (bound to a otherwise)
+#define NN_MAP_BINDING_OUT 2
+#define NN_MAP_BINDING_COUNT 3
+
+struct NnMapParams {
+  uint op;
+  uint channels, in_height, in_width;  // of a
+  uint out_channels, out_height, out_width;
+  uint k;      // window of the pool and the unfold
   uint count;  // out_channels * out_height * out_width
 };
 

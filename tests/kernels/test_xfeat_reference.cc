@@ -6,6 +6,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "host/nn/xfeat_weights.h"
 #include "io/error.h"
 #include "kernels/nn/xfeat_reference.h"
 
@@ -15,12 +16,21 @@ namespace {
 const std::string kModel = std::string(LITGS_NN_MODELS) + "/xfeat/xfeat_640x640.onnx";
 const std::string kReference = std::string(LITGS_TEST_DATA_DIR) + "/xfeat/reference.json";
 
-io::OnnxTensor tensor(std::vector<int64_t> dims, std::vector<float> values) {
-  io::OnnxTensor t;
-  t.name = "test";
-  t.dims = std::move(dims);
-  t.floats = std::move(values);
-  return t;
+ConvWeights weights(uint32_t out, uint32_t in, uint32_t k, std::vector<float> w, std::vector<float> b,
+                    uint32_t stride, uint32_t pad) {
+  ConvWeights c;
+  c.out_channels = out;
+  c.in_channels = in;
+  c.kernel = k;
+  c.weight = std::move(w);
+  c.bias = std::move(b);
+  c.stride = stride;
+  c.pad = pad;
+  return c;
+}
+
+XfeatReference load_xfeat() {
+  return XfeatReference(host::nn::xfeat_weights(io::read_onnx_model(kModel)));
 }
 
 TEST(NnReference, ConvolutionWithStrideAndPaddingByHand) {
@@ -28,14 +38,13 @@ TEST(NnReference, ConvolutionWithStrideAndPaddingByHand) {
   // input pixels its window covers.
   FeatureMap in(1, 3, 3);
   for (int i = 0; i < 9; ++i) in.values[i] = i + 1;
-  const FeatureMap out =
-      conv2d(in, tensor({1, 1, 3, 3}, std::vector<float>(9, 1.0f)), tensor({1}, {0.5f}), 2, 1);
+  const FeatureMap out = conv2d(in, weights(1, 1, 3, std::vector<float>(9, 1.0f), {0.5f}, 2, 1));
   ASSERT_EQ(out.height, 2);
   ASSERT_EQ(out.width, 2);
   EXPECT_DOUBLE_EQ(out.at(0, 0, 0), 1 + 2 + 4 + 5 + 0.5);
   EXPECT_DOUBLE_EQ(out.at(0, 0, 1), 2 + 3 + 5 + 6 + 0.5);
   EXPECT_DOUBLE_EQ(out.at(0, 1, 1), 5 + 6 + 8 + 9 + 0.5);
-  EXPECT_THROW(conv2d(in, tensor({1, 2, 3, 3}, std::vector<float>(18, 1.0f)), tensor({1}, {0}), 1, 1),
+  EXPECT_THROW(conv2d(in, weights(1, 2, 3, std::vector<float>(18, 1.0f), {0.0f}, 1, 1)),
                std::invalid_argument);
 }
 
@@ -85,7 +94,7 @@ double element(const FeatureMap& m, bool nhwc, size_t i) {
 }
 
 TEST(XfeatReference, MatchesOnnxRuntimeOnBothPatterns) {
-  const XfeatReference xfeat(io::read_onnx_model(kModel));
+  const XfeatReference xfeat = load_xfeat();
   std::ifstream in(kReference);
   ASSERT_TRUE(in) << kReference;
   const nlohmann::json ref = nlohmann::json::parse(in);
@@ -113,7 +122,7 @@ TEST(XfeatReference, MatchesOnnxRuntimeOnBothPatterns) {
 }
 
 TEST(XfeatReferenceHardCases, UniformSmallestAndRefusedSizes) {
-  const XfeatReference xfeat(io::read_onnx_model(kModel));
+  const XfeatReference xfeat = load_xfeat();
   FeatureMap uniform(1, 32, 32);  // a normalized uniform image is all zeros
   const XfeatOutputs out = xfeat.run(uniform);
   EXPECT_EQ(out.features.width, 4);
@@ -127,7 +136,7 @@ TEST(XfeatReferenceHardCases, UniformSmallestAndRefusedSizes) {
 TEST(XfeatReferenceHardCases, ALighterGlueModelIsNotTakenForXfeat) {
   const std::string other = std::string(LITGS_NN_MODELS) + "/lighterglue/lighterglue_L3.onnx";
   try {
-    XfeatReference xfeat(io::read_onnx_model(other));
+    host::nn::xfeat_weights(io::read_onnx_model(other));
     FAIL() << "LighterGlue accepted as XFeat";
   } catch (const io::IoError& e) {
     EXPECT_NE(std::string(e.what()).find("XFeat"), std::string::npos) << e.what();

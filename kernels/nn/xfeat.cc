@@ -1,0 +1,110 @@
+#include "kernels/nn/xfeat.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "engine/sequence.h"
+#include "kernels/nn/nn_shared.h"
+
+namespace litgs::kernels {
+namespace {
+
+// A feature map of the forward pass: its array lives in the pass's pool until the sequence has run.
+struct Map {
+  engine::DeviceArray<float>* data = nullptr;
+  MapShape shape;
+  const engine::Buffer& buffer() const { return data->buffer(); }
+};
+
+}  // namespace
+
+XfeatNetwork::XfeatNetwork(engine::Context& context, const nn::XfeatWeights& weights)
+    : context_(&context), conv_(context), map_(context) {
+  if (weights.convs.size() != 27)
+    throw std::invalid_argument("XfeatNetwork: " + std::to_string(weights.convs.size()) +
+                                " convolutions, XFeat has 27");
+  for (const nn::ConvWeights& c : weights.convs) {
+    Layer l;
+    l.weight = std::make_unique<engine::DeviceArray<float>>(context, "xfeat: weight", c.weight.size());
+    l.bias = std::make_unique<engine::DeviceArray<float>>(context, "xfeat: bias", c.bias.size());
+    l.weight->upload(c.weight);
+    l.bias->upload(c.bias);
+    l.out_channels = c.out_channels;
+    l.in_channels = c.in_channels;
+    l.kernel = c.kernel;
+    l.stride = c.stride;
+    l.pad = c.pad;
+    layers_.push_back(std::move(l));
+  }
+}
+
+XfeatNetwork::~XfeatNetwork() = default;
+
+XfeatDeviceOutputs XfeatNetwork::run(const std::vector<float>& image, uint32_t height, uint32_t width) const {
+  if (!height || !width || height % 32 || width % 32 || image.size() != size_t{height} * width)
+    throw std::invalid_argument(
+        "XfeatNetwork: a one-channel image whose sides are positive multiples of 32, not " +
+        std::to_string(width) + "x" + std::to_string(height) + " with " + std::to_string(image.size()) +
+        " values");
+  engine::Context& ctx = *context_;
+  engine::Sequence s(ctx);
+  std::vector<std::unique_ptr<engine::DeviceArray<float>>> pool;  // every map, alive until submit_and_wait
+  const auto make = [&](const MapShape& shape) {
+    pool.push_back(std::make_unique<engine::DeviceArray<float>>(ctx, "xfeat: feature map", shape.elements()));
+    return Map{pool.back().get(), shape};
+  };
+  // Layers first .. first + count - 1 in turn: ReLU after each but the last, `last` after the last.
+  const auto layers = [&](const Map& in, size_t first, size_t count, uint32_t last) {
+    Map x = in;
+    for (size_t i = first; i < first + count; ++i) {
+      const Layer& l = layers_[i];
+      const ConvShape c{x.shape.channels,
+                        x.shape.height,
+                        x.shape.width,
+                        l.out_channels,
+                        l.kernel,
+                        l.stride,
+                        l.pad,
+                        i + 1 < first + count ? uint32_t{NN_ACTIVATION_RELU} : last};
+      const Map y = make({c.out_channels, c.out_height(), c.out_width()});
+      conv_.record(s, x.buffer(), l.weight->buffer(), l.bias->buffer(), y.buffer(), c);
+      x = y;
+    }
+    return x;
+  };
+  const Map input = make({1, height, width});
+  input.data->upload(image);
+  // The dataflow and the layer indices of kernels/nn/xfeat_reference.cc (XfeatReference::run).
+  const Map x1 = layers(input, 0, 4, NN_ACTIVATION_RELU);
+  const Map pooled = make({1, height / 4, width / 4});
+  map_.average_pool(s, input.buffer(), pooled.buffer(), input.shape, 4);
+  const Map skip = layers(pooled, 4, 1, NN_ACTIVATION_NONE);
+  const Map sum1 = make(x1.shape);
+  map_.add(s, x1.buffer(), skip.buffer(), sum1.buffer(), x1.shape);
+  const Map x2 = layers(sum1, 5, 2, NN_ACTIVATION_RELU);
+  const Map x3 = layers(x2, 7, 3, NN_ACTIVATION_RELU);
+  const Map x4 = layers(x3, 10, 3, NN_ACTIVATION_RELU);
+  const Map x5 = layers(x4, 13, 4, NN_ACTIVATION_RELU);
+  const Map up4 = make({x4.shape.channels, x3.shape.height, x3.shape.width});
+  map_.resize(s, x4.buffer(), up4.buffer(), x4.shape, x3.shape.height, x3.shape.width);
+  const Map up5 = make({x5.shape.channels, x3.shape.height, x3.shape.width});
+  map_.resize(s, x5.buffer(), up5.buffer(), x5.shape, x3.shape.height, x3.shape.width);
+  const Map fused34 = make(x3.shape), fused = make(x3.shape);
+  map_.add(s, x3.buffer(), up4.buffer(), fused34.buffer(), x3.shape);
+  map_.add(s, fused34.buffer(), up5.buffer(), fused.buffer(), x3.shape);
+  const Map features = layers(fused, 17, 3, NN_ACTIVATION_NONE);
+  const Map heatmap = layers(features, 20, 3, NN_ACTIVATION_SIGMOID);
+  const Map cells = make({64, height / 8, width / 8});
+  map_.unfold(s, input.buffer(), cells.buffer(), input.shape, 8);
+  const Map keypoints = layers(cells, 23, 4, NN_ACTIVATION_NONE);
+  s.submit_and_wait();
+  XfeatDeviceOutputs out;
+  out.height = features.shape.height;
+  out.width = features.shape.width;
+  out.features = features.data->download();
+  out.keypoints = keypoints.data->download();
+  out.heatmap = heatmap.data->download();
+  return out;
+}
+
+}  // namespace litgs::kernels
