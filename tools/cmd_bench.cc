@@ -14,6 +14,7 @@ void add_bench_command(CLI::App& app) {
   add_bench_loss_command(*bench);
   add_bench_serve_command(*bench);
   add_bench_frontend_command(*bench);
+  add_bench_features_command(*bench);
 }
 
 }  // namespace litgs::tools

@@ -14,8 +14,9 @@ struct LidarMapReport;
 namespace litgs::tools {
 
 void add_info_command(CLI::App& app);
-void add_bench_command(CLI::App& app);  // bench sort | render | gather | loss | serve | frontend
+void add_bench_command(CLI::App& app);  // bench sort | render | gather | loss | serve | frontend | features
 void add_bench_sort_command(CLI::App& bench);
+void add_bench_features_command(CLI::App& bench);
 void add_bench_render_command(CLI::App& bench);
 void add_bench_gather_command(CLI::App& bench);
 void add_bench_loss_command(CLI::App& bench);

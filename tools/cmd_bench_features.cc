@@ -1,0 +1,146 @@
+// `litgs-engine bench features [--image FILE] [--runs N] [--json]`: milliseconds per image for each detector
+// on one frame, in one run: ORB, SIFT and AKAZE (OpenCV, on the CPU, at the front end's defaults), XFeat's
+// network on the Vulkan device (upload, forward pass and download; the post-processing is not built yet)
+// and XFeat's double-precision CPU reference (one run). The frame is cropped to multiples of 32.
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "engine/context.h"
+#include "host/frontend/features.h"
+#include "host/frontend/intensity.h"
+#include "host/frontend/preprocess.h"
+#include "host/nn/xfeat_weights.h"
+#include "io/image.h"
+#include "io/onnx_model.h"
+#include "kernels/nn/xfeat.h"
+#include "kernels/nn/xfeat_reference.h"
+#include "tools/bench_stats.h"
+#include "tools/commands.h"
+#include "tools/device_json.h"
+
+namespace litgs::tools {
+namespace {
+
+struct BenchFeaturesOptions {
+  std::filesystem::path image;  // empty: a 640x512 pattern
+  std::filesystem::path model = LITGS_XFEAT_MODEL;
+  uint32_t runs = 5;
+  bool json = false;
+};
+
+// The frame as the front end sees it (a 1-99 percentile stretch to 8 bits), cropped to multiples of 32.
+host::frontend::Gray8 load_frame(const std::filesystem::path& path) {
+  io::Image raw;
+  if (path.empty()) {
+    raw.width = 640;
+    raw.height = 512;
+    raw.data.resize(size_t{640} * 512);
+    for (int y = 0; y < raw.height; ++y)
+      for (int x = 0; x < raw.width; ++x)
+        raw.data[size_t(y) * 640 + x] =
+            static_cast<uint16_t>(127 + 60 * std::sin(0.11 * (x + 0.7 * y)) + 40 * std::cos(0.023 * x) +
+                                  (((x >> 5) + (y >> 5)) % 2 ? 20 : 0));
+  } else {
+    raw = io::read_image(path);
+  }
+  if (raw.channels != 1) throw std::invalid_argument(path.string() + ": a one-channel frame is needed");
+  host::frontend::Histogram h = host::frontend::empty_histogram();
+  host::frontend::add_to_histogram(h, raw.data);
+  const host::frontend::Gray8 full = host::frontend::to_gray8(
+      raw, host::frontend::percentile_stretch(h, 1, 99), host::frontend::PreprocessOptions{});
+  host::frontend::Gray8 g;
+  g.width = full.width / 32 * 32;
+  g.height = full.height / 32 * 32;
+  if (!g.width || !g.height) throw std::invalid_argument("the frame is smaller than 32x32");
+  for (int y = 0; y < g.height; ++y)
+    g.pixels.insert(g.pixels.end(), full.pixels.begin() + y * full.width,
+                    full.pixels.begin() + y * full.width + g.width);
+  return g;
+}
+
+// Zero mean, unit variance, as XFeat takes its input.
+std::vector<float> normalized(const host::frontend::Gray8& g) {
+  double mean = 0, variance = 0;
+  for (uint8_t p : g.pixels) mean += p;
+  mean /= double(g.pixels.size());
+  for (uint8_t p : g.pixels) variance += (p - mean) * (p - mean);
+  const double sd = std::max(std::sqrt(variance / double(g.pixels.size())), 1e-6);
+  std::vector<float> out;
+  for (uint8_t p : g.pixels) out.push_back(static_cast<float>((p - mean) / sd));
+  return out;
+}
+
+void run_bench_features(const BenchFeaturesOptions& o) {
+  if (o.runs < 1) throw std::invalid_argument("--runs must be at least 1");
+  const host::frontend::Gray8 frame = load_frame(o.image);
+  nlohmann::json rows = nlohmann::json::array();
+  for (const char* name : {"orb", "sift", "akaze"}) {
+    host::frontend::FeatureOptions f;
+    f.type = host::frontend::parse_feature_type(name);
+    std::vector<double> ms;
+    size_t keypoints = 0;
+    for (uint32_t r = 0; r <= o.runs; ++r) {
+      const double t =
+          time_ms([&] { keypoints = host::frontend::detect_features(frame, f).keypoints.size(); });
+      if (r) ms.push_back(t);
+    }
+    rows.push_back(
+        {{"detector", name}, {"where", "CPU (OpenCV)"}, {"ms", median(ms)}, {"keypoints", keypoints}});
+  }
+  const kernels::nn::XfeatWeights weights = host::nn::xfeat_weights(io::read_onnx_model(o.model));
+  const std::vector<float> input = normalized(frame);
+  engine::Context context;
+  const kernels::XfeatNetwork network(context, weights);
+  std::vector<double> ms;
+  for (uint32_t r = 0; r <= o.runs; ++r) {
+    const double t = time_ms([&] { network.run(input, uint32_t(frame.height), uint32_t(frame.width)); });
+    if (r) ms.push_back(t);
+  }
+  rows.push_back(
+      {{"detector", "xfeat network"}, {"where", "device: " + context.info().name}, {"ms", median(ms)}});
+  kernels::nn::FeatureMap image(1, frame.height, frame.width);
+  image.values.assign(input.begin(), input.end());
+  const kernels::nn::XfeatReference reference(weights);
+  const double cpu_ms = time_ms([&] { reference.run(image); });
+  rows.push_back(
+      {{"detector", "xfeat network"}, {"where", "CPU double reference, 1 thread"}, {"ms", cpu_ms}});
+  if (o.json) {
+    std::cout << nlohmann::json{{"width", frame.width},
+                                {"height", frame.height},
+                                {"runs", o.runs},
+                                {"rows", rows},
+                                {"device", device_json(context.info())}}
+                     .dump(2)
+              << "\n";
+    return;
+  }
+  std::cout << "bench features: " << frame.width << "x" << frame.height << ", median of " << o.runs
+            << " runs after one warm-up (the CPU reference: one run)\n";
+  for (const auto& r : rows)
+    std::cout << "  " << std::left << std::setw(14) << r["detector"].get<std::string>() << std::setw(48)
+              << r["where"].get<std::string>() << std::right << std::fixed << std::setprecision(1)
+              << std::setw(9) << r["ms"].get<double>() << " ms"
+              << (r.contains("keypoints") ? "  " + std::to_string(r["keypoints"].get<size_t>()) + " keypoints"
+                                          : "")
+              << "\n";
+}
+
+}  // namespace
+
+void add_bench_features_command(CLI::App& bench) {
+  auto o = std::make_shared<BenchFeaturesOptions>();
+  CLI::App* cmd =
+      bench.add_subcommand("features", "Milliseconds per frame of each detector, XFeat on the device");
+  cmd->add_option("--image", o->image, "A one-channel 8- or 16-bit frame (default: a 640x512 pattern)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--model", o->model, "XFeat's ONNX model")->capture_default_str();
+  cmd->add_option("--runs", o->runs, "Timed runs after one warm-up")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print one JSON object");
+  cmd->callback([o] { run_bench_features(*o); });
+}
+
+}  // namespace litgs::tools
