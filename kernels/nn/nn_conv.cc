@@ -48,7 +48,8 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
   p.stride = c.stride;
   p.pad = c.pad;
   p.activation = c.activation;
-  p.count = static_cast<uint32_t>(c.out_elements());
+  p.count = static_cast<uint32_t>(uint64_t{(c.out_channels + NN_CONV_OUTPUTS - 1) / NN_CONV_OUTPUTS} *
+                                  c.out_height() * c.out_width());
   s.dispatch(*kernel_, elementwise_groups(*context_, p.count, who),
              {{NN_CONV_BINDING_IN, &in, engine::Access::kRead},
               {NN_CONV_BINDING_WEIGHT, &weight, engine::Access::kRead},

@@ -9,7 +9,9 @@ namespace litgs::kernels {
 using uint = uint32_t;
 #endif
 
-// ---- nn_conv2d.comp: one invocation per output element (channel, row, column) ----
+// ---- nn_conv2d.comp: one invocation per NN_CONV_OUTPUTS output channels at one pixel (each input value
+// loaded once for all of them) ----
+#define NN_CONV_OUTPUTS 8
 #define NN_CONV_BINDING_IN 0      // [C_in][H_in][W_in]
 #define NN_CONV_BINDING_WEIGHT 1  // [C_out][C_in][k][k]
 #define NN_CONV_BINDING_BIAS 2    // [C_out]
