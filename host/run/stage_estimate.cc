@@ -20,6 +20,7 @@ namespace fs = std::filesystem;
 // the 2-core development machine (docs/results.md, "What a run will cost", lists estimate against time).
 constexpr double kSynthSecondsPerMpx = 1.4;    // rendering frames, scans and the maps
 constexpr double kImportSecondsPerMpx = 0.05;  // reading and converting recorded frames
+constexpr double kEvalSecondsPerMpx = 0.05;    // rendering and scoring the held-out views
 constexpr double kMapSecondsPerScanMb = 0.026;
 constexpr double kMatchSecondsPerMpx = 0.8;        // on 2 threads
 constexpr double kRefineSecondsPerMpxLidar = 4.5;  // with the LiDAR point-to-plane term
@@ -190,7 +191,7 @@ std::optional<StageEstimate> estimate_stage(const std::string& stage, InputKind 
     const double emd = c.eval.geometry && s.lidar_map
                            ? 0.4 * c.eval.emd_rounds * std::pow(c.eval.emd_samples / 1000.0, 3)
                            : 0.0;
-    e = fixed(1.5 + emd + kImportSecondsPerMpx * mpx, "held-out views of " + size_text(s));
+    e = fixed(1.5 + emd + kEvalSecondsPerMpx * mpx, "held-out views of " + size_text(s));
   } else if (stage == "report") {
     e = fixed(0.2, "the report page");
   } else {

@@ -4,10 +4,14 @@
 #include <string>
 
 #include "kernels/elementwise.h"
+#include "kernels/loss/loss_sum.h"
 #include "kernels/nn/nn_shared.h"
 #include "kernels/subgroup_kernel.h"
 
 namespace litgs::kernels {
+
+// The binding-size check every kernel wrapper shares (kernels/loss/loss_sum.h).
+using loss_detail::check_binding;
 
 void ConvShape::check() const {
   if (!in_channels || !in_height || !in_width || !out_channels || !kernel || !stride)
@@ -27,16 +31,11 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
                           const engine::Buffer& bias, const engine::Buffer& out, const ConvShape& c) const {
   static const char* who = "Conv2dKernel::record";
   c.check();
-  const auto need = [](const char* name, const engine::Buffer& b, uint64_t floats) {
-    if (b.size_bytes() < floats * sizeof(float))
-      throw std::invalid_argument(std::string(who) + ": " + name + " holds " +
-                                  std::to_string(b.size_bytes()) + " bytes, the shape needs " +
-                                  std::to_string(floats * sizeof(float)));
-  };
-  need("in", in, uint64_t{c.in_channels} * c.in_height * c.in_width);
-  need("weight", weight, uint64_t{c.out_channels} * c.in_channels * c.kernel * c.kernel);
-  need("bias", bias, c.out_channels);
-  need("out", out, c.out_elements());
+  check_binding(who, "in", in, uint64_t{c.in_channels} * c.in_height * c.in_width * sizeof(float));
+  check_binding(who, "weight", weight,
+                uint64_t{c.out_channels} * c.in_channels * c.kernel * c.kernel * sizeof(float));
+  check_binding(who, "bias", bias, uint64_t{c.out_channels} * sizeof(float));
+  check_binding(who, "out", out, c.out_elements() * sizeof(float));
   NnConvParams p{};
   p.in_channels = c.in_channels;
   p.in_height = c.in_height;
@@ -58,14 +57,6 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
              p);
 }
 
-namespace {
-void need(const char* who, const char* name, const engine::Buffer& b, uint64_t floats) {
-  if (b.size_bytes() < floats * sizeof(float))
-    throw std::invalid_argument(std::string(who) + ": " + name + " holds " + std::to_string(b.size_bytes()) +
-                                " bytes, the shape needs " + std::to_string(floats * sizeof(float)));
-}
-}  // namespace
-
 MapKernel::MapKernel(engine::Context& context)
     : context_(&context),
       kernel_(make_kernel(context, "nn/nn_map", NN_MAP_BINDING_COUNT, sizeof(NnMapParams))) {}
@@ -77,9 +68,9 @@ void MapKernel::dispatch(engine::Sequence& s, uint32_t op, const engine::Buffer&
   static const char* who = "MapKernel";
   if (!in.elements() || !o.elements())
     throw std::invalid_argument(std::string(who) + ": an empty feature map");
-  need(who, "a", a, in.elements());
-  need(who, "b", b, op == NN_MAP_ADD ? in.elements() : 0);
-  need(who, "out", out, o.elements());
+  check_binding(who, "a", a, in.elements() * sizeof(float));
+  check_binding(who, "b", b, op == NN_MAP_ADD ? in.elements() * sizeof(float) : 0);
+  check_binding(who, "out", out, o.elements() * sizeof(float));
   NnMapParams p{};
   p.op = op;
   p.channels = in.channels;
