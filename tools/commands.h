@@ -36,8 +36,9 @@ void print_lidar_map_report(const host::LidarMapReport& report, const std::strin
 void add_eval_command(CLI::App& app);
 void add_run_command(CLI::App& app);  // and its report: tools/cmd_run.cc
 void add_report_command(CLI::App& app);
-void add_ablate_command(CLI::App& app);  // tools/cmd_ablate.cc
-void add_calib_command(CLI::App& app);   // calib intrinsics: tools/cmd_calib.cc
+void add_ablate_command(CLI::App& app);     // tools/cmd_ablate.cc
+void add_partition_command(CLI::App& app);  // partition and merge: tools/cmd_partition.cc
+void add_calib_command(CLI::App& app);      // calib intrinsics: tools/cmd_calib.cc
 // This program's path ($LITGS_ENGINE where set, else /proc/self/exe): `run` and `ablate` run their stages
 // with it.
 std::filesystem::path this_executable();

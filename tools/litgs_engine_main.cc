@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   litgs::tools::add_map_command(app);
   litgs::tools::add_refine_command(app);
   litgs::tools::add_calib_command(app);
+  litgs::tools::add_partition_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
