@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/point_cloud.h"
@@ -48,6 +49,10 @@ struct SceneConfig {
   // Recentring: original world coordinates = scene world coordinates + world_offset_m (keeps float32 work
   // near the origin for data sets that sit far from it).
   Eigen::Vector3d world_offset_m = Eigen::Vector3d::Zero();
+  // scene.yaml `intensity_window: [low, high]`, optional: the raw counts a 16-bit frame is stretched from,
+  // shared by every part of a larger scene (`partition` writes the whole scene's into each block, so that the
+  // blocks' models share one intensity scale). Absent: training takes percentiles of the scene's own frames.
+  std::optional<std::pair<double, double>> intensity_window;
   std::string source;  // free text: where the scene came from
 };
 

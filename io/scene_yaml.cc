@@ -127,6 +127,10 @@ std::string check_scene_config(const SceneConfig& c) {
   if (std::string p = check_rigid(c.T_imu_lidar); !p.empty()) return "T_imu_lidar: " + p;
   if (!std::isfinite(c.time_offset_cam_lidar_s)) return "time_offset_cam_lidar_s: must be finite";
   if (!c.world_offset_m.allFinite()) return "world_offset_m: must be finite";
+  if (c.intensity_window &&
+      !(std::isfinite(c.intensity_window->first) && c.intensity_window->first < c.intensity_window->second &&
+        std::isfinite(c.intensity_window->second)))
+    return "intensity_window: must be two finite numbers, low < high";
   return {};
 }
 
@@ -155,11 +159,11 @@ SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
     fail(path, 0, "cannot open for reading");
   }
   const Reader r{path};
-  r.only_keys(
-      root,
-      {"format", "version", "units", "camera", "T_cam_lidar", "T_imu_lidar", "time_offset_cam_lidar_s",
-       "poses_frame", "poses_origin", "lidar_map", "lidar_holdout_every", "world_offset_m", "source"},
-      "");
+  r.only_keys(root,
+              {"format", "version", "units", "camera", "T_cam_lidar", "T_imu_lidar",
+               "time_offset_cam_lidar_s", "poses_frame", "poses_origin", "lidar_map", "lidar_holdout_every",
+               "world_offset_m", "intensity_window", "source"},
+              "");
   if (r.text(r.get(root, "format", ""), "format") != "litgs-scene")
     fail(path, r.line(root["format"]), "format: expected 'litgs-scene'");
   r.integer(r.get(root, "version", ""), "version", 1, 1);
@@ -215,6 +219,11 @@ SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
   const auto offset = r.numbers(r.get(root, "world_offset_m", ""), "world_offset_m");
   if (offset.size() != 3) fail(path, r.line(root["world_offset_m"]), "world_offset_m: expected 3 numbers");
   c.world_offset_m = {offset[0], offset[1], offset[2]};
+  if (root["intensity_window"]) {
+    const auto w = r.numbers(root["intensity_window"], "intensity_window");
+    if (w.size() != 2) fail(path, r.line(root["intensity_window"]), "intensity_window: expected [low, high]");
+    c.intensity_window = std::make_pair(w[0], w[1]);
+  }
   if (root["source"]) c.source = r.text(root["source"], "source");
   const std::string problem = check_scene_config(c);
   if (!problem.empty()) fail(path, r.line(root), problem);
@@ -259,8 +268,12 @@ void write_scene_yaml(const std::filesystem::path& path, const SceneConfig& c) {
         << "  # scans 0, N, 2N, ... left out of lidar/map.pcd (0: none); lidar/heldout.pcd holds them\n"
         << "world_offset_m: [" << format_double(c.world_offset_m.x()) << ", "
         << format_double(c.world_offset_m.y()) << ", " << format_double(c.world_offset_m.z())
-        << "]  # original coordinates = scene coordinates + this\n"
-        << "source: " << quoted(c.source) << "\n";
+        << "]  # original coordinates = scene coordinates + this\n";
+    if (c.intensity_window)
+      out << "intensity_window: [" << format_double(c.intensity_window->first) << ", "
+          << format_double(c.intensity_window->second)
+          << "]  # raw counts stretched to [0, 1] in training, shared by the blocks of a partition\n";
+    out << "source: " << quoted(c.source) << "\n";
   });
 }
 

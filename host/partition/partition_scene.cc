@@ -8,13 +8,16 @@
 #include <optional>
 #include <stdexcept>
 
+#include "host/frontend/intensity.h"
 #include "host/run/content_hash.h"
 #include "host/train/output_frame.h"
+#include "host/train/training_data.h"
 #include "io/atomic_file.h"
 #include "io/export_scene.h"
 #include "io/gaussian_ply.h"
 #include "io/pcd.h"
 #include "io/scene.h"
+#include "io/scene_yaml.h"
 
 namespace litgs::host::partition {
 namespace fs = std::filesystem;
@@ -66,6 +69,23 @@ void link_or_copy(const fs::path& from, const fs::path& to) {
   if (ec) fs::copy_file(from, to, fs::copy_options::overwrite_existing);
 }
 
+// The whole scene's intensity window, as training would take it (host/train/training_data.h), for every
+// block: models trained apart then share one intensity scale. 8-bit frames are not stretched.
+io::SceneConfig block_config(const fs::path& scene_dir, const io::Scene& scene) {
+  io::SceneConfig c = scene.config;
+  if (c.camera.bit_depth != 16 || c.intensity_window) return c;
+  frontend::Histogram histogram = frontend::empty_histogram();
+  for (size_t i = 0; i < scene.frames.size(); ++i) {
+    const io::Image img = io::load_frame(scene_dir, scene, i);
+    frontend::add_to_histogram(histogram, img.data, static_cast<size_t>(img.channels));
+  }
+  const TrainingDataOptions training;
+  const frontend::Stretch s =
+      frontend::percentile_stretch(histogram, training.low_percentile, training.high_percentile);
+  c.intensity_window = std::make_pair(s.low, s.high);
+  return c;
+}
+
 json plan_json(const BlockPlan& plan, const std::vector<size_t>& view_frame) {
   json blocks = json::array();
   for (const Block& b : plan.blocks) {
@@ -91,8 +111,8 @@ json plan_json(const BlockPlan& plan, const std::vector<size_t>& view_frame) {
           {"blocks", blocks}};
 }
 
-void write_block(const fs::path& scene_dir, const io::Scene& scene, const Block& b,
-                 const std::vector<size_t>& view_frame, const fs::path& dir) {
+void write_block(const fs::path& scene_dir, const io::Scene& scene, const io::SceneConfig& config,
+                 const Block& b, const std::vector<size_t>& view_frame, const fs::path& dir) {
   fs::create_directories(dir / "thermal");
   fs::create_directories(dir / "lidar");
   link_or_copy(scene_dir / "poses.txt", dir / "poses.txt");
@@ -114,8 +134,7 @@ void write_block(const fs::path& scene_dir, const io::Scene& scene, const Block&
        << "\n";
   });
   // scene.yaml last: a block folder without it is not a scene, so a failure above leaves no half scene.
-  io::write_file_atomic(dir / "scene.yaml",
-                        [&](std::ostream& os) { os << std::ifstream(scene_dir / "scene.yaml").rdbuf(); });
+  io::write_scene_yaml(dir / "scene.yaml", config);
 }
 
 }  // namespace
@@ -165,15 +184,18 @@ PartitionReport partition_scene(const fs::path& scene_dir, const fs::path& out, 
     throw std::runtime_error("partition: " + out.string() +
                              " holds another partition of this scene (other blocks, cells or frames): its "
                              "blocks' trainings would be merged with the wrong cells; use another folder");
+  const io::SceneConfig config = block_config(scene_dir, scene);
   fs::create_directories(out / kBlocksDir);
   for (const Block& b : r.plan.blocks)
-    write_block(scene_dir, scene, b, view_frame, out / kBlocksDir / b.name);
+    write_block(scene_dir, scene, config, b, view_frame, out / kBlocksDir / b.name);
   j["scene"] = fs::weakly_canonical(scene_dir).string();
   j["scene_fingerprint"] = fingerprint;
   j["frames"] = scene.frames.size();
   j["map_points"] = scene.map->size();
   j["heldout_every"] = o.scene_holdout_every;
   j["heldout_frames"] = r.heldout_frames;
+  if (config.intensity_window)
+    j["intensity_window"] = {config.intensity_window->first, config.intensity_window->second};
   io::write_file_atomic(manifest, [&](std::ostream& os) { os << j.dump(2) << "\n"; });
   r.out = out;
   r.frames = scene.frames.size();

@@ -2,7 +2,8 @@
 // `train` accepts unchanged, and the blocks' trained models joined into one 3DGS PLY by core cell.
 //
 //   DIR/partition.json          the plan, the source scene and its fingerprint
-//   DIR/blocks/block-C-R/       a scene: scene.yaml and poses.txt as the source's, thermal/ (hard links
+//   DIR/blocks/block-C-R/       a scene: scene.yaml as the source's with the whole scene's
+//                               intensity_window (16-bit frames), poses.txt, thermal/ (hard links
 //                               to the block's frames, copies across file systems), lidar/map.pcd (the map
 //                               points inside the expanded bounds), gt/poses.txt where the source has one,
 //                               block.json (the core cell)

@@ -152,7 +152,10 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
   const bool percentile = o.mapping == IntensityMapping::kPercentile ||
                           (o.mapping == IntensityMapping::kAuto && k.bit_depth == 16);
   frontend::Stretch stretch{0, k.bit_depth == 16 ? 65535.0 : 255.0};
-  if (percentile) stretch = frontend::percentile_stretch(histogram, o.low_percentile, o.high_percentile);
+  if (percentile && scene.config.intensity_window)
+    stretch = {scene.config.intensity_window->first, scene.config.intensity_window->second};
+  else if (percentile)
+    stretch = frontend::percentile_stretch(histogram, o.low_percentile, o.high_percentile);
   out.stretch_low = stretch.low;
   out.stretch_high = stretch.high;
   for (auto& frame : raw)

@@ -9,6 +9,7 @@
 #include "host/partition/block_plan.h"
 #include "host/partition/partition_scene.h"
 #include "host/synth/synth.h"
+#include "host/train/training_data.h"
 #include "io/gaussian_ply.h"
 #include "io/scene.h"
 
@@ -186,8 +187,15 @@ TEST_F(PartitionSceneTest, BlocksAreScenesAndMergeKeepsEachGaussianOnce) {
   // held-out frames (0, 8, 16): eval of the merged model scores views no block trained on.
   const io::Scene whole = io::read_scene(scene);
   EXPECT_EQ(r.heldout_frames, 3u);
+  // One intensity window for all blocks, the whole scene's as training takes it, so their models share a
+  // scale, not each its own percentiles.
+  const TrainingData whole_data = load_training_data(scene, {});
   for (const Block& b : r.plan.blocks) {
     const io::Scene s = io::read_scene(dir_ / "part/blocks" / b.name);
+    ASSERT_TRUE(s.config.intensity_window) << b.name;
+    EXPECT_EQ(s.config.intensity_window->first, whole_data.stretch_low) << b.name;
+    EXPECT_EQ(s.config.intensity_window->second, whole_data.stretch_high) << b.name;
+    EXPECT_EQ(load_training_data(dir_ / "part/blocks" / b.name, {}).stretch_high, whole_data.stretch_high);
     EXPECT_EQ(s.frames.size(), b.views.size()) << b.name;
     EXPECT_EQ(s.map->size(), b.map_points.size()) << b.name;
     for (const auto& f : s.frames)

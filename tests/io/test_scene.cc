@@ -29,6 +29,7 @@ class SceneTest : public testing::TempDirTest {
     c.T_imu_lidar.topRightCorner<3, 1>() = Eigen::Vector3d(-0.27255, 0.00053, -0.17954);
     c.time_offset_cam_lidar_s = -0.0123;
     c.lidar_holdout_every = 8;
+    c.intensity_window = std::make_pair(3620.5, 4618.0);
     c.poses_frame = PoseFrame::kImu;
     c.world_offset_m = {999.59453537619925, 1002.8533203485084, 101.14485388253293};
     c.source = "unit test \"full\" scene";
@@ -115,6 +116,7 @@ TEST_F(SceneTest, RoundTripKeepsEverything) {
   EXPECT_EQ(b.has_lidar_map, a.has_lidar_map);
   EXPECT_EQ(b.lidar_holdout_every, a.lidar_holdout_every);
   EXPECT_EQ(b.world_offset_m, a.world_offset_m);
+  EXPECT_EQ(b.intensity_window, a.intensity_window);
   EXPECT_EQ(b.source, a.source);
   ASSERT_EQ(r.frames.size(), 3u);
   for (size_t i = 0; i < 3; ++i) {
@@ -232,6 +234,12 @@ TEST_F(SceneTest, BadSceneYamlNamesTheLine) {
   replace("time_offset_cam_lidar_s: -0.0123", "time_offset_cam_lidar_s: .nan");
   testing::expect_io_error([&] { read_scene(dir_); },
                            {"scene.yaml:25:", "time_offset_cam_lidar_s", "non-finite"});
+  replace("intensity_window: [3620.5, 4618]", "intensity_window: [4618, 3620.5]");
+  testing::expect_io_error([&] { read_scene(dir_); },
+                           {"scene.yaml", "intensity_window: must be", "low < high"});
+  replace("intensity_window: [3620.5, 4618]", "intensity_window: [3620.5]");
+  testing::expect_io_error([&] { read_scene(dir_); },
+                           {"scene.yaml:", "intensity_window: expected [low, high]"});
   replace("units: {length: m,", "units: {length: mm,");
   testing::expect_io_error([&] { read_scene(dir_); }, {"scene.yaml:4:", "only 'm'"});
   replace("camera:\n", "camera: [\n");
