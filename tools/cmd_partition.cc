@@ -7,15 +7,22 @@
 #include <stdexcept>
 
 #include "engine/context.h"
+#include "host/partition/partition_option_names.h"
 #include "host/partition/partition_scene.h"
+#include "host/partition/train_in_blocks.h"
 #include "tools/commands.h"
 
 namespace litgs::tools {
 namespace {
 
-// "auto" or "CxR".
+// "auto", "N" or "CxR".
 void parse_blocks(const std::string& text, host::partition::PartitionOptions& o) {
   if (text == "auto") return;
+  if (!text.empty() && text.find_first_not_of("0123456789") == std::string::npos) {
+    o.blocks = std::stoul(text);
+    if (o.blocks == 0) throw CLI::ValidationError("--blocks", "the block count must be >= 1");
+    return;
+  }
   const size_t x = text.find('x');
   size_t used_c = 0, used_r = 0;
   try {
@@ -23,7 +30,7 @@ void parse_blocks(const std::string& text, host::partition::PartitionOptions& o)
     o.columns = std::stoul(text.substr(0, x), &used_c);
     o.rows = std::stoul(text.substr(x + 1), &used_r);
   } catch (const std::exception&) {
-    throw CLI::ValidationError("--blocks", "expected auto or COLUMNSxROWS (e.g. 3x1), got '" + text + "'");
+    throw CLI::ValidationError("--blocks", "expected auto, N or COLUMNSxROWS (e.g. 3x1), got '" + text + "'");
   }
   if (used_c != x || used_r != text.size() - x - 1 || o.columns == 0 || o.rows == 0)
     throw CLI::ValidationError("--blocks",
@@ -42,6 +49,37 @@ void print_report(const host::partition::PartitionReport& r) {
               << " in the core)\n";
 }
 
+// The options partition and train-blocks share.
+void add_partition_options(CLI::App* c, std::string& blocks, host::partition::PartitionOptions& o) {
+  c->add_option(host::partition_option::kBlocks.flag, blocks,
+                "auto (from the budget), N (laid out along the cameras' extent), or COLUMNSxROWS along the "
+                "scene's x and y")
+      ->capture_default_str();
+  c->add_option("--overlap", o.overlap_m,
+                "Metres each core cell grows by (default: 15 % of a cell's larger side)");
+  c->add_option("--max-gaussians-per-block", o.max_gaussians_per_block,
+                "auto: the block count keeps each block under this (default: half of what one storage "
+                "buffer of the device holds at SH degree 3)");
+  c->add_option("--gaussians", o.scene_gaussians,
+                "auto: the whole scene's budget (default: the map's points)");
+  c->add_option("--holdout-every", o.scene_holdout_every,
+                "The scene's frames i % N == 0 (eval's held-out views) go to no block (0: none)")
+      ->capture_default_str();
+  c->add_option("--visibility-share", o.visibility_share,
+                "A view outside a block joins it when this share of the map points it sees lie in the core")
+      ->capture_default_str();
+}
+
+// auto without a per-block limit: half of what one storage buffer of the device holds at SH degree 3.
+void resolve_auto(const std::string& blocks, host::partition::PartitionOptions& o) {
+  parse_blocks(blocks, o);
+  if (o.columns == 0 && o.blocks == 0 && o.max_gaussians_per_block == 0) {
+    engine::Context context;
+    o.max_gaussians_per_block =
+        host::partition::gaussians_per_buffer(context.info().max_storage_buffer_range, 3, 1) / 2;
+  }
+}
+
 }  // namespace
 
 void add_partition_command(CLI::App& app) {
@@ -55,28 +93,9 @@ void add_partition_command(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingDirectory);
   c->add_option("--out", *out, "Partition folder: partition.json and blocks/<name>/")->required();
-  c->add_option("--blocks", *blocks, "auto, or COLUMNSxROWS along the scene's x and y")
-      ->capture_default_str();
-  c->add_option("--overlap", o->overlap_m,
-                "Metres each core cell grows by (default: 15 % of a cell's larger side)");
-  c->add_option("--max-gaussians-per-block", o->max_gaussians_per_block,
-                "auto: the block count keeps each block under this (default: half of what one storage "
-                "buffer of the device holds at SH degree 3)");
-  c->add_option("--gaussians", o->scene_gaussians,
-                "auto: the whole scene's budget (default: the map's points)");
-  c->add_option("--holdout-every", o->scene_holdout_every,
-                "The scene's frames i % N == 0 (eval's held-out views) go to no block (0: none)")
-      ->capture_default_str();
-  c->add_option("--visibility-share", o->visibility_share,
-                "A view outside a block joins it when this share of the map points it sees lie in the core")
-      ->capture_default_str();
+  add_partition_options(c, *blocks, *o);
   c->callback([scene, out, blocks, o] {
-    parse_blocks(*blocks, *o);
-    if (o->columns == 0 && o->max_gaussians_per_block == 0) {
-      engine::Context context;
-      o->max_gaussians_per_block =
-          host::partition::gaussians_per_buffer(context.info().max_storage_buffer_range, 3, 1) / 2;
-    }
+    resolve_auto(*blocks, *o);
     print_report(host::partition::partition_scene(*scene, *out, *o));
   });
 
@@ -95,6 +114,47 @@ void add_partition_command(CLI::App& app) {
                 << " Gaussians (centres in its core cell)\n";
     std::cout << "merge: " << r.gaussians << " Gaussians from " << r.blocks.size() << " blocks, written to "
               << r.out.string() << "\n";
+  });
+
+  CLI::App* t = app.add_subcommand(
+      "train-blocks", "Partition a scene, train its blocks (locally or as a Slurm job array) and merge them");
+  auto tscene = std::make_shared<std::filesystem::path>();
+  auto tout = std::make_shared<std::filesystem::path>();
+  auto tblocks = std::make_shared<std::string>("auto");
+  auto tpo = std::make_shared<host::partition::PartitionOptions>();
+  auto tto = std::make_shared<host::partition::BlockTrainingOptions>();
+  auto executor = std::make_shared<std::string>("local");
+  t->add_option("scene", *tscene, "Scene directory (needs lidar/map.pcd)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  t->add_option("--out", *tout, "Output folder: point_cloud.ply, metrics.json, partition/")->required();
+  add_partition_options(t, *tblocks, *tpo);
+  namespace P = host::partition_option;
+  t->add_option(P::kExecutor.flag, *executor, P::kExecutor.help)
+      ->check(CLI::IsMember({"local", "slurm"}))
+      ->capture_default_str();
+  t->add_option(P::kJobs.flag, tto->parallel, P::kJobs.help)->capture_default_str();
+  t->add_option(P::kGres.flag, tto->slurm.gres, P::kGres.help)->capture_default_str();
+  t->add_option(P::kMem.flag, tto->slurm.mem, P::kMem.help);
+  t->add_option(P::kTime.flag, tto->slurm.time, P::kTime.help);
+  t->add_option(P::kSlurmPartition.flag, tto->slurm.partition, P::kSlurmPartition.help);
+  t->add_option("--sbatch-arg", tto->slurm.extra, "slurm: one more #SBATCH line's arguments (repeatable)");
+  t->add_option("--sbatch", tto->sbatch, "slurm: the sbatch program")->capture_default_str();
+  t->add_option("--train-arg", tto->train_args, "One more argument for every block's train (repeatable)");
+  t->callback([tscene, tout, tblocks, tpo, tto, executor] {
+    resolve_auto(*tblocks, *tpo);
+    tto->executor = host::partition::executor_from(*executor);
+    const auto r = host::partition::train_in_blocks(
+        *tscene, *tout, *tpo, *tto, this_executable(), [](const host::partition::BlockOutcome& b) {
+          std::cout << "  " << b.name << ": " << b.state;
+          if (b.state == "trained")
+            std::cout << " in " << std::fixed << std::setprecision(1) << b.seconds << " s";
+          std::cout << " (log " << b.log.string() << ")\n" << std::flush;
+        });
+    print_report(r.partition);
+    std::cout << "train-blocks: " << r.merge.gaussians << " Gaussians from " << r.merge.blocks.size()
+              << " blocks in " << std::fixed << std::setprecision(1) << r.seconds << " s; wrote "
+              << (*tout / "point_cloud.ply").string() << " and metrics.json\n";
   });
 }
 

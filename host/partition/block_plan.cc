@@ -45,7 +45,7 @@ void PartitionOptions::check() const {
     throw std::invalid_argument("partition: visibility_share must be in (0, 1]");
   if (!(max_view_depth_m > 0)) throw std::invalid_argument("partition: max_view_depth_m must be > 0");
   if (!std::isfinite(overlap_m)) throw std::invalid_argument("partition: overlap_m must be finite");
-  if (columns == 0 && max_gaussians_per_block == 0)
+  if (columns == 0 && blocks == 0 && max_gaussians_per_block == 0)
     throw std::invalid_argument("partition: auto needs max_gaussians_per_block > 0");
 }
 
@@ -81,16 +81,19 @@ BlockPlan plan_blocks(const std::vector<PlanView>& views, const std::vector<Eige
     plan.why = "as asked";
   } else {
     const size_t gaussians = o.scene_gaussians > 0 ? o.scene_gaussians : map.size();
-    const size_t n = blocks_needed(gaussians, o.max_gaussians_per_block);
+    const size_t n = o.blocks > 0 ? o.blocks : blocks_needed(gaussians, o.max_gaussians_per_block);
     Eigen::Vector3d lo = centres[0], hi = centres[0];
     for (const auto& c : centres) lo = lo.cwiseMin(c), hi = hi.cwiseMax(c);
     const double ex = std::max(hi.x() - lo.x(), 1e-3), ey = std::max(hi.y() - lo.y(), 1e-3);
     plan.columns = std::clamp<size_t>(
         static_cast<size_t>(std::lround(std::sqrt(static_cast<double>(n) * ex / ey))), 1, n);
     plan.rows = (n + plan.columns - 1) / plan.columns;
-    plan.why = std::to_string(gaussians) + " Gaussians at most " + std::to_string(o.max_gaussians_per_block) +
-               " per block: " + std::to_string(n) + " blocks, laid out along the cameras' extent (" +
-               std::to_string(static_cast<int>(ex)) + " x " + std::to_string(static_cast<int>(ey)) + " m)";
+    plan.why =
+        o.blocks > 0
+            ? std::to_string(n) + " blocks as asked, laid out along the cameras' extent"
+            : std::to_string(gaussians) + " Gaussians at most " + std::to_string(o.max_gaussians_per_block) +
+                  " per block: " + std::to_string(n) + " blocks, laid out along the cameras' extent (" +
+                  std::to_string(static_cast<int>(ex)) + " x " + std::to_string(static_cast<int>(ey)) + " m)";
   }
 
   // Columns by the cameras' x, then rows by the y of the cameras in each column.

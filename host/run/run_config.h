@@ -12,6 +12,7 @@
 #include "host/eval/eval_option_names.h"
 #include "host/frontend/match_option_names.h"
 #include "host/lidar_map/map_option_names.h"
+#include "host/partition/partition_option_names.h"
 #include "host/refine/refine_option_names.h"
 #include "host/train/train_defaults.h"
 #include "host/train/train_option_names.h"
@@ -76,6 +77,14 @@ struct RunConfig {
     uint32_t checkpoint_every = 250;
     uint32_t progress_every = 50;
     std::vector<std::string> extra_args;
+    // Training in blocks (host/partition/partition_option_names.h): "1" is one training of the whole scene.
+    std::string blocks = "1";
+    std::string executor = "local";
+    uint32_t block_jobs = 1;
+    std::string slurm_gres = "gpu:1";
+    std::string slurm_mem;
+    std::string slurm_time;
+    std::string slurm_partition;
   } train;
   struct Eval {
     uint32_t emd_samples = 1000;
@@ -130,6 +139,7 @@ void for_each_field(Config& c, F&& f) {
   named("refine", refine_option::kThreads, c.refine.threads);
   f("refine", "extra_args", c.refine.extra_args, "more flags for `litgs-engine refine`, as is");
   namespace T = train_option;
+  namespace P = partition_option;
   named("train", T::kIterations, c.train.iterations);
   named("train", T::kDownscale, c.train.downscale);
   named("train", T::kStrategy, c.train.strategy);
@@ -145,6 +155,13 @@ void for_each_field(Config& c, F&& f) {
   named("train", T::kCheckpointEvery, c.train.checkpoint_every);
   named("train", T::kProgressEvery, c.train.progress_every);
   f("train", "extra_args", c.train.extra_args, "more flags for `litgs-engine train`, as is");
+  named("train", P::kBlocks, c.train.blocks);
+  named("train", P::kExecutor, c.train.executor);
+  named("train", P::kJobs, c.train.block_jobs);
+  named("train", P::kGres, c.train.slurm_gres);
+  named("train", P::kMem, c.train.slurm_mem);
+  named("train", P::kTime, c.train.slurm_time);
+  named("train", P::kSlurmPartition, c.train.slurm_partition);
   named("eval", eval_option::kEmdSamples, c.eval.emd_samples);
   named("eval", eval_option::kEmdRounds, c.eval.emd_rounds);
   named("eval", eval_option::kSeed, c.eval.seed);

@@ -1,6 +1,7 @@
 // train: the Gaussian map (`litgs-engine train`), resumed from its checkpoints after an interruption.
 #include <stdexcept>
 
+#include "host/partition/partition_option_names.h"
 #include "host/run/stage.h"
 #include "host/train/train_option_names.h"
 
@@ -26,6 +27,28 @@ std::vector<std::string> init_flags(const StageContext& c, std::vector<std::file
   return {"--init", init};
 }
 
+// train.blocks other than 1: `train-blocks` partitions the scene (DIR/train/partition), trains each block
+// with the train flags (on all its frames: the scene's held-out views are kept out of every block), merges.
+StagePlan plan_in_blocks(const StageContext& c, StagePlan p, const std::vector<std::string>& train_flags) {
+  namespace P = partition_option;
+  const RunConfig::Train& o = c.config.train;
+  const fs::path dir = c.stage_dir("train");
+  p.command = {"train-blocks",  c.scene().string(), "--out",           dir.string(),
+               P::kBlocks.flag, o.blocks,           "--holdout-every", std::to_string(o.holdout_every)};
+  const std::vector<std::string> executor =
+      option_flags(p.options, {P::kExecutor, P::kJobs, P::kGres, P::kMem, P::kTime, P::kSlurmPartition});
+  p.command.insert(p.command.end(), executor.begin(), executor.end());
+  for (const std::string& a : train_flags) p.command.push_back("--train-arg=" + a);
+  for (const std::string& a : {std::string("--holdout-every"), std::string("0")})
+    p.command.push_back("--train-arg=" + a);
+  const fs::path rel = c.stage_rel("train");
+  p.outputs = {rel / "point_cloud.ply", rel / "metrics.json"};
+  p.resumable = true;  // the partition and the blocks already trained are kept
+  p.resume_from = {rel / "partition"};
+  p.notes.push_back("in blocks (" + o.blocks + ", executor " + o.executor + "): DIR/train/partition");
+  return p;
+}
+
 StagePlan plan(const StageContext& c) {
   namespace T = train_option;
   const RunConfig::Train& o = c.config.train;
@@ -34,6 +57,16 @@ StagePlan plan(const StageContext& c) {
   StagePlan p;
   p.inputs = {scene};
   p.options = section_json(c.config, "train");
+  if (o.blocks != "1") {
+    std::vector<std::string> train_flags;
+    for (const auto& flags :
+         {option_flags(p.options, {T::kIterations, T::kDownscale, T::kStrategy, T::kMaxGaussians,
+                                   T::kMcmcGrowth, T::kLambdaGeo, T::kIntensity, T::kPoses, T::kSeed,
+                                   T::kCheckpointEvery, T::kProgressEvery}),
+          init_flags(c, p.inputs), o.extra_args})
+      train_flags.insert(train_flags.end(), flags.begin(), flags.end());
+    return plan_in_blocks(c, p, train_flags);
+  }
   p.command = {"train", scene, "--out", dir.string()};
   for (const auto& flags :
        {option_flags(p.options, {T::kIterations, T::kDownscale, T::kStrategy, T::kMaxGaussians,

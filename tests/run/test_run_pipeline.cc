@@ -235,6 +235,33 @@ TEST(RunStages, TrainStartsFromRefinedPoints) {
   EXPECT_EQ(std::stoul(r.output.substr(init + 5, at - init - 5)), points) << r.output;
 }
 
+// train.blocks: 2 trains the scene as two blocks (train-blocks, the local executor) and merges them; eval
+// scores the merged model on the whole scene; a rerun finds the stage done.
+TEST(RunStages, TrainInBlocksMergesAndEvaluatesTheWholeScene) {
+  const fs::path dir = kRoot / "blocks";
+  fs::remove_all(dir);
+  const fs::path config =
+      write_text(kRoot / "blocks.yaml", small_run_yaml("  blocks: \"2\"\n  block_jobs: 2\n", 20));
+  const CommandResult r = run_engine(run_args("synth:street", dir, config));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const nlohmann::json metrics = read_json_file(dir / "train" / "metrics.json");
+  ASSERT_TRUE(metrics.is_object()) << r.output;
+  ASSERT_EQ(metrics["blocks"].size(), 2u);
+  size_t kept = 0;
+  for (const auto& b : metrics["blocks"]) {
+    EXPECT_EQ(b["state"], "trained");
+    EXPECT_GT(b["kept"].get<size_t>(), 0u);
+    kept += b["kept"].get<size_t>();
+  }
+  EXPECT_EQ(metrics["gaussians"].get<size_t>(), kept);
+  const nlohmann::json eval = read_json_file(dir / "eval" / "eval.json");
+  ASSERT_TRUE(eval.is_object()) << r.output;
+  EXPECT_EQ(eval["gaussians"].get<size_t>(), kept) << "eval scored the merged model";
+  const CommandResult again = run_engine(run_args("synth:street", dir, config));
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_EQ(stage_status(dir, "train"), "up to date") << again.output;
+}
+
 TEST(RunBadInput, UnknownInputKind) {
   const fs::path dir = kRoot / "unknown";
   fs::remove_all(dir);

@@ -1,0 +1,47 @@
+#include "host/partition/train_in_blocks.h"
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+
+#include "io/atomic_file.h"
+
+namespace litgs::host::partition {
+namespace fs = std::filesystem;
+
+TrainInBlocksReport train_in_blocks(const fs::path& scene, const fs::path& out, const PartitionOptions& po,
+                                    const BlockTrainingOptions& to, const fs::path& engine,
+                                    const BlockProgress& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  TrainInBlocksReport r;
+  const fs::path dir = out / "partition";
+  r.partition = partition_scene(scene, dir, po);
+  r.training = train_blocks(dir, engine, to, progress);
+  r.merge = merge_blocks(dir, out / "point_cloud.ply");
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  nlohmann::json blocks = nlohmann::json::array();
+  for (size_t k = 0; k < r.training.blocks.size(); ++k) {
+    const BlockOutcome& b = r.training.blocks[k];
+    const Block& planned = r.partition.plan.blocks.at(k);
+    blocks.push_back({{"name", b.name},
+                      {"state", b.state},
+                      {"seconds", b.seconds},
+                      {"views", planned.views.size()},
+                      {"map_points", planned.map_points.size()},
+                      {"gaussians", r.merge.blocks.at(k).gaussians},
+                      {"kept", r.merge.blocks.at(k).kept},
+                      {"log", b.log.string()}});
+  }
+  const nlohmann::json metrics = {{"gaussians", r.merge.gaussians},
+                                  {"wall_s", r.seconds},
+                                  {"executor", to.executor == Executor::kLocal ? "local" : "slurm"},
+                                  {"columns", r.partition.plan.columns},
+                                  {"rows", r.partition.plan.rows},
+                                  {"blocks", blocks}};
+  // One training's loss curve has no meaning here; the run report reads an empty one.
+  io::write_file_atomic(out / "trace.jsonl", [](std::ostream&) {});
+  io::write_file_atomic(out / "metrics.json", [&](std::ostream& os) { os << metrics.dump(2) << "\n"; });
+  return r;
+}
+
+}  // namespace litgs::host::partition
