@@ -147,7 +147,7 @@ void add_partition_command(CLI::App& app) {
     const auto r = host::partition::train_in_blocks(
         *tscene, *tout, *tpo, *tto, this_executable(), [](const host::partition::BlockOutcome& b) {
           std::cout << "  " << b.name << ": " << b.state;
-          if (b.state == "trained")
+          if (b.state == "trained" && b.seconds > 0)
             std::cout << " in " << std::fixed << std::setprecision(1) << b.seconds << " s";
           std::cout << " (log " << b.log.string() << ")\n" << std::flush;
         });

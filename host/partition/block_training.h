@@ -42,8 +42,8 @@ struct BlockOutcome {
   std::string name;
   std::string state;  // "trained", "done before", "failed"
   std::filesystem::path log;
-  double seconds = 0;
-  std::string tail;  // a failed block's last output
+  double seconds = 0;  // its training's wall time; 0 under slurm (the scheduler's accounting has it)
+  std::string tail;    // a failed block's last output
 };
 
 struct BlockTrainingReport {
