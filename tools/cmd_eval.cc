@@ -11,7 +11,10 @@
 #include "host/eval/evaluate_model.h"
 #include "host/eval/trajectory_eval.h"
 #include "host/eval/view_images.h"
+#include "host/partition/seam_metrics.h"
+#include "host/train/training_data.h"
 #include "io/atomic_file.h"
+#include "io/scene.h"
 #include "tools/commands.h"
 #include "tools/data_flags.h"
 
@@ -23,6 +26,7 @@ struct EvalCliOptions {
   bool json = false;
   std::string out;        // eval.json, written atomically
   std::string views_out;  // folder for the held-out views' pictures
+  std::string partition;  // a partition folder: PSNR per block and along the seams
   DataFlags data_flags;
   host::EvalOptions eval;
 };
@@ -117,9 +121,17 @@ void run_eval(const EvalCliOptions& cli) {
     return;
   }
   std::vector<host::ViewImages> images;
+  const bool keep_images = !cli.views_out.empty() || !cli.partition.empty();
   const host::ModelEvaluation e =
-      host::evaluate_model(cli.model, cli.scene, o, cli.views_out.empty() ? nullptr : &images);
+      host::evaluate_model(cli.model, cli.scene, o, keep_images ? &images : nullptr);
   nlohmann::json j = host::to_json(e);
+  if (!cli.partition.empty()) {
+    const io::Scene scene = io::read_scene(cli.scene, {.check_images = false, .load_map = false});
+    std::vector<kernels::SplatCamera> cameras;
+    for (const host::ViewMetrics& v : e.views)
+      cameras.push_back(host::training_camera(cli.scene, scene, v.t_s, o.data));
+    j["partition"] = host::partition::to_json(host::partition::seam_metrics(cli.partition, images, cameras));
+  }
   j["trajectory"] = host::trajectory_json_or_reason(cli.scene, o.data.true_poses);
   if (!cli.views_out.empty()) {
     std::filesystem::create_directories(cli.views_out);
@@ -129,10 +141,23 @@ void run_eval(const EvalCliOptions& cli) {
         {"folder", cli.views_out}, {"views", pictures}, {"error_full_scale", host::kErrorFullScale}};
   }
   if (!cli.out.empty()) io::write_file_atomic(cli.out, [&](std::ostream& s) { s << j.dump(2) << "\n"; });
-  if (cli.json)
+  if (cli.json) {
     std::cout << j.dump(2) << "\n";
-  else
-    print_text(e, j["trajectory"]);
+    return;
+  }
+  print_text(e, j["trajectory"]);
+  if (j.contains("partition")) {
+    const nlohmann::json& p = j["partition"];
+    auto line = [](const nlohmann::json& r) {
+      return r["name"].get<std::string>() + " " +
+             (r["psnr_db"].is_null() ? std::string("-") : fixed(r["psnr_db"].get<double>(), 2)) + " dB (" +
+             std::to_string(r["pixels"].get<size_t>()) + " px)";
+    };
+    std::cout << "eval: held-out PSNR by block:";
+    for (const auto& b : p["blocks"]) std::cout << " " << line(b) << ";";
+    std::cout << " within " << fixed(p["seam_width_m"].get<double>(), 2)
+              << " m of a seam: " << line(p["seams"]) << ", elsewhere: " << line(p["interior"]) << "\n";
+  }
 }
 
 }  // namespace
@@ -153,6 +178,10 @@ void add_eval_command(CLI::App& app) {
   cmd->add_option("--out", o->out, "Also write the JSON results to this file (atomically)");
   cmd->add_option("--views-out", o->views_out,
                   "Write each held-out view's render, frame, error map, false colour and depth as PNG here");
+  cmd->add_option(
+         "--partition", o->partition,
+         "A partition folder (partition, train-blocks): the held-out PSNR per block and along the seams")
+      ->check(CLI::ExistingDirectory);
   add_data_flags(cmd, o->eval.data, o->data_flags);
   cmd->add_option(E::kEmdSamples.flag, o->eval.emd.samples, E::kEmdSamples.help)->capture_default_str();
   cmd->add_option(E::kEmdRounds.flag, o->eval.emd.rounds, E::kEmdRounds.help)->capture_default_str();

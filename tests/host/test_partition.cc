@@ -8,6 +8,7 @@
 
 #include "host/partition/block_plan.h"
 #include "host/partition/partition_scene.h"
+#include "host/partition/seam_metrics.h"
 #include "host/synth/synth.h"
 #include "host/train/training_data.h"
 #include "io/gaussian_ply.h"
@@ -150,6 +151,42 @@ TEST(PartitionBadInput, NonFinitePoseOrNoViews) {
   EXPECT_THROW(plan_blocks(views, wall(0, 4), o), std::invalid_argument);
   o.rows = 0;  // columns without rows
   EXPECT_THROW(o.check(), std::invalid_argument);
+}
+
+// Two blocks split at x = 0, one view looking down the world's +z at a surface 5 m away: the render errs by
+// 0.01 in block 0 and by 0.1 in block 1, so their PSNRs are 40 and 20 dB; the seam band of 0.5 m is the
+// columns whose surface point lies within 0.5 m of x = 0.
+TEST(PartitionSeams, PsnrPerBlockAndAlongTheSeam) {
+  const fs::path dir = fs::temp_directory_path() / ("litgs-seams-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / kPartitionFile)
+      << R"({"overlap_m": 1.0, "blocks": [{"name": "block-0-0", "core": [null, 0.0, null, null]},
+                                          {"name": "block-1-0", "core": [0.0, null, null, null]}]})";
+  kernels::SplatCamera cam;  // identity pose: camera frame = world frame
+  cam.fx = cam.fy = 100;
+  cam.cx = 80, cam.cy = 60, cam.width = 160, cam.height = 120;
+  ViewImages v;
+  v.name = "v";
+  v.width = 160, v.height = 120;
+  const size_t n = 160 * 120;
+  v.target.assign(n, 0.5f);
+  v.depth_m.assign(n, 5.0f);
+  v.alpha.assign(n, 1.0f);
+  v.render.resize(n);
+  for (size_t p = 0; p < n; ++p) v.render[p] = p % 160 < 80 ? 0.51f : 0.6f;  // x < 0: block 0
+  v.alpha[0] = 0.1f;                                                         // one pixel without a surface
+  const SeamMetrics m = seam_metrics(dir, {v}, {cam});
+  fs::remove_all(dir);
+  EXPECT_EQ(m.seam_width_m, 0.5);  // half the overlap
+  ASSERT_EQ(m.blocks.size(), 2u);
+  EXPECT_NEAR(m.blocks[0].psnr_db, 40.0, 1e-4);  // float32 0.51 - 0.5
+  EXPECT_NEAR(m.blocks[1].psnr_db, 20.0, 1e-4);
+  EXPECT_EQ(m.unplaced, 1u);
+  EXPECT_EQ(m.blocks[0].pixels + m.blocks[1].pixels, n - 1);
+  // |x| = |u + 0.5 - 80| / 100 * 5 < 0.5: columns 70..89, 20 of them, in every row.
+  EXPECT_EQ(m.seams.pixels, 20u * 120u);
+  EXPECT_EQ(m.interior.pixels, n - 1 - 20u * 120u);
+  EXPECT_THROW(seam_metrics(dir, {v}, {}), std::invalid_argument);
 }
 
 class PartitionSceneTest : public ::testing::Test {
