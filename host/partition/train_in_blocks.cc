@@ -1,12 +1,24 @@
 #include "host/partition/train_in_blocks.h"
 
 #include <chrono>
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
 
 namespace litgs::host::partition {
 namespace fs = std::filesystem;
+
+namespace {
+
+// A block's own training metrics (train's metrics.json), or null where it has none.
+nlohmann::json block_training_metric(const fs::path& block, const char* key) {
+  std::ifstream in(block / kBlockTrainDir / "metrics.json");
+  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+  return in && j.is_object() && j.contains(key) ? j[key] : nlohmann::json(nullptr);
+}
+
+}  // namespace
 
 TrainInBlocksReport train_in_blocks(const fs::path& scene, const fs::path& out, const PartitionOptions& po,
                                     const BlockTrainingOptions& to, const fs::path& engine,
@@ -23,14 +35,16 @@ TrainInBlocksReport train_in_blocks(const fs::path& scene, const fs::path& out, 
   for (size_t k = 0; k < r.training.blocks.size(); ++k) {
     const BlockOutcome& b = r.training.blocks[k];
     const Block& planned = r.partition.plan.blocks.at(k);
-    blocks.push_back({{"name", b.name},
-                      {"state", b.state},
-                      {"seconds", b.seconds},
-                      {"views", planned.views.size()},
-                      {"map_points", planned.map_points.size()},
-                      {"gaussians", r.merge.blocks.at(k).gaussians},
-                      {"kept", r.merge.blocks.at(k).kept},
-                      {"log", b.log.string()}});
+    blocks.push_back(
+        {{"name", b.name},
+         {"state", b.state},
+         {"seconds", b.seconds},
+         {"views", planned.views.size()},
+         {"map_points", planned.map_points.size()},
+         {"gaussians", r.merge.blocks.at(k).gaussians},
+         {"kept", r.merge.blocks.at(k).kept},
+         {"peak_device_bytes", block_training_metric(dir / kBlocksDir / b.name, "peak_device_bytes")},
+         {"log", b.log.string()}});
   }
   const nlohmann::json metrics = {{"gaussians", r.merge.gaussians},
                                   {"wall_s", r.seconds},

@@ -251,6 +251,7 @@ TEST(RunStages, TrainInBlocksMergesAndEvaluatesTheWholeScene) {
   for (const auto& b : metrics["blocks"]) {
     EXPECT_EQ(b["state"], "trained");
     EXPECT_GT(b["kept"].get<size_t>(), 0u);
+    EXPECT_GT(b["peak_device_bytes"].get<double>(), 0) << "gathered from the block's own metrics.json";
     kept += b["kept"].get<size_t>();
   }
   EXPECT_EQ(metrics["gaussians"].get<size_t>(), kept);
