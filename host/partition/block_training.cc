@@ -6,7 +6,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
-#include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -19,23 +18,6 @@ namespace litgs::host::partition {
 namespace fs = std::filesystem;
 
 namespace {
-
-struct BlockEntry {
-  std::string name;
-  size_t views = 0;
-};
-
-std::vector<BlockEntry> read_blocks(const fs::path& dir) {
-  const fs::path manifest = dir / kPartitionFile;
-  std::ifstream in(manifest);
-  if (!in) throw std::runtime_error("train blocks: " + manifest.string() + " not found: partition first");
-  const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.contains("blocks"))
-    throw std::runtime_error("train blocks: " + manifest.string() + " is not a partition (does not parse)");
-  std::vector<BlockEntry> blocks;
-  for (const auto& b : j.at("blocks")) blocks.push_back({b.at("name"), b.value("views", size_t{0})});
-  return blocks;
-}
 
 fs::path block_dir(const fs::path& dir, const std::string& name) {
   return dir / kBlocksDir / name;
@@ -93,7 +75,7 @@ void throw_if_failed(const BlockTrainingReport& r, const std::string& executor) 
 }
 
 BlockTrainingReport train_local(const fs::path& dir, const fs::path& engine,
-                                const std::vector<BlockEntry>& blocks, const BlockTrainingOptions& o,
+                                const std::vector<PartitionBlock>& blocks, const BlockTrainingOptions& o,
                                 const BlockProgress& progress) {
   BlockTrainingReport r;
   r.blocks.resize(blocks.size());
@@ -127,7 +109,7 @@ BlockTrainingReport train_local(const fs::path& dir, const fs::path& engine,
 }
 
 BlockTrainingReport train_slurm(const fs::path& dir, const fs::path& engine,
-                                const std::vector<BlockEntry>& blocks, const BlockTrainingOptions& o,
+                                const std::vector<PartitionBlock>& blocks, const BlockTrainingOptions& o,
                                 const BlockProgress& progress) {
   const fs::path sbatch = find_program(o.sbatch);
   if (sbatch.empty())
@@ -177,7 +159,7 @@ Executor executor_from(const std::string& name) {
 SlurmResources default_slurm_resources(const fs::path& dir, SlurmResources r) {
   if (!r.mem.empty()) return r;
   double largest = 0;
-  for (const auto& b : read_blocks(dir)) {
+  for (const auto& b : read_partition(dir, "train blocks").blocks) {
     const io::SceneConfig c = io::read_scene_yaml(block_dir(dir, b.name) / "scene.yaml");
     largest = std::max(largest, static_cast<double>(b.views) * c.camera.width * c.camera.height);
   }
@@ -215,7 +197,7 @@ std::string slurm_array_script(const fs::path& dir, const fs::path& engine,
 BlockTrainingReport train_blocks(const fs::path& dir, const fs::path& engine, const BlockTrainingOptions& o,
                                  const BlockProgress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<BlockEntry> blocks = read_blocks(dir);
+  const std::vector<PartitionBlock> blocks = read_partition(dir, "train blocks").blocks;
   BlockTrainingReport r = o.executor == Executor::kLocal ? train_local(dir, engine, blocks, o, progress)
                                                          : train_slurm(dir, engine, blocks, o, progress);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

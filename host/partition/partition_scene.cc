@@ -204,14 +204,23 @@ PartitionReport partition_scene(const fs::path& scene_dir, const fs::path& out, 
   return r;
 }
 
-MergeReport merge_blocks(const fs::path& dir, const fs::path& out_ply, const std::string& model_dir) {
+PartitionManifest read_partition(const fs::path& dir, const std::string& who) {
   const fs::path manifest = dir / kPartitionFile;
-  if (!fs::exists(manifest)) throw std::runtime_error("merge: " + manifest.string() + " not found");
-  const json plan = json::parse(std::ifstream(manifest), nullptr, false);
+  std::ifstream in(manifest);
+  if (!in) throw std::runtime_error(who + ": " + manifest.string() + " not found: partition first");
+  const json plan = json::parse(in, nullptr, false);
   if (plan.is_discarded() || !plan.contains("blocks"))
-    throw std::runtime_error("merge: " + manifest.string() + " is not a partition (does not parse)");
+    throw std::runtime_error(who + ": " + manifest.string() + " is not a partition (does not parse)");
+  PartitionManifest m;
+  m.overlap_m = plan.value("overlap_m", 0.0);
+  for (const auto& b : plan.at("blocks"))
+    m.blocks.push_back({b.at("name"), cell_from(b.at("core")), b.value("views", size_t{0})});
+  return m;
+}
+
+MergeReport merge_blocks(const fs::path& dir, const fs::path& out_ply, const std::string& model_dir) {
   std::vector<std::pair<std::string, CoreCell>> cores;
-  for (const auto& b : plan.at("blocks")) cores.emplace_back(b.at("name"), cell_from(b.at("core")));
+  for (const PartitionBlock& b : read_partition(dir, "merge").blocks) cores.emplace_back(b.name, b.core);
 
   MergeReport r;
   r.out = out_ply;

@@ -36,6 +36,22 @@ struct PartitionReport {
 PartitionReport partition_scene(const std::filesystem::path& scene, const std::filesystem::path& out,
                                 const PartitionOptions& options);
 
+// What a partition folder's partition.json says about its blocks, as merge, the executors and the seam
+// metrics need it.
+struct PartitionBlock {
+  std::string name;
+  CoreCell core;
+  size_t views = 0;
+};
+struct PartitionManifest {
+  double overlap_m = 0;
+  std::vector<PartitionBlock> blocks;  // in the plan's order
+};
+
+// DIR/partition.json. std::runtime_error starting with `who` and naming the file when it is missing or is not
+// a partition.
+PartitionManifest read_partition(const std::filesystem::path& dir, const std::string& who);
+
 struct MergedBlock {
   std::string name;
   size_t gaussians = 0;  // in the block's model

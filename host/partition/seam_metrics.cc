@@ -1,7 +1,6 @@
 #include "host/partition/seam_metrics.h"
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <stdexcept>
 
@@ -26,11 +25,6 @@ struct Accumulator {
   }
 };
 
-CoreCell cell_of(const json& j) {
-  auto edge = [](const json& e, double infinite) { return e.is_null() ? infinite : e.get<double>(); };
-  return {edge(j.at(0), -kInf), edge(j.at(1), kInf), edge(j.at(2), -kInf), edge(j.at(3), kInf)};
-}
-
 // Distance from (x, y) inside `c` to its nearest bounded edge (a border with another block).
 double to_border(const CoreCell& c, double x, double y) {
   double d = kInf;
@@ -54,18 +48,13 @@ SeamMetrics seam_metrics(const fs::path& dir, const std::vector<ViewImages>& vie
   if (views.size() != cameras.size())
     throw std::invalid_argument("seam metrics: " + std::to_string(views.size()) + " views but " +
                                 std::to_string(cameras.size()) + " cameras");
-  std::ifstream in(dir / kPartitionFile);
-  const json plan = json::parse(in, nullptr, false);
-  if (!in || plan.is_discarded() || !plan.contains("blocks"))
-    throw std::runtime_error("seam metrics: " + (dir / kPartitionFile).string() +
-                             " cannot be read as a partition");
+  const PartitionManifest plan = read_partition(dir, "seam metrics");
   std::vector<std::string> names;
   std::vector<CoreCell> cores;
-  for (const auto& b : plan.at("blocks"))
-    names.push_back(b.at("name")), cores.push_back(cell_of(b.at("core")));
+  for (const PartitionBlock& b : plan.blocks) names.push_back(b.name), cores.push_back(b.core);
 
   SeamMetrics m;
-  m.seam_width_m = o.seam_width_m >= 0 ? o.seam_width_m : 0.5 * plan.value("overlap_m", 0.0);
+  m.seam_width_m = o.seam_width_m >= 0 ? o.seam_width_m : 0.5 * plan.overlap_m;
   std::vector<Accumulator> per_block(cores.size());
   Accumulator seams, interior;
   for (size_t k = 0; k < views.size(); ++k) {
