@@ -61,4 +61,54 @@ std::filesystem::path write_intrinsics_files(const std::filesystem::path& path, 
   return info;
 }
 
+namespace {
+
+nlohmann::json matrix_rows(const Eigen::Matrix4d& T) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({T(r, 0), T(r, 1), T(r, 2), T(r, 3)});
+  return rows;
+}
+
+nlohmann::json optional_number(double v) {
+  return v >= 0 ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+nlohmann::json extrinsic_json(const ExtrinsicResult& r) {
+  nlohmann::json views = nlohmann::json::array();
+  for (const auto& v : r.views)
+    views.push_back({{"view", v.name},
+                     {"used", v.used},
+                     {"rms_px", optional_number(v.rms_px)},
+                     {"rms_m", optional_number(v.rms_m)},
+                     {"note", v.note}});
+  return {{"T_cam_lidar", matrix_rows(r.T_cam_lidar.matrix())},
+          {"rms_px", r.rms_px},
+          {"rms_m", r.rms_m},
+          {"rotation_sd_deg", r.rotation_sd_deg},
+          {"translation_sd_m", r.translation_sd_m},
+          {"views_used", r.views_used},
+          {"views", views}};
+}
+
+void write_extrinsic_yaml(const std::filesystem::path& path, const ExtrinsicResult& r) {
+  const Eigen::Matrix4d T = r.T_cam_lidar.matrix();
+  io::write_file_atomic(path, [&](std::ostream& out) {
+    out << "# Thermal-to-LiDAR extrinsic from litgs-engine calib extrinsic (" << r.views_used
+        << " views, RMS " << r.rms_px << " px, " << r.rms_m
+        << " m): scene.yaml's T_cam_lidar (docs/scene-format.md)\n"
+        << "T_cam_lidar:  # maps LiDAR points into the camera frame\n"
+        << std::setprecision(17);
+    for (int row = 0; row < 4; ++row)
+      out << "  - [" << T(row, 0) << ", " << T(row, 1) << ", " << T(row, 2) << ", " << T(row, 3) << "]\n";
+  });
+}
+
+void write_extrinsic_into_scene(const std::filesystem::path& scene_yaml, const ExtrinsicResult& r) {
+  io::SceneConfig scene = io::read_scene_yaml(scene_yaml);
+  scene.T_cam_lidar = r.T_cam_lidar.matrix();
+  io::write_scene_yaml(scene_yaml, scene);
+}
+
 }  // namespace litgs::calib

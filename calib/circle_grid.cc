@@ -14,18 +14,9 @@ namespace litgs::calib {
 namespace {
 
 cv::Mat to_8bit(const io::Image& image) {
-  if (image.channels != 1) throw std::invalid_argument("circle grid: a one-channel (gray) image is needed");
-  cv::Mat out(image.height, image.width, CV_8U);
-  if (image.bit_depth == 8) {
-    for (size_t k = 0; k < image.data.size(); ++k) out.data[k] = static_cast<uint8_t>(image.data[k]);
-    return out;
-  }
-  // The front end's stretch, so that a board is seen as the matcher sees the frames.
-  host::frontend::Histogram histogram = host::frontend::empty_histogram();
-  host::frontend::add_to_histogram(histogram, image.data);
-  const host::frontend::Stretch stretch = host::frontend::percentile_stretch(histogram, 0.5, 99.5);
-  for (size_t k = 0; k < image.data.size(); ++k)
-    out.data[k] = static_cast<uint8_t>(stretch.unit(image.data[k]) * 255.0 + 0.5);
+  const io::Image eight = thermal_8bit(image);
+  cv::Mat out(eight.height, eight.width, CV_8U);
+  for (size_t k = 0; k < eight.data.size(); ++k) out.data[k] = static_cast<uint8_t>(eight.data[k]);
   return out;
 }
 
@@ -100,6 +91,23 @@ void refine_centres(const cv::Mat& dark, std::vector<Eigen::Vector2d>& centres) 
 }
 
 }  // namespace
+
+io::Image thermal_8bit(const io::Image& image) {
+  if (image.channels != 1) throw std::invalid_argument("a one-channel (gray) thermal image is needed");
+  io::Image out{image.width, image.height, 1, 8, {}};
+  out.data.resize(image.data.size());
+  if (image.bit_depth == 8) {
+    out.data = image.data;
+    return out;
+  }
+  // The front end's stretch, so that a board is seen as the matcher sees the frames.
+  host::frontend::Histogram histogram = host::frontend::empty_histogram();
+  host::frontend::add_to_histogram(histogram, image.data);
+  const host::frontend::Stretch stretch = host::frontend::percentile_stretch(histogram, 0.5, 99.5);
+  for (size_t k = 0; k < image.data.size(); ++k)
+    out.data[k] = static_cast<uint16_t>(stretch.unit(image.data[k]) * 255.0 + 0.5);
+  return out;
+}
 
 std::vector<Eigen::Vector3d> CircleGrid::board_points() const {
   std::vector<Eigen::Vector3d> out;

@@ -31,6 +31,10 @@ struct GridDetection {
   std::string why_not;                   // where not found
 };
 
+// A one-channel frame as 8 bits: a 16-bit frame by the front end's 0.5 / 99.5 percentile stretch, an 8-bit
+// one as it is. std::invalid_argument for more channels.
+io::Image thermal_8bit(const io::Image& image);
+
 // The image as 8 bits: a 16-bit frame by its 0.5 / 99.5 percentile stretch, an 8-bit one as it is; then
 // CLAHE where asked. The grid is searched for with hot circles, cold circles or (auto) both.
 GridDetection detect_circle_grid(const io::Image& image, const CircleGrid& grid, Polarity polarity,

@@ -136,6 +136,7 @@ std::string check_scene_config(const SceneConfig& c) {
 
 namespace {
 SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path);
+CameraIntrinsics read_camera_block(const Reader& r, const YAML::Node& root);
 }  // namespace
 
 SceneConfig read_scene_yaml(const std::filesystem::path& path) {
@@ -146,7 +147,46 @@ SceneConfig read_scene_yaml(const std::filesystem::path& path) {
   }
 }
 
+CameraIntrinsics read_camera_yaml(const std::filesystem::path& path) {
+  try {
+    if (!std::filesystem::exists(path)) fail(path, 0, "file does not exist");
+    const YAML::Node root = YAML::LoadFile(path.string());
+    const Reader r{path};
+    SceneConfig c;
+    c.camera = read_camera_block(r, root);
+    const std::string problem = check_scene_config(c);
+    if (!problem.empty()) fail(path, r.line(root), problem);
+    return c.camera;
+  } catch (const YAML::Exception& e) {
+    fail(path, e.mark.line >= 0 ? e.mark.line + 1 : 0, "YAML: " + e.msg);
+  }
+}
+
 namespace {
+
+CameraIntrinsics read_camera_block(const Reader& r, const YAML::Node& root) {
+  const std::filesystem::path& path = r.path;
+  CameraIntrinsics camera;
+  const YAML::Node cam = r.get(root, "camera", "");
+  r.only_keys(cam, {"model", "width", "height", "fx", "fy", "cx", "cy", "distortion", "bit_depth"},
+              "camera.");
+  const std::string model = r.text(r.get(cam, "model", "camera."), "camera.model");
+  if (model == "pinhole")
+    camera.model = CameraModel::kPinhole;
+  else if (model == "equidistant")
+    camera.model = CameraModel::kEquidistant;
+  else
+    fail(path, r.line(cam["model"]), "camera.model: '" + model + "' is not pinhole or equidistant");
+  camera.width = r.integer(r.get(cam, "width", "camera."), "camera.width", 1, 1 << 16);
+  camera.height = r.integer(r.get(cam, "height", "camera."), "camera.height", 1, 1 << 16);
+  camera.fx = r.number(r.get(cam, "fx", "camera."), "camera.fx");
+  camera.fy = r.number(r.get(cam, "fy", "camera."), "camera.fy");
+  camera.cx = r.number(r.get(cam, "cx", "camera."), "camera.cx");
+  camera.cy = r.number(r.get(cam, "cy", "camera."), "camera.cy");
+  camera.distortion = r.numbers(r.get(cam, "distortion", "camera."), "camera.distortion");
+  camera.bit_depth = r.integer(r.get(cam, "bit_depth", "camera."), "camera.bit_depth", 8, 16);
+  return camera;
+}
 
 SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) fail(path, 0, "file does not exist");
@@ -176,24 +216,7 @@ SceneConfig read_scene_yaml_unguarded(const std::filesystem::path& path) {
       fail(path, r.line(units[key]), std::string("units.") + key + ": only '" + unit + "' is supported");
 
   SceneConfig c;
-  const YAML::Node cam = r.get(root, "camera", "");
-  r.only_keys(cam, {"model", "width", "height", "fx", "fy", "cx", "cy", "distortion", "bit_depth"},
-              "camera.");
-  const std::string model = r.text(r.get(cam, "model", "camera."), "camera.model");
-  if (model == "pinhole")
-    c.camera.model = CameraModel::kPinhole;
-  else if (model == "equidistant")
-    c.camera.model = CameraModel::kEquidistant;
-  else
-    fail(path, r.line(cam["model"]), "camera.model: '" + model + "' is not pinhole or equidistant");
-  c.camera.width = r.integer(r.get(cam, "width", "camera."), "camera.width", 1, 1 << 16);
-  c.camera.height = r.integer(r.get(cam, "height", "camera."), "camera.height", 1, 1 << 16);
-  c.camera.fx = r.number(r.get(cam, "fx", "camera."), "camera.fx");
-  c.camera.fy = r.number(r.get(cam, "fy", "camera."), "camera.fy");
-  c.camera.cx = r.number(r.get(cam, "cx", "camera."), "camera.cx");
-  c.camera.cy = r.number(r.get(cam, "cy", "camera."), "camera.cy");
-  c.camera.distortion = r.numbers(r.get(cam, "distortion", "camera."), "camera.distortion");
-  c.camera.bit_depth = r.integer(r.get(cam, "bit_depth", "camera."), "camera.bit_depth", 8, 16);
+  c.camera = read_camera_block(r, root);
   c.T_cam_lidar = r.transform(r.get(root, "T_cam_lidar", ""), "T_cam_lidar");
   c.T_imu_lidar = r.transform(r.get(root, "T_imu_lidar", ""), "T_imu_lidar");
   c.time_offset_cam_lidar_s = r.number(r.get(root, "time_offset_cam_lidar_s", ""), "time_offset_cam_lidar_s");

@@ -17,6 +17,10 @@ SceneConfig read_scene_yaml(const std::filesystem::path& path);
 // Throws std::invalid_argument naming the field on the same checks; writes atomically.
 void write_scene_yaml(const std::filesystem::path& path, const SceneConfig& config);
 
+// The `camera:` block of a file: camera.yaml as `calib intrinsics` writes it, or a scene.yaml. IoError as
+// read_scene_yaml gives for that block.
+CameraIntrinsics read_camera_yaml(const std::filesystem::path& path);
+
 // scene.yaml's `camera:` block, as write_scene_yaml writes it (`calib intrinsics` writes it alone).
 std::string camera_yaml_block(const CameraIntrinsics& camera);
 

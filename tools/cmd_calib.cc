@@ -1,5 +1,5 @@
-// `litgs-engine calib intrinsics --images DIR --grid COLSxROWS --spacing S ...`: thermal intrinsics from an
-// asymmetric circle grid (calib/). Parses, reads the images, calls calib/, prints and writes.
+// `litgs-engine calib intrinsics ...`: thermal intrinsics from an asymmetric circle grid; `calib extrinsic
+// ...`: the thermal-to-LiDAR extrinsic from a holed board (calib/). Parses, calls calib/, prints and writes.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -9,8 +9,11 @@
 
 #include "calib/calibration_files.h"
 #include "calib/circle_grid.h"
+#include "calib/extrinsic_views.h"
+#include "calib/holed_board.h"
 #include "calib/intrinsics.h"
 #include "io/image.h"
+#include "io/scene_yaml.h"
 #include "tools/commands.h"
 
 namespace litgs::tools {
@@ -87,10 +90,63 @@ void run_intrinsics(const IntrinsicsCli& o) {
   std::cout << "  wrote " << o.out.string() << " and " << info.string() << "\n";
 }
 
+struct ExtrinsicCli {
+  fs::path images, scans, board, intrinsics, scene, out;
+  double beam_divergence_mrad = 3;
+  bool json = false;
+};
+
+void run_extrinsic(const ExtrinsicCli& o) {
+  if (o.intrinsics.empty() && o.scene.empty())
+    throw std::invalid_argument(
+        "calib extrinsic: the camera's intrinsics are needed: --intrinsics camera.yaml "
+        "(as calib intrinsics writes it) or --scene scene.yaml");
+  const io::CameraIntrinsics K = io::read_camera_yaml(o.intrinsics.empty() ? o.scene : o.intrinsics);
+  const calib::HoledBoard board = calib::read_holed_board(o.board);
+  calib::BoardInScanOptions scan_options;
+  scan_options.beam_divergence_rad = o.beam_divergence_mrad / 1000;
+  const auto print_view = [&](const calib::ExtrinsicView& v) {
+    if (o.json) return;
+    std::cout << "  " << v.name << ": image " << (v.image.found ? "board found" : v.image.why_not)
+              << "; scan "
+              << (v.scan.found ? "board found (" + std::to_string(v.scan.board_points) + " returns)"
+                               : v.scan.why_not)
+              << "\n";
+  };
+  const std::vector<calib::ExtrinsicView> views =
+      calib::find_boards(o.images, o.scans, K, board, scan_options, print_view);
+  const calib::ExtrinsicResult r = calib::solve_extrinsic(views, K, board, {});
+  calib::write_extrinsic_yaml(o.out, r);
+  if (!o.scene.empty()) calib::write_extrinsic_into_scene(o.scene, r);
+  if (o.json) {
+    std::cout << calib::extrinsic_json(r).dump(2) << "\n";
+    return;
+  }
+  char line[256];
+  std::snprintf(
+      line, sizeof line,
+      "calib extrinsic: %zu of %zu views used, RMS %.3f px, %.4f m (rotation +- %.3g deg, translation "
+      "+- %.2g m)\n",
+      r.views_used, views.size(), r.rms_px, r.rms_m, r.rotation_sd_deg, r.translation_sd_m);
+  std::cout << line << "  T_cam_lidar:\n";
+  const Eigen::Matrix4d T = r.T_cam_lidar.matrix();
+  for (int row = 0; row < 4; ++row) {
+    std::snprintf(line, sizeof line, "    %10.6f %10.6f %10.6f %10.5f\n", T(row, 0), T(row, 1), T(row, 2),
+                  T(row, 3));
+    std::cout << line;
+  }
+  for (const auto& v : r.views)
+    if (!v.used && v.rms_px >= 0) std::cout << "  left out " << v.name << ": " << v.note << "\n";
+  std::cout << "  wrote " << o.out.string()
+            << (o.scene.empty() ? "" : " and T_cam_lidar into " + o.scene.string()) << "\n";
+}
+
 }  // namespace
 
 void add_calib_command(CLI::App& app) {
-  CLI::App* calib = app.add_subcommand("calib", "Calibrate the rig: thermal intrinsics from a circle grid");
+  CLI::App* calib = app.add_subcommand(
+      "calib",
+      "Calibrate the rig: thermal intrinsics from a circle grid, the LiDAR extrinsic from a holed board");
   calib->require_subcommand(1);
   auto o = std::make_shared<IntrinsicsCli>();
   CLI::App* in =
@@ -115,6 +171,31 @@ void add_calib_command(CLI::App& app) {
       ->required();
   in->add_flag("--json", o->json, "Print the result as one JSON object");
   in->callback([o] { run_intrinsics(*o); });
+
+  auto e = std::make_shared<ExtrinsicCli>();
+  CLI::App* ex = calib->add_subcommand(
+      "extrinsic", "The thermal-to-LiDAR extrinsic from views of a board with circular holes");
+  ex->add_option("--images", e->images, "Folder of the thermal views (8- or 16-bit PNG or TIFF)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  ex->add_option("--scans", e->scans,
+                 "Folder of the LiDAR scans (.pcd or .ply, LiDAR frame), named as the images")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  ex->add_option("--board", e->board, "board.yaml: the board's size, hole radius and hole centres")
+      ->required()
+      ->check(CLI::ExistingFile);
+  ex->add_option("--intrinsics", e->intrinsics,
+                 "camera.yaml (calib intrinsics' output), else --scene's camera")
+      ->check(CLI::ExistingFile);
+  ex->add_option("--scene", e->scene, "A scene.yaml whose T_cam_lidar is replaced by the result")
+      ->check(CLI::ExistingFile);
+  ex->add_option("--beam-divergence", e->beam_divergence_mrad,
+                 "The LiDAR beam's full divergence in mrad (edges seem wider by half a footprint)")
+      ->capture_default_str();
+  ex->add_option("--out", e->out, "extrinsic.yaml to write (scene.yaml's T_cam_lidar block)")->required();
+  ex->add_flag("--json", e->json, "Print the result as one JSON object");
+  ex->callback([e] { run_extrinsic(*e); });
 }
 
 }  // namespace litgs::tools

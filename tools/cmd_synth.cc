@@ -21,9 +21,8 @@ void add_synth_command(CLI::App& app) {
   auto height = std::make_shared<int>(0);
   synth
       ->add_option("--preset", o->preset,
-                   "facade | street | corridor, or circle-grid (a calibration set for `calib intrinsics`; "
-                   "--rig renders it "
-                   "through the rig's lens)")
+                   "facade | street | corridor, or circle-grid (a calibration set for `calib intrinsics`) "
+                   "or holed-board (one for `calib extrinsic`); --rig renders a set through the rig's lens")
       ->capture_default_str();
   synth->add_option("--out", o->out, "Scene directory to write")->required();
   synth->add_option("--seed", o->seed, "Random seed: the same seed gives the same bytes")
@@ -79,6 +78,15 @@ void add_synth_command(CLI::App& app) {
                 << " asymmetric circle grid (" << *polarity << " circles, spacing " << r.grid.spacing_m
                 << " m) at " << r.width << "x" << r.height << (r.distorted ? " through --rig's lens" : "")
                 << "; written to " << o->out.string() << "/images, the truth to truth.json\n";
+      return;
+    }
+    if (o->preset == host::synth::kHoledBoardPreset) {
+      const host::synth::HoledBoardSetReport r = host::synth::generate_holed_board_set(*o);
+      std::cout << "synth holed-board: " << r.views << " views of a board with 4 holes by the camera at "
+                << r.width << "x" << r.height << " and a 32-ring LiDAR"
+                << (r.rig ? " (--rig's camera and extrinsic)" : "") << "; written to " << o->out.string()
+                << " (images/, scans/, board.yaml, camera.yaml), the truth "
+                << "to truth.json\n";
       return;
     }
     const host::synth::SynthReport r = host::synth::generate_synthetic_scene(*o);

@@ -68,6 +68,8 @@ void cast_rect(const Rect& r, int i, const Ray& ray, double min_m, double& best_
   if (u < 0 || u > r.u_len_m || v < 0 || v > r.v_len_m) return;
   for (const Hole& h : r.holes)
     if (u > h.u0_m && u < h.u1_m && v > h.v0_m && v < h.v1_m) return;
+  for (const RoundHole& h : r.round_holes)
+    if ((u - h.u_m) * (u - h.u_m) + (v - h.v_m) * (v - h.v_m) < h.radius_m * h.radius_m) return;
   best_t = t;
   best = Hit{t, ray.origin + t * ray.dir, denom < 0 ? n : Eigen::Vector3d(-n), u, v, r.texture, i};
 }

@@ -1,6 +1,6 @@
 // The synthetic world: textured rectangles (walls, ground, doors, window panes, box faces; optionally with
-// rectangular holes) and vertical cylinders, with a brute-force ray caster. Every rectangle is one true
-// plane of gt/planes.txt.
+// rectangular or round holes) and vertical cylinders, with a brute-force ray caster. Every rectangle is one
+// true plane of gt/planes.txt.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,6 +22,11 @@ struct Hole {
   double u0_m = 0, v0_m = 0, u1_m = 0, v1_m = 0;
 };
 
+// A round hole in a rectangle's (u, v) coordinates (metres): the extrinsic calibration board's.
+struct RoundHole {
+  double u_m = 0, v_m = 0, radius_m = 0;
+};
+
 // origin + u * u_axis + v * v_axis for u in [0, u_len_m], v in [0, v_len_m], minus the holes.
 struct Rect {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
@@ -30,6 +35,7 @@ struct Rect {
   double u_len_m = 1, v_len_m = 1;
   std::vector<Hole> holes;
   int texture = 0;  // index into World::textures
+  std::vector<RoundHole> round_holes;
 };
 
 // A vertical cylinder (posts, pipes, columns): its side only.

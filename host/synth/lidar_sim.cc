@@ -22,6 +22,8 @@ std::string LidarOptions::check() const {
   }
   if (!(range_min_m >= 0 && range_max_m > range_min_m)) return "range_min_m/range_max_m: need 0 <= min < max";
   if (!(range_noise_m >= 0)) return "range_noise_m: must be >= 0";
+  if (!(beam_divergence_rad >= 0 && beam_divergence_rad < 0.1))
+    return "beam_divergence_rad: must be in [0, 0.1)";
   return "";
 }
 
@@ -32,7 +34,16 @@ LidarScan simulate_lidar_scan(const World& world, const Eigen::Isometry3d& T_wor
   const Eigen::Matrix3d R = T_world_lidar.linear();
   const Eigen::Vector3d origin = T_world_lidar.translation();
   auto shoot = [&](const Eigen::Vector3d& dir_lidar) {
-    const auto hit = world.cast({origin, R * dir_lidar}, o.range_min_m, o.range_max_m);
+    const Eigen::Vector3d dir = R * dir_lidar;
+    auto hit = world.cast({origin, dir}, o.range_min_m, o.range_max_m);
+    if (o.beam_divergence_rad > 0) {
+      const Eigen::Vector3d a = dir.unitOrthogonal(), b = dir.cross(a);
+      const double h = std::tan(o.beam_divergence_rad / 2);
+      for (const Eigen::Vector3d& off : {a, Eigen::Vector3d(-a), b, Eigen::Vector3d(-b)}) {
+        const auto edge = world.cast({origin, (dir + h * off).normalized()}, o.range_min_m, o.range_max_m);
+        if (edge && (!hit || edge->range_m < hit->range_m)) hit = edge;
+      }
+    }
     const double noise = o.range_noise_m * rng.normal();  // drawn for every beam: misses keep streams aligned
     if (!hit) return;
     scan.points_lidar.push_back(dir_lidar * (hit->range_m + noise));

@@ -31,6 +31,10 @@ struct LidarOptions {
   double range_min_m = 0.5;      // returns closer than this are dropped
   double range_max_m = 60;       // and farther than this
   double range_noise_m = 0.015;  // standard deviation of the range error, along the beam
+  // The beam's full divergence (0: an ideal ray). A beam returns from the nearest surface any part of its
+  // footprint touches (five rays: the centre and four at half the divergence), placed along its centre ray:
+  // at an edge, the nearer surface seems to reach up to half a footprint past it.
+  double beam_divergence_rad = 0;
 
   std::string check() const;  // empty if valid, else the first bad field and why
 };

@@ -1,0 +1,238 @@
+#include "calib/board_in_image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/circle_grid.h"
+#include "calib/layout_fit.h"
+#include "io/lens_distortion.h"
+
+namespace litgs::calib {
+namespace {
+
+double median_of(std::vector<uint8_t> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// The hole's intensity-weighted centroid: weights go from 0 at the board's level (the median of a ring of
+// board around the hole) to 1 at the hole's (the median inside it), so the blur's spread of the edge keeps
+// the centroid where it was.
+bool hole_centroid(const cv::Mat& gray, const std::vector<cv::Point>& contour, Eigen::Vector2d& centre) {
+  const double area = cv::contourArea(contour);
+  const int margin = std::max(2, static_cast<int>(std::lround(0.25 * std::sqrt(area / M_PI))));
+  cv::Mat hole = cv::Mat::zeros(gray.size(), CV_8U);
+  cv::drawContours(hole, std::vector<std::vector<cv::Point>>{contour}, 0, 255, cv::FILLED);
+  cv::Mat inner, near, window;
+  cv::erode(hole, inner, cv::Mat(), cv::Point(-1, -1), 2);
+  cv::dilate(hole, near, cv::Mat(), cv::Point(-1, -1), 2);
+  cv::dilate(hole, window,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin + 1, 2 * margin + 1)));
+  std::vector<uint8_t> inside, ring;
+  for (int y = 0; y < gray.rows; ++y)
+    for (int x = 0; x < gray.cols; ++x) {
+      if (!window.at<uint8_t>(y, x)) continue;
+      if (inner.at<uint8_t>(y, x)) inside.push_back(gray.at<uint8_t>(y, x));
+      if (!near.at<uint8_t>(y, x)) ring.push_back(gray.at<uint8_t>(y, x));
+    }
+  if (inside.empty() || ring.empty()) return false;
+  const double hole_level = median_of(inside), board_level = median_of(ring);
+  if (std::abs(hole_level - board_level) < 8) return false;
+  double w = 0, sx = 0, sy = 0;
+  for (int y = 0; y < gray.rows; ++y)
+    for (int x = 0; x < gray.cols; ++x) {
+      if (!window.at<uint8_t>(y, x)) continue;
+      const double t =
+          std::clamp((gray.at<uint8_t>(y, x) - board_level) / (hole_level - board_level), 0.0, 1.0);
+      w += t;
+      sx += t * x;
+      sy += t * y;
+    }
+  if (!(w > 0)) return false;
+  centre = {sx / w, sy / w};
+  return true;
+}
+
+std::vector<cv::Point2d> undistorted(const io::CameraIntrinsics& K, const std::vector<Eigen::Vector2d>& px) {
+  std::vector<cv::Point2d> out;
+  for (const auto& p : px) {
+    const auto u = io::undistort_normalized(K, {(p.x() - K.cx) / K.fx, (p.y() - K.cy) / K.fy});
+    if (!u) return {};
+    out.emplace_back(u->x(), u->y());
+  }
+  return out;
+}
+
+Eigen::Isometry3d to_isometry(const cv::Mat& rvec, const cv::Mat& tvec) {
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Matrix3d r;
+  cv::cv2eigen(R, r);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = r;
+  T.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  return T;
+}
+
+double rms_px(const io::CameraIntrinsics& K, const Eigen::Isometry3d& T,
+              const std::vector<Eigen::Vector3d>& board, const std::vector<Eigen::Vector2d>& px) {
+  double sq = 0;
+  for (size_t k = 0; k < board.size(); ++k) sq += (project_to_pixel(K, T * board[k]) - px[k]).squaredNorm();
+  return std::sqrt(sq / static_cast<double>(board.size()));
+}
+
+// Where the centroid of hole k's image lies against the projection of its centre: the hole's outline
+// projected through the pose and the lens, its area centroid (shoelace) minus the centre's projection.
+Eigen::Vector2d centroid_offset(const io::CameraIntrinsics& K, const Eigen::Isometry3d& T,
+                                const HoledBoard& board, size_t k) {
+  constexpr int kSamples = 180;
+  std::vector<Eigen::Vector2d> outline;
+  for (int i = 0; i < kSamples; ++i) {
+    const double a = 2 * M_PI * i / kSamples;
+    const Eigen::Vector3d q(board.holes[k].x() + board.hole_radius_m * std::cos(a),
+                            board.holes[k].y() + board.hole_radius_m * std::sin(a), 0);
+    outline.push_back(project_to_pixel(K, T * q));
+  }
+  double area = 0, cx = 0, cy = 0;
+  for (int i = 0; i < kSamples; ++i) {
+    const Eigen::Vector2d& a = outline[i];
+    const Eigen::Vector2d& b = outline[(i + 1) % kSamples];
+    const double cross = a.x() * b.y() - b.x() * a.y();
+    area += cross;
+    cx += (a.x() + b.x()) * cross;
+    cy += (a.y() + b.y()) * cross;
+  }
+  const Eigen::Vector2d centroid(cx / (3 * area), cy / (3 * area));
+  return centroid - project_to_pixel(K, T * Eigen::Vector3d(board.holes[k].x(), board.holes[k].y(), 0));
+}
+
+}  // namespace
+
+Eigen::Vector2d project_to_pixel(const io::CameraIntrinsics& K, const Eigen::Vector3d& p) {
+  const Eigen::Vector2d d = io::distort_normalized(K, {p.x() / p.z(), p.y() / p.z()});
+  return {K.fx * d.x() + K.cx, K.fy * d.y() + K.cy};
+}
+
+BoardInImage find_board_in_image(const io::Image& image, const io::CameraIntrinsics& K,
+                                 const HoledBoard& board) {
+  board.check();
+  BoardInImage out;
+  if (image.width != K.width || image.height != K.height) {
+    out.why_not = "image " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                  ", intrinsics " + std::to_string(K.width) + "x" + std::to_string(K.height);
+    return out;
+  }
+  const io::Image eight = thermal_8bit(image);
+  const cv::Mat gray(eight.height, eight.width, CV_8U);
+  for (size_t i = 0; i < eight.data.size(); ++i) gray.data[i] = static_cast<uint8_t>(eight.data[i]);
+  cv::Mat high;
+  cv::threshold(gray, high, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+  const size_t n = board.holes.size();
+  // The board: the largest region of one side of the threshold with at least n inner contours (holes).
+  std::vector<std::vector<cv::Point>> best_holes;
+  double best_area = 0;
+  std::string tried;
+  for (const bool warm : {true, false}) {
+    cv::Mat mask = warm ? high : cv::Mat(255 - high);
+    std::vector<std::vector<cv::Point>> contours;
+    std::vector<cv::Vec4i> tree;
+    cv::findContours(mask, contours, tree, cv::RETR_CCOMP, cv::CHAIN_APPROX_NONE);
+    size_t most = 0;
+    for (size_t i = 0; i < contours.size(); ++i) {
+      if (tree[i][3] >= 0) continue;  // an inner contour
+      std::vector<std::vector<cv::Point>> holes;
+      for (int c = tree[i][2]; c >= 0; c = tree[c][0])
+        if (cv::contourArea(contours[c]) >= 12) holes.push_back(contours[c]);
+      most = std::max(most, holes.size());
+      if (holes.size() < n) continue;
+      std::sort(holes.begin(), holes.end(),
+                [](const auto& a, const auto& b) { return cv::contourArea(a) > cv::contourArea(b); });
+      holes.resize(n);
+      if (cv::contourArea(holes.front()) > 6 * cv::contourArea(holes.back())) continue;
+      const double area = cv::contourArea(contours[i]);
+      if (area > best_area) {
+        best_area = area;
+        best_holes = holes;
+        out.polarity = warm ? "warm board" : "cold board";
+      }
+    }
+    tried += std::string(tried.empty() ? "" : ", ") + (warm ? "warm" : "cold") + " regions with at most " +
+             std::to_string(most) + " holes";
+  }
+  if (best_holes.empty()) {
+    out.why_not = "no board with " + std::to_string(n) + " holes (" + tried + ")";
+    return out;
+  }
+  std::vector<Eigen::Vector2d> centroids(n);
+  for (size_t k = 0; k < n; ++k)
+    if (!hole_centroid(gray, best_holes[k], centroids[k])) {
+      out.why_not = "a hole without contrast against the board";
+      return out;
+    }
+  // The correspondence: the cyclic shift whose pose reprojects best; on a symmetric board the most upright.
+  const std::vector<Eigen::Vector3d> on_board = board.hole_centres();
+  std::vector<cv::Point3d> object;
+  for (const auto& q : on_board) object.emplace_back(q.x(), q.y(), q.z());
+  const cv::Mat identity = cv::Mat::eye(3, 3, CV_64F);
+  const std::vector<cv::Point2d> rays = undistorted(K, centroids);
+  if (rays.empty()) {
+    out.why_not = "a hole centre outside the lens model's range";
+    return out;
+  }
+  struct Candidate {
+    std::vector<Eigen::Vector2d> px;
+    Eigen::Isometry3d T;
+    double rms = 0;
+  };
+  std::vector<Candidate> candidates;
+  double least = std::numeric_limits<double>::infinity();
+  for (const auto& match : cyclic_correspondences(board.holes, centroids)) {
+    Candidate c;
+    std::vector<cv::Point2d> image_points;
+    for (size_t k = 0; k < n; ++k) {
+      c.px.push_back(centroids[match[k]]);
+      image_points.push_back(rays[match[k]]);
+    }
+    cv::Mat rvec, tvec;
+    if (!cv::solvePnP(object, image_points, identity, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_IPPE))
+      continue;
+    c.T = to_isometry(rvec, tvec);
+    c.rms = rms_px(K, c.T, on_board, c.px);
+    least = std::min(least, c.rms);
+    candidates.push_back(c);
+  }
+  const Candidate* chosen = nullptr;
+  for (const Candidate& c : candidates)
+    if (c.rms <= 1.5 * least + 0.5 && (!chosen || c.T.linear()(1, 1) > chosen->T.linear()(1, 1))) chosen = &c;
+  if (!chosen) {
+    out.why_not = "no board pose fits the holes";
+    return out;
+  }
+  // The centroids moved onto the centres' projections, and the pose solved again.
+  const std::vector<Eigen::Vector2d> measured = chosen->px;
+  Eigen::Isometry3d T = chosen->T;
+  std::vector<Eigen::Vector2d> corrected = measured;
+  for (int pass = 0; pass < 3; ++pass) {
+    for (size_t k = 0; k < n; ++k) corrected[k] = measured[k] - centroid_offset(K, T, board, k);
+    const std::vector<cv::Point2d> image_points = undistorted(K, corrected);
+    if (image_points.empty()) break;
+    cv::Mat R(3, 3, CV_64F), rvec, tvec(3, 1, CV_64F);
+    cv::eigen2cv(Eigen::Matrix3d(T.linear()), R);
+    cv::Rodrigues(R, rvec);
+    for (int i = 0; i < 3; ++i) tvec.at<double>(i) = T.translation()(i);
+    cv::solvePnP(object, image_points, identity, cv::noArray(), rvec, tvec, true, cv::SOLVEPNP_ITERATIVE);
+    T = to_isometry(rvec, tvec);
+  }
+  out.centres_px = corrected;
+  out.T_cam_board = T;
+  out.pnp_rms_px = rms_px(K, T, on_board, corrected);
+  out.found = true;
+  return out;
+}
+
+}  // namespace litgs::calib
