@@ -21,8 +21,9 @@ double median_of(std::vector<uint8_t> v) {
 }
 
 // The hole's intensity-weighted centroid: weights go from 0 at the board's level (the median of a ring of
-// board around the hole) to 1 at the hole's (the median inside it), so the blur's spread of the edge keeps
-// the centroid where it was.
+// board around the hole) to 1 at half the way to the hole's (the median inside it), so the blur's spread of
+// the edge keeps the centroid where it was (it is symmetric about the outline) and a background that differs
+// across the hole (wall and ground) does not pull it.
 bool hole_centroid(const cv::Mat& gray, const std::vector<cv::Point>& contour, Eigen::Vector2d& centre) {
   const double area = cv::contourArea(contour);
   const int margin = std::max(2, static_cast<int>(std::lround(0.25 * std::sqrt(area / M_PI))));
@@ -48,7 +49,7 @@ bool hole_centroid(const cv::Mat& gray, const std::vector<cv::Point>& contour, E
     for (int x = 0; x < gray.cols; ++x) {
       if (!window.at<uint8_t>(y, x)) continue;
       const double t =
-          std::clamp((gray.at<uint8_t>(y, x) - board_level) / (hole_level - board_level), 0.0, 1.0);
+          std::clamp((gray.at<uint8_t>(y, x) - board_level) / (0.5 * (hole_level - board_level)), 0.0, 1.0);
       w += t;
       sx += t * x;
       sy += t * y;

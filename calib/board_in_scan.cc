@@ -147,9 +147,20 @@ BoardInScan find_board_in_scan(const std::vector<Eigen::Vector3d>& p, const Hole
         "no returns within " + std::to_string(o.min_range_m) + "-" + std::to_string(o.max_range_m) + " m";
     return out;
   }
-  if (rings.size() > 512) {
-    out.why_not = "the returns form no rings (" + std::to_string(rings.size()) +
-                  " distinct elevations): a spinning LiDAR's scan is needed";
+  // A spinning LiDAR's returns fall on a few dozen cones of one elevation each; a non-repetitive pattern's
+  // (Livox) spread over the field of view.
+  double widest = 0;
+  for (const Ring& r : rings) {
+    const auto [lo, hi] = std::minmax_element(r.points.begin(), r.points.end(), [&](size_t a, size_t b) {
+      return std::atan2(p[a].z(), p[a].head<2>().norm()) < std::atan2(p[b].z(), p[b].head<2>().norm());
+    });
+    widest = std::max(widest, std::atan2(p[*hi].z(), p[*hi].head<2>().norm()) -
+                                  std::atan2(p[*lo].z(), p[*lo].head<2>().norm()));
+  }
+  if (rings.size() > 512 || widest > 1 * kDeg) {
+    out.why_not = "the returns form no rings of one elevation each (" + std::to_string(rings.size()) +
+                  " groups, the widest over " + std::to_string(static_cast<int>(std::ceil(widest / kDeg))) +
+                  " degrees): a spinning LiDAR's scan is needed";
     return out;
   }
   // The board: the planar segment whose extent in its plane best matches the board's outline.
