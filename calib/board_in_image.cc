@@ -14,42 +14,54 @@
 namespace litgs::calib {
 namespace {
 
-double median_of(std::vector<uint8_t> v) {
+double median_of(std::vector<double> v) {
   if (v.empty()) return 0;
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
   return v[v.size() / 2];
 }
 
-// The hole's intensity-weighted centroid: weights go from 0 at the board's level (the median of a ring of
-// board around the hole) to 1 at half the way to the hole's (the median inside it), so the blur's spread of
-// the edge keeps the centroid where it was (it is symmetric about the outline) and a background that differs
-// across the hole (wall and ground) does not pull it.
-bool hole_centroid(const cv::Mat& gray, const std::vector<cv::Point>& contour, Eigen::Vector2d& centre) {
+// The hole's intensity-weighted centroid in the frame's own values: weights go from 0 at the board's level
+// to 1 at half the way to the hole's (the median inside it), so the blur's spread of the edge keeps the
+// centroid where it was (it is symmetric about the outline) and a background that differs across the hole
+// (wall and ground) does not pull it. The board's level is a plane fitted to a ring of board around the
+// hole: a gradient across the board (vignetting, a warmer side) would otherwise weigh one side's noise more.
+bool hole_centroid(const cv::Mat& values, const std::vector<cv::Point>& contour, Eigen::Vector2d& centre) {
   const double area = cv::contourArea(contour);
   const int margin = std::max(2, static_cast<int>(std::lround(0.25 * std::sqrt(area / M_PI))));
-  cv::Mat hole = cv::Mat::zeros(gray.size(), CV_8U);
+  cv::Mat hole = cv::Mat::zeros(values.size(), CV_8U);
   cv::drawContours(hole, std::vector<std::vector<cv::Point>>{contour}, 0, 255, cv::FILLED);
   cv::Mat inner, near, window;
   cv::erode(hole, inner, cv::Mat(), cv::Point(-1, -1), 2);
   cv::dilate(hole, near, cv::Mat(), cv::Point(-1, -1), 2);
   cv::dilate(hole, window,
              cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin + 1, 2 * margin + 1)));
-  std::vector<uint8_t> inside, ring;
-  for (int y = 0; y < gray.rows; ++y)
-    for (int x = 0; x < gray.cols; ++x) {
+  std::vector<double> inside;
+  Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
+  size_t ring = 0;
+  for (int y = 0; y < values.rows; ++y)
+    for (int x = 0; x < values.cols; ++x) {
       if (!window.at<uint8_t>(y, x)) continue;
-      if (inner.at<uint8_t>(y, x)) inside.push_back(gray.at<uint8_t>(y, x));
-      if (!near.at<uint8_t>(y, x)) ring.push_back(gray.at<uint8_t>(y, x));
+      if (inner.at<uint8_t>(y, x)) inside.push_back(values.at<double>(y, x));
+      if (!near.at<uint8_t>(y, x)) {
+        const Eigen::Vector3d a(1, x, y);
+        AtA += a * a.transpose();
+        Atb += a * values.at<double>(y, x);
+        ++ring;
+      }
     }
-  if (inside.empty() || ring.empty()) return false;
-  const double hole_level = median_of(inside), board_level = median_of(ring);
-  if (std::abs(hole_level - board_level) < 8) return false;
+  if (inside.empty() || ring < 12) return false;
+  const Eigen::Vector3d board = AtA.ldlt().solve(Atb);
+  const auto board_level = [&](int x, int y) { return board(0) + board(1) * x + board(2) * y; };
+  const Eigen::Vector2d middle = Eigen::Vector2d(AtA(0, 1), AtA(0, 2)) / AtA(0, 0);
+  const double contrast =
+      median_of(inside) - board_level(static_cast<int>(middle.x()), static_cast<int>(middle.y()));
+  if (!(std::abs(contrast) > 0)) return false;
   double w = 0, sx = 0, sy = 0;
-  for (int y = 0; y < gray.rows; ++y)
-    for (int x = 0; x < gray.cols; ++x) {
+  for (int y = 0; y < values.rows; ++y)
+    for (int x = 0; x < values.cols; ++x) {
       if (!window.at<uint8_t>(y, x)) continue;
-      const double t =
-          std::clamp((gray.at<uint8_t>(y, x) - board_level) / (0.5 * (hole_level - board_level)), 0.0, 1.0);
+      const double t = std::clamp((values.at<double>(y, x) - board_level(x, y)) / (0.5 * contrast), 0.0, 1.0);
       w += t;
       sx += t * x;
       sy += t * y;
@@ -169,9 +181,12 @@ BoardInImage find_board_in_image(const io::Image& image, const io::CameraIntrins
     out.why_not = "no board with " + std::to_string(n) + " holes (" + tried + ")";
     return out;
   }
+  cv::Mat values(image.height, image.width, CV_64F);  // the frame's own values, not the 8-bit stretch
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) values.at<double>(y, x) = image.at(x, y);
   std::vector<Eigen::Vector2d> centroids(n);
   for (size_t k = 0; k < n; ++k)
-    if (!hole_centroid(gray, best_holes[k], centroids[k])) {
+    if (!hole_centroid(values, best_holes[k], centroids[k])) {
       out.why_not = "a hole without contrast against the board";
       return out;
     }

@@ -60,43 +60,54 @@ void add_synth_command(CLI::App& app) {
                   "freeze) in the raw frames; the truth in gt/levels.txt");
   synth->add_option("--threads", o->threads, "Worker threads (0: all cores, at most 8)")
       ->capture_default_str();
+  synth
+      ->add_option(
+          "--sensor-noise", o->sensor_noise,
+          "circle-grid, holed-board: the thermal camera's temporal and fixed-pattern noise times this")
+      ->capture_default_str();
+  auto range_noise = std::make_shared<double>(0.01);
+  CLI::Option* range_noise_option =
+      synth->add_option("--range-noise", *range_noise,
+                        "holed-board: the LiDAR's range noise, metres (standard deviation; default 0.01)");
   auto polarity = std::make_shared<std::string>("hot");
   synth
       ->add_option("--polarity", *polarity,
                    "circle-grid: circles hotter (hot) or colder (cold) than the board")
       ->check(CLI::IsMember({"hot", "cold"}))
       ->capture_default_str();
-  synth->callback([o, frames, width, height, rate, f, w, h, rate_option, polarity] {
-    if (f->count()) o->frames = *frames;
-    if (rate_option->count()) o->frame_rate_hz = *rate;
-    if (w->count()) o->width = *width;
-    if (h->count()) o->height = *height;
-    if (o->preset == host::synth::kCircleGridPreset) {
-      const host::synth::CalibrationSetReport r =
-          host::synth::generate_calibration_set(*o, *polarity == "hot");
-      std::cout << "synth circle-grid: " << r.views << " views of a " << r.grid.cols << "x" << r.grid.rows
-                << " asymmetric circle grid (" << *polarity << " circles, spacing " << r.grid.spacing_m
-                << " m) at " << r.width << "x" << r.height << (r.distorted ? " through --rig's lens" : "")
-                << "; written to " << o->out.string() << "/images, the truth to truth.json\n";
-      return;
-    }
-    if (o->preset == host::synth::kHoledBoardPreset) {
-      const host::synth::HoledBoardSetReport r = host::synth::generate_holed_board_set(*o);
-      std::cout << "synth holed-board: " << r.views << " views of a board with 4 holes by the camera at "
-                << r.width << "x" << r.height << " and a 32-ring LiDAR"
-                << (r.rig ? " (--rig's camera and extrinsic)" : "") << "; written to " << o->out.string()
-                << " (images/, scans/, board.yaml, camera.yaml), the truth "
-                << "to truth.json\n";
-      return;
-    }
-    const host::synth::SynthReport r = host::synth::generate_synthetic_scene(*o);
-    std::cout << std::fixed << std::setprecision(2) << "synth " << r.preset << ": " << r.frames
-              << " thermal frames (" << r.frozen_frames << " frozen by NUC), " << r.frames
-              << " LiDAR scans with " << r.scan_points << " points, a map of " << r.map_points
-              << " points on " << r.planes << " true planes, " << r.anchors << " anchors, " << r.imu_samples
-              << " IMU samples; path " << r.path_length_m << " m, final pose drift " << r.final_drift_m
-              << " m; written to " << o->out.string() << " in " << r.seconds << " s\n";
-  });
+  synth->callback(
+      [o, frames, width, height, rate, f, w, h, rate_option, polarity, range_noise, range_noise_option] {
+        if (f->count()) o->frames = *frames;
+        if (range_noise_option->count()) o->range_noise_m = *range_noise;
+        if (rate_option->count()) o->frame_rate_hz = *rate;
+        if (w->count()) o->width = *width;
+        if (h->count()) o->height = *height;
+        if (o->preset == host::synth::kCircleGridPreset) {
+          const host::synth::CalibrationSetReport r =
+              host::synth::generate_calibration_set(*o, *polarity == "hot");
+          std::cout << "synth circle-grid: " << r.views << " views of a " << r.grid.cols << "x" << r.grid.rows
+                    << " asymmetric circle grid (" << *polarity << " circles, spacing " << r.grid.spacing_m
+                    << " m) at " << r.width << "x" << r.height << (r.distorted ? " through --rig's lens" : "")
+                    << "; written to " << o->out.string() << "/images, the truth to truth.json\n";
+          return;
+        }
+        if (o->preset == host::synth::kHoledBoardPreset) {
+          const host::synth::HoledBoardSetReport r = host::synth::generate_holed_board_set(*o);
+          std::cout << "synth holed-board: " << r.views << " views of a board with 4 holes by the camera at "
+                    << r.width << "x" << r.height << " and a 32-ring LiDAR"
+                    << (r.rig ? " (--rig's camera and extrinsic)" : "") << "; written to " << o->out.string()
+                    << " (images/, scans/, board.yaml, camera.yaml), the truth "
+                    << "to truth.json\n";
+          return;
+        }
+        const host::synth::SynthReport r = host::synth::generate_synthetic_scene(*o);
+        std::cout << std::fixed << std::setprecision(2) << "synth " << r.preset << ": " << r.frames
+                  << " thermal frames (" << r.frozen_frames << " frozen by NUC), " << r.frames
+                  << " LiDAR scans with " << r.scan_points << " points, a map of " << r.map_points
+                  << " points on " << r.planes << " true planes, " << r.anchors << " anchors, "
+                  << r.imu_samples << " IMU samples; path " << r.path_length_m << " m, final pose drift "
+                  << r.final_drift_m << " m; written to " << o->out.string() << " in " << r.seconds << " s\n";
+      });
 }
 
 }  // namespace litgs::tools

@@ -55,7 +55,11 @@ CalibrationSetReport generate_calibration_set(const SynthOptions& o, bool hot_ci
     c.camera.width = o.width.value_or(320);
     c.camera.height = o.height.value_or(256);
   }
+  if (o.range_noise_m)
+    throw std::invalid_argument("synth: --range-noise applies to --preset holed-board only");
   c.camera.blur_px = 0.5;  // the optics' blur of the scene presets' textured appearance
+  c.camera.temporal_noise_raw *= o.sensor_noise;
+  c.camera.fixed_pattern_raw *= o.sensor_noise;
   c.views = o.frames.value_or(40);
   c.seed = o.seed;
   c.hot_circles = hot_circles;
@@ -83,6 +87,9 @@ HoledBoardSetReport generate_holed_board_set(const SynthOptions& o) {
     h.camera.height = o.height.value_or(256);
   }
   h.camera.blur_px = 0.5;  // the optics' blur of the scene presets' textured appearance
+  h.camera.temporal_noise_raw *= o.sensor_noise;
+  h.camera.fixed_pattern_raw *= o.sensor_noise;
+  if (o.range_noise_m) h.lidar.range_noise_m = *o.range_noise_m;
   h.views = o.frames.value_or(40);
   h.seed = o.seed;
   if (const std::string problem = h.check(); !problem.empty())

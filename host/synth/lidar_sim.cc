@@ -1,5 +1,6 @@
 #include "host/synth/lidar_sim.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -37,11 +38,29 @@ LidarScan simulate_lidar_scan(const World& world, const Eigen::Isometry3d& T_wor
     const Eigen::Vector3d dir = R * dir_lidar;
     auto hit = world.cast({origin, dir}, o.range_min_m, o.range_max_m);
     if (o.beam_divergence_rad > 0) {
+      // The footprint returns from the nearest surface any of its rays meets, at the mean range of the rays
+      // that meet that surface: the centre's range inside a surface, a nearer one at its edge.
       const Eigen::Vector3d a = dir.unitOrthogonal(), b = dir.cross(a);
       const double h = std::tan(o.beam_divergence_rad / 2);
-      for (const Eigen::Vector3d& off : {a, Eigen::Vector3d(-a), b, Eigen::Vector3d(-b)}) {
-        const auto edge = world.cast({origin, (dir + h * off).normalized()}, o.range_min_m, o.range_max_m);
-        if (edge && (!hit || edge->range_m < hit->range_m)) hit = edge;
+      std::vector<Hit> hits;
+      if (hit) hits.push_back(*hit);
+      for (const Eigen::Vector3d& off : {a, Eigen::Vector3d(-a), b, Eigen::Vector3d(-b)})
+        if (const auto edge =
+                world.cast({origin, (dir + h * off).normalized()}, o.range_min_m, o.range_max_m))
+          hits.push_back(*edge);
+      if (!hits.empty()) {
+        const Hit nearest = *std::min_element(
+            hits.begin(), hits.end(), [](const Hit& x, const Hit& y) { return x.range_m < y.range_m; });
+        double sum = 0;
+        int n = 0;
+        for (const Hit& x : hits)
+          if (x.plane_id == nearest.plane_id && x.texture == nearest.texture &&
+              x.range_m < nearest.range_m + 0.5) {
+            sum += x.range_m;
+            ++n;
+          }
+        hit = hit && hit->plane_id == nearest.plane_id ? hit : nearest;
+        hit->range_m = sum / n;
       }
     }
     const double noise = o.range_noise_m * rng.normal();  // drawn for every beam: misses keep streams aligned

@@ -85,6 +85,10 @@ std::string SynthOptions::check() const {
   if (threads < 0 || threads > 64) return "threads: must be in [0, 64]";
   if (appearance != "textured" && appearance != "flat")
     return "appearance: must be textured or flat, got '" + appearance + "'";
+  if (!(sensor_noise > 0 && sensor_noise <= 100))
+    return "sensor_noise: must be in (0, 100], got " + std::to_string(sensor_noise);
+  if (range_noise_m && !(*range_noise_m >= 0 && *range_noise_m < 1))
+    return "range_noise_m: must be in [0, 1) metres, got " + std::to_string(*range_noise_m);
   return "";
 }
 
@@ -110,6 +114,11 @@ SynthReport generate_synthetic_scene(const SynthOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   if (const std::string problem = options.check(); !problem.empty())
     throw std::invalid_argument("synth: " + problem);
+  if (options.sensor_noise != 1 || options.range_noise_m)
+    throw std::invalid_argument(
+        "synth: --sensor-noise and --range-noise apply to the calibration sets "
+        "(circle-grid, holed-board), not to --preset " +
+        options.preset);
   Preset p = make_preset(options.preset, options.seed, parse_appearance(options.appearance));
   if (options.frame_rate_hz) {  // the same stretch of the world, sampled more or less densely
     p.max_frames = static_cast<int>(std::floor(p.max_frames * *options.frame_rate_hz / p.frame_rate_hz));

@@ -37,6 +37,10 @@ struct SynthOptions {
   std::filesystem::path rig;
   std::string rig_camera_block = "Cam-thermal";
   std::string rig_imu_block = "Handsfree IMU";
+  // Calibration sets only (circle-grid, holed-board): the thermal camera's temporal and fixed-pattern noise
+  // times this; holed-board: the LiDAR's range noise (standard deviation, metres; default 0.01).
+  double sensor_noise = 1;
+  std::optional<double> range_noise_m;
 
   // Empty if valid, else the first bad field and why (std::invalid_argument from generate_* carries it).
   std::string check() const;

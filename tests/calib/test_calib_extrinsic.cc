@@ -136,17 +136,27 @@ TEST(CalibExtrinsic, TheScanDetectorPutsTheHoleCentresOnTheTruth) {
 
 TEST(CalibExtrinsic, TheImageDetectorPutsTheHoleCentresOnTheirProjections) {
   const RenderedSet& s = rendered_set();
-  double worst = 0;
+  double worst = 0, outward = 0;
+  int count = 0;
   for (const auto& view : s.views) {
     const BoardInImage b = find_board_in_image(view.raw, s.K, s.board);
     ASSERT_TRUE(b.found) << b.why_not;
     EXPECT_EQ(b.polarity, "warm board");
     const auto truth = s.board.hole_centres();
-    for (size_t k = 0; k < truth.size(); ++k)
-      worst = std::max(worst, (b.centres_px[k] - project_to_pixel(s.K, view.T_cam_board * truth[k])).norm());
+    for (size_t k = 0; k < truth.size(); ++k) {
+      const Eigen::Vector2d e = b.centres_px[k] - project_to_pixel(s.K, view.T_cam_board * truth[k]);
+      worst = std::max(worst, e.norm());
+      // Outward from the image's centre: a scale error of the centres, which moves the extrinsic along the
+      // line of sight (a board-level gradient once pulled them out by 0.04 px on average).
+      const Eigen::Vector2d radial = (b.centres_px[k] - Eigen::Vector2d(s.K.cx, s.K.cy)).normalized();
+      outward += e.dot(radial);
+      ++count;
+    }
   }
-  std::printf("  worst hole centre %.3f px from its true projection\n", worst);
-  EXPECT_LT(worst, 0.35);
+  std::printf("  worst hole centre %.3f px from its true projection, %+.4f px outward on average\n", worst,
+              outward / count);
+  EXPECT_LT(worst, 0.25);
+  EXPECT_LT(std::abs(outward / count), 0.02);
 }
 
 TEST(CalibExtrinsic, RenderedViewsRecoverTheRig) {
