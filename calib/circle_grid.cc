@@ -20,6 +20,12 @@ cv::Mat to_8bit(const io::Image& image) {
   return out;
 }
 
+double quantile(std::vector<double> v, double q) {
+  const auto at = v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), at, v.end());
+  return *at;
+}
+
 // Blobs from a few pixels wide up to a tenth of the image: thermal frames are small.
 cv::Ptr<cv::FeatureDetector> blob_detector(const cv::Mat& image) {
   cv::SimpleBlobDetector::Params p;
@@ -44,10 +50,12 @@ cv::Ptr<cv::FeatureDetector> blob_detector(const cv::Mat& image) {
 }
 
 // Each centre moved to its circle's intensity-weighted centroid in `dark` (circles dark on a brighter
-// board): weights are how far a pixel lies below the board's level (the median of the window's outer ring),
-// in a window of 0.45 times the distance to the nearest other centre, twice. The blob detector's centre is
-// the mean of thresholded shapes' centres, which was biased by up to a pixel on rendered hot circles; the
-// centroid of the frame's own values is not.
+// board), in a window of 0.45 times the distance to the nearest other centre, until it settles. The blob
+// detector's centre is the mean of thresholded shapes' centres, which was biased by up to a pixel on
+// rendered hot circles; the centroid of the frame's own values is not. Weights: 0 up to two noise sigmas
+// below the board's level (the median of the window's outer ring; sigma from its spread), rising to 1 at
+// half the way to the circle's level (the window's 5th percentile). Without the dead band every board
+// pixel's noise weighs in and pulls the centroid to the window's centre, the detector's estimate.
 void refine_centres(const cv::Mat& dark, std::vector<Eigen::Vector2d>& centres) {
   const std::vector<Eigen::Vector2d> start = centres;
   for (size_t k = 0; k < centres.size(); ++k) {
@@ -57,34 +65,43 @@ void refine_centres(const cv::Mat& dark, std::vector<Eigen::Vector2d>& centres) 
     const double radius = 0.45 * nearest;
     if (!(radius >= 2)) continue;
     Eigen::Vector2d c = start[k];
-    for (int pass = 0; pass < 2; ++pass) {
+    for (int pass = 0; pass < 6; ++pass) {
       const int x0 = static_cast<int>(std::floor(c.x() - radius)),
                 x1 = static_cast<int>(std::ceil(c.x() + radius));
       const int y0 = static_cast<int>(std::floor(c.y() - radius)),
                 y1 = static_cast<int>(std::ceil(c.y() + radius));
       if (x0 < 0 || y0 < 0 || x1 >= dark.cols || y1 >= dark.rows) break;
-      std::vector<uint8_t> ring;
+      std::vector<double> ring, disc;
       for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
           const double d = std::hypot(x - c.x(), y - c.y());
-          if (d > 0.8 * radius && d <= radius) ring.push_back(dark.at<uint8_t>(y, x));
+          if (d > radius) continue;
+          disc.push_back(dark.at<uint8_t>(y, x));
+          if (d > 0.8 * radius) ring.push_back(dark.at<uint8_t>(y, x));
         }
-      if (ring.empty()) break;
-      std::nth_element(ring.begin(), ring.begin() + static_cast<std::ptrdiff_t>(ring.size() / 2), ring.end());
-      const double level = ring[ring.size() / 2];
+      if (ring.size() < 8) break;
+      const double level = quantile(ring, 0.5);
+      std::vector<double> spread;
+      for (double v : ring) spread.push_back(std::abs(v - level));
+      const double sigma = 1.4826 * quantile(spread, 0.5);
+      const double floor = 2 * sigma, full = 0.5 * (level - quantile(disc, 0.05));
+      if (!(full > floor + 1)) break;  // no circle stands out of the noise here
       double w = 0, sx = 0, sy = 0;
       for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
           if (std::hypot(x - c.x(), y - c.y()) > radius) continue;
-          const double weight = std::max(0.0, level - dark.at<uint8_t>(y, x));
+          const double weight =
+              std::clamp((level - dark.at<uint8_t>(y, x) - floor) / (full - floor), 0.0, 1.0);
           w += weight;
           sx += weight * x;
           sy += weight * y;
         }
       if (!(w > 0)) break;
       const Eigen::Vector2d next(sx / w, sy / w);
-      if ((next - start[k]).norm() > 0.5 * radius) break;  // wandered off: keep the detector's
+      if ((next - start[k]).norm() > 0.5 * radius) break;  // wandered off: keep the last
+      const double moved = (next - c).norm();
       c = next;
+      if (moved < 1e-3) break;
     }
     centres[k] = c;
   }

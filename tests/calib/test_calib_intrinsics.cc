@@ -174,17 +174,18 @@ TEST(CalibIntrinsics, ANoisySensorsGridsAreFoundAtThirtyTwoTimesTheNoise) {
   o.camera.blur_px = 0.5;
   o.camera.temporal_noise_raw *= 32;
   o.camera.fixed_pattern_raw *= 32;
-  o.views = 10;
+  o.views = 20;
   const auto rendered = host::synth::render_circle_grid_views(o, 2);
   const io::CameraIntrinsics k = o.camera.intrinsics();
   const CircleGrid grid = parse_circle_grid("4x11", o.grid.spacing_m);
   const std::vector<CalibrationView> views = detected_views(rendered, grid, false);
   const IntrinsicsResult r = calibrate_intrinsics(views, grid, {});
-  std::printf("  %zu of 10 views found; fx %.3f (true %.3f), RMS %.3f px\n", found_count(views), r.camera.fx,
-              k.fx, r.rms_px);
-  EXPECT_GE(found_count(views), 8u);
+  std::printf("  %zu of 20 views found; fx %.3f (true %.3f), cx %.2f (%.2f), cy %.2f (%.2f), RMS %.3f px\n",
+              found_count(views), r.camera.fx, k.fx, r.camera.cx, k.cx, r.camera.cy, k.cy, r.rms_px);
+  EXPECT_GE(found_count(views), 17u);
   EXPECT_GT(r.rms_px, 0.1) << "the noise reaches the centres";
   EXPECT_LT(std::abs(r.camera.fx / k.fx - 1), 0.005);
+  // The principal point is the weak part at this noise: 1.4-1.9 px off at 40 views (docs/results.md).
   EXPECT_LT(std::hypot(r.camera.cx - k.cx, r.camera.cy - k.cy), 5);
 }
 
