@@ -20,11 +20,12 @@ double median_of(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// The hole's intensity-weighted centroid in the frame's own values: weights go from 0 at the board's level
-// to 1 at half the way to the hole's (the median inside it), so the blur's spread of the edge keeps the
-// centroid where it was (it is symmetric about the outline) and a background that differs across the hole
-// (wall and ground) does not pull it. The board's level is a plane fitted to a ring of board around the
-// hole: a gradient across the board (vignetting, a warmer side) would otherwise weigh one side's noise more.
+// The hole's intensity-weighted centroid in the frame's own values: weights go from 0 at two noise sigmas
+// past the board's level to 1 at half the way to the hole's (the median inside it), so the blur's spread of
+// the edge keeps the centroid where it was (it is symmetric about the outline) and a background that differs
+// across the hole (wall and ground) does not pull it. The board's level is a plane fitted to a ring of board
+// around the hole: a gradient across the board (vignetting, a warmer side) would otherwise weigh one side's
+// noise more.
 bool hole_centroid(const cv::Mat& values, const std::vector<cv::Point>& contour, Eigen::Vector2d& centre) {
   const double area = cv::contourArea(contour);
   const int margin = std::max(2, static_cast<int>(std::lround(0.25 * std::sqrt(area / M_PI))));
@@ -56,12 +57,23 @@ bool hole_centroid(const cv::Mat& values, const std::vector<cv::Point>& contour,
   const Eigen::Vector2d middle = Eigen::Vector2d(AtA(0, 1), AtA(0, 2)) / AtA(0, 0);
   const double contrast =
       median_of(inside) - board_level(static_cast<int>(middle.x()), static_cast<int>(middle.y()));
-  if (!(std::abs(contrast) > 0)) return false;
+  // A dead band of two noise sigmas (the ring's spread about its plane), so that the board's own noise does
+  // not weigh in and pull the centroid towards the window's centre.
+  std::vector<double> spread;
+  for (int y = 0; y < values.rows; ++y)
+    for (int x = 0; x < values.cols; ++x)
+      if (window.at<uint8_t>(y, x) && !near.at<uint8_t>(y, x))
+        spread.push_back(std::abs(values.at<double>(y, x) - board_level(x, y)));
+  // On a noisy frame the band stops at half the way to full weight, not to lose the hole.
+  const double full = 0.5 * std::abs(contrast), floor = std::min(2 * 1.4826 * median_of(spread), 0.5 * full);
+  if (!(full > 0)) return false;
+  const double sign = contrast > 0 ? 1 : -1;
   double w = 0, sx = 0, sy = 0;
   for (int y = 0; y < values.rows; ++y)
     for (int x = 0; x < values.cols; ++x) {
       if (!window.at<uint8_t>(y, x)) continue;
-      const double t = std::clamp((values.at<double>(y, x) - board_level(x, y)) / (0.5 * contrast), 0.0, 1.0);
+      const double t = std::clamp(
+          (sign * (values.at<double>(y, x) - board_level(x, y)) - floor) / (full - floor), 0.0, 1.0);
       w += t;
       sx += t * x;
       sy += t * y;

@@ -85,7 +85,9 @@ void refine_centres(const cv::Mat& dark, std::vector<Eigen::Vector2d>& centres) 
       for (double v : ring) spread.push_back(std::abs(v - level));
       const double sigma = 1.4826 * quantile(spread, 0.5);
       const double floor = 2 * sigma, full = 0.5 * (level - quantile(disc, 0.05));
-      if (!(full > floor + 1)) break;  // no circle stands out of the noise here
+      // Too noisy to weigh: the detector's centre stays (a narrower band did worse at 32 times synth's
+      // noise: focal error 0.29-0.43 % against 0.14-0.29 %).
+      if (!(full > floor + 1)) break;
       double w = 0, sx = 0, sy = 0;
       for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
