@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "calib/layout_fit.h"
+#include "calib/robust_stats.h"
 
 namespace litgs::calib {
 namespace {
@@ -21,12 +22,6 @@ struct Ring {
   std::vector<double> azimuth;
   double elevation = 0;
 };
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 std::vector<Ring> split_rings(const std::vector<Eigen::Vector3d>& p, const BoardInScanOptions& o) {
   std::vector<size_t> idx;

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "calib/robust_stats.h"
 #include "host/frontend/intensity.h"
 
 namespace litgs::calib {
@@ -18,12 +19,6 @@ cv::Mat to_8bit(const io::Image& image) {
   cv::Mat out(eight.height, eight.width, CV_8U);
   for (size_t k = 0; k < eight.data.size(); ++k) out.data[k] = static_cast<uint8_t>(eight.data[k]);
   return out;
-}
-
-double quantile(std::vector<double> v, double q) {
-  const auto at = v.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), at, v.end());
-  return *at;
 }
 
 // Blobs from a few pixels wide up to a tenth of the image: thermal frames are small.

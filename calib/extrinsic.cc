@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "calib/robust_stats.h"
 #include "io/lens_distortion.h"
 
 namespace litgs::calib {
@@ -85,11 +86,6 @@ Solution solve(const std::vector<Pair>& pairs, const io::CameraIntrinsics& K) {
     s.translation_sd_m = std::sqrt(std::max(0.0, (ct[0] + ct[4] + ct[8]) * variance_px));
   }
   return s;
-}
-
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
 }
 
 }  // namespace

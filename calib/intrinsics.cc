@@ -6,6 +6,8 @@
 #include <opencv2/calib3d.hpp>
 #include <stdexcept>
 
+#include "calib/robust_stats.h"
+
 namespace litgs::calib {
 namespace {
 
@@ -51,11 +53,6 @@ Solve solve(const std::vector<std::vector<cv::Point3f>>& object,
     s.per_view_rms.push_back(std::sqrt(sum / static_cast<double>(projected.size())));
   }
   return s;
-}
-
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
 }
 
 }  // namespace
