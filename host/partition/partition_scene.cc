@@ -73,15 +73,14 @@ void link_or_copy(const fs::path& from, const fs::path& to) {
 // block: models trained apart then share one intensity scale. 8-bit frames are not stretched.
 io::SceneConfig block_config(const fs::path& scene_dir, const io::Scene& scene) {
   io::SceneConfig c = scene.config;
-  if (c.camera.bit_depth != 16 || c.intensity_window) return c;
+  if (c.intensity_window) return c;
   frontend::Histogram histogram = frontend::empty_histogram();
   for (size_t i = 0; i < scene.frames.size(); ++i) {
     const io::Image img = io::load_frame(scene_dir, scene, i);
     frontend::add_to_histogram(histogram, img.data, static_cast<size_t>(img.channels));
   }
-  const TrainingDataOptions training;
-  const frontend::Stretch s =
-      frontend::percentile_stretch(histogram, training.low_percentile, training.high_percentile);
+  // Training's own rule; recorded for 8-bit frames too (training reads it when it maps by percentiles).
+  const frontend::Stretch s = percentile_window(c, histogram, TrainingDataOptions{});
   c.intensity_window = std::make_pair(s.low, s.high);
   return c;
 }

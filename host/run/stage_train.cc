@@ -58,6 +58,12 @@ StagePlan plan(const StageContext& c) {
   p.inputs = {scene};
   p.options = section_json(c.config, "train");
   if (o.blocks != "1") {
+    for (const std::string& a : o.extra_args)
+      if (a == "--holdout-every" || a.rfind("--holdout-every=", 0) == 0)
+        throw std::invalid_argument(
+            "train.extra_args: --holdout-every does not apply with train.blocks: each block trains on all "
+            "its "
+            "frames, and the scene's held-out views (train.holdout_every) are kept out of every block");
     std::vector<std::string> train_flags;
     for (const auto& flags :
          {option_flags(p.options, {T::kIterations, T::kDownscale, T::kStrategy, T::kMaxGaussians,

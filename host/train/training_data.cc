@@ -129,6 +129,12 @@ void TrainingDataOptions::check() const {
     throw std::invalid_argument("TrainingDataOptions.frozen_threshold must be >= 0");
 }
 
+frontend::Stretch percentile_window(const io::SceneConfig& config, const frontend::Histogram& all_frames,
+                                    const TrainingDataOptions& o) {
+  if (config.intensity_window) return {config.intensity_window->first, config.intensity_window->second};
+  return frontend::percentile_stretch(all_frames, o.low_percentile, o.high_percentile);
+}
+
 TrainingData load_training_data(const std::filesystem::path& dir, const TrainingDataOptions& o) {
   o.check();
   io::SceneReadOptions read;
@@ -152,10 +158,7 @@ TrainingData load_training_data(const std::filesystem::path& dir, const Training
   const bool percentile = o.mapping == IntensityMapping::kPercentile ||
                           (o.mapping == IntensityMapping::kAuto && k.bit_depth == 16);
   frontend::Stretch stretch{0, k.bit_depth == 16 ? 65535.0 : 255.0};
-  if (percentile && scene.config.intensity_window)
-    stretch = {scene.config.intensity_window->first, scene.config.intensity_window->second};
-  else if (percentile)
-    stretch = frontend::percentile_stretch(histogram, o.low_percentile, o.high_percentile);
+  if (percentile) stretch = percentile_window(scene.config, histogram, o);
   out.stretch_low = stretch.low;
   out.stretch_high = stretch.high;
   for (auto& frame : raw)

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "host/frontend/intensity.h"
 #include "io/scene.h"
 #include "kernels/splat/splat_types.h"
 
@@ -35,6 +36,13 @@ struct TrainingDataOptions {
   bool true_poses = false;
   void check() const;  // throws std::invalid_argument naming the bad field
 };
+
+// The stretch that maps raw values to [0, 1] when training maps by percentiles: the scene's
+// intensity_window where it has one, else the options' percentiles of all frames' values together
+// (`all_frames`). `partition` records it as every block's window, so that the blocks map as one training of
+// the whole scene does.
+frontend::Stretch percentile_window(const io::SceneConfig& config, const frontend::Histogram& all_frames,
+                                    const TrainingDataOptions& options);
 
 struct TrainingView {
   std::string name;  // the frame's file name

@@ -263,6 +263,24 @@ TEST(RunStages, TrainInBlocksMergesAndEvaluatesTheWholeScene) {
   EXPECT_EQ(stage_status(dir, "train"), "up to date") << again.output;
 }
 
+// Blocks train on all their frames (the scene's held-out views are kept out of every block): a
+// --holdout-every among train.extra_args would reach each block's train after the blocks' own and clash, so
+// the train stage refuses it by name.
+TEST(RunBadInput, HoldoutEveryAmongExtraArgsWithBlocksIsRefused) {
+  const fs::path dir = kRoot / "blocks-holdout";
+  fs::remove_all(dir);
+  const fs::path config = write_text(
+      kRoot / "blocks-holdout.yaml",
+      "import:\n  synth_frames: 16\n  synth_width: 64\n  synth_height: 48\nmatch:\n  enabled: false\n"
+      "refine:\n  enabled: false\ntrain:\n  blocks: \"2\"\n  extra_args: [\"--holdout-every\", \"4\"]\n");
+  const CommandResult r = run_engine(run_args("synth:street", dir, config, "--until train"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.output.find("train.extra_args: --holdout-every does not apply with train.blocks"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(dir / "train" / "partition")) << "refused before partitioning";
+}
+
 TEST(RunBadInput, UnknownInputKind) {
   const fs::path dir = kRoot / "unknown";
   fs::remove_all(dir);
