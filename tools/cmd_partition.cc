@@ -56,7 +56,7 @@ void add_partition_options(CLI::App* c, std::string& blocks, host::partition::Pa
                 "scene's x and y")
       ->capture_default_str();
   c->add_option("--overlap", o.overlap_m,
-                "Metres each core cell grows by (default: 15 % of a cell's larger side)");
+                "Metres each core cell grows by (default: 30 % of a cell's larger side)");
   c->add_option("--max-gaussians-per-block", o.max_gaussians_per_block,
                 "auto: the block count keeps each block under this (default: half of what one storage "
                 "buffer of the device holds at SH degree 3)");

@@ -32,7 +32,7 @@ struct PlanView {
 struct PartitionOptions {
   size_t columns = 0, rows = 0;  // the grid along x and y; 0 x 0: auto
   size_t blocks = 0;             // auto: this many blocks (0: blocks_needed from the budget)
-  double overlap_m = -1;         // each core cell's border grows by this; < 0: 15 % of the cell's larger side
+  double overlap_m = -1;         // each core cell's border grows by this; < 0: 30 % of the cell's larger side
   // A view outside a block's expanded bounds still joins it when at least this share of the map points it
   // sees lie in the block's core cell (VastGaussian's visibility-based camera selection).
   double visibility_share = 0.25;
