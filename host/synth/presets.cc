@@ -176,12 +176,12 @@ Preset facade(uint64_t seed, Appearance appearance) {
   return p;
 }
 
-Preset street(uint64_t seed, Appearance appearance) {
-  Preset p;
-  p.name = "street";
-  p.description = "a street between two facades with parked cars and posts, driven fast";
-  World& w = p.world;
-  w.sky_raw = 3010;
+// The street's surfaces: asphalt, plaster, brick, glass, doors, warm and cold cars, metal posts, bins.
+struct StreetTextures {
+  int asphalt, plaster, brick, glass, door, warm_car, cold_car, metal, bin;
+};
+
+StreetTextures add_street_textures(World& w, uint64_t seed) {
   const int asphalt = w.add_texture(uniform(3650, 15, 1.5, seed + 1));
   const int plaster = w.add_texture(uniform(3480, 4, 5, seed + 2));
   const int brick = w.add_texture(cells(ThermalPattern::kBrick, 3530, 0.25, 0.065, 0.012, -14, 6, seed + 3));
@@ -203,22 +203,29 @@ Preset street(uint64_t seed, Appearance appearance) {
   const int metal = w.add_texture(uniform(3330, 3, 1, seed + 8));
   const int bin = w.add_texture(uniform(3560, 4, 0.3, seed + 9));
 
-  add_ground(w, -30, -25, 160, 25, asphalt);
-  add_wall_with_openings(w, Vector3d(-20, 10, 0), 70, 14, plaster,
-                         facade_openings(70, 4, 3.5, 5, glass, door), appearance);
-  add_wall_with_openings(w, Vector3d(50, 10, 0), 90, 10, brick, facade_openings(90, 3, 4.0, 4, glass, door),
-                         appearance);
-  add_wall_with_openings(w, Vector3d(-20, -10, 0), 160, 12, plaster,
-                         facade_openings(160, 3, 3.8, 6, glass, door), appearance);
-  w.add_box(Vector3d(30, 7.2, 0), Vector3d(4.5, 1.8, 1.5), 0, warm_car);
-  w.add_box(Vector3d(62, -7.0, 0), Vector3d(4.5, 1.8, 1.5), 0.05, cold_car);
-  w.add_box(Vector3d(95, 7.2, 0), Vector3d(4.3, 1.8, 1.45), -0.03, warm_car);
-  for (double x = 0; x < 140; x += 20) {
-    w.cylinders.push_back({Eigen::Vector2d(x, 8.6), 0.1, 0, 6, metal});
-    w.cylinders.push_back({Eigen::Vector2d(x + 10, -8.6), 0.1, 0, 6, metal});
-  }
-  w.add_box(Vector3d(45, 9.2, 0), Vector3d(0.7, 0.7, 1.1), 0.2, bin);
+  return {asphalt, plaster, brick, glass, door, warm_car, cold_car, metal, bin};
+}
 
+// One 160 m block of the street, starting at x = x0 - 20: its facades, parked cars, posts and a bin.
+void add_street_block(World& w, double x0, const StreetTextures& t, Appearance appearance) {
+  add_wall_with_openings(w, Vector3d(x0 - 20, 10, 0), 70, 14, t.plaster,
+                         facade_openings(70, 4, 3.5, 5, t.glass, t.door), appearance);
+  add_wall_with_openings(w, Vector3d(x0 + 50, 10, 0), 90, 10, t.brick,
+                         facade_openings(90, 3, 4.0, 4, t.glass, t.door), appearance);
+  add_wall_with_openings(w, Vector3d(x0 - 20, -10, 0), 160, 12, t.plaster,
+                         facade_openings(160, 3, 3.8, 6, t.glass, t.door), appearance);
+  w.add_box(Vector3d(x0 + 30, 7.2, 0), Vector3d(4.5, 1.8, 1.5), 0, t.warm_car);
+  w.add_box(Vector3d(x0 + 62, -7.0, 0), Vector3d(4.5, 1.8, 1.5), 0.05, t.cold_car);
+  w.add_box(Vector3d(x0 + 95, 7.2, 0), Vector3d(4.3, 1.8, 1.45), -0.03, t.warm_car);
+  for (double x = 0; x < 140; x += 20) {
+    w.cylinders.push_back({Eigen::Vector2d(x0 + x, 8.6), 0.1, 0, 6, t.metal});
+    w.cylinders.push_back({Eigen::Vector2d(x0 + x + 10, -8.6), 0.1, 0, 6, t.metal});
+  }
+  w.add_box(Vector3d(x0 + 45, 9.2, 0), Vector3d(0.7, 0.7, 1.1), 0.2, t.bin);
+}
+
+// The street's motion: driven fast, weaving a little.
+void street_motion(Preset& p, uint64_t seed) {
   p.trajectory.start_m = Vector3d(0, 0, 1.8);
   p.trajectory.speed_mean_m_s = 6;
   p.trajectory.speed_amplitude_m_s = 4;  // 2..10 m/s
@@ -235,8 +242,40 @@ Preset street(uint64_t seed, Appearance appearance) {
   p.T_imu_cam = camera_mount(75 * kDeg, 8 * kDeg, Vector3d(0.2, 0.3, 0.15), rig);
   p.T_imu_lidar = lidar_mount(Vector3d(0.0, 0.0, 0.25), rig);
   p.lidar.range_max_m = 80;
+}
+
+Preset street(uint64_t seed, Appearance appearance) {
+  Preset p;
+  p.name = "street";
+  p.description = "a street between two facades with parked cars and posts, driven fast";
+  World& w = p.world;
+  w.sky_raw = 3010;
+  const StreetTextures t = add_street_textures(w, seed);
+  add_ground(w, -30, -25, 160, 25, t.asphalt);
+  add_street_block(w, 0, t, appearance);
+  street_motion(p, seed);
   p.frames = 80;
   p.max_frames = 220;  // 140 m of street
+  p.map_voxel_m = 0.15;
+  return p;
+}
+
+// The street's block repeated ten times, about 1.6 km (issue 49's long scene: training in blocks). The
+// blocks are alike: the front end would find the same facades again, the training does not mind.
+Preset long_street(uint64_t seed, Appearance appearance) {
+  Preset p;
+  p.name = "long-street";
+  p.description = "the street, ten 160 m blocks long, driven fast (a scene for training in blocks)";
+  World& w = p.world;
+  w.sky_raw = 3010;
+  const StreetTextures t = add_street_textures(w, seed);
+  constexpr int kBlocks = 10;
+  add_ground(w, -30, -25, 160.0 * kBlocks, 25, t.asphalt);
+  for (int k = 0; k < kBlocks; ++k) add_street_block(w, 160.0 * k, t, appearance);
+  street_motion(p, seed);
+  p.lidar.range_max_m = 80;
+  p.frames = 80;
+  p.max_frames = 2300;  // 1.4 km at 6 m/s on average, short of the street's end
   p.map_voxel_m = 0.15;
   return p;
 }
@@ -310,7 +349,7 @@ std::string NucOptions::check() const {
 }
 
 std::vector<std::string> preset_names() {
-  return {"facade", "street", "corridor"};
+  return {"facade", "street", "corridor", "long-street"};
 }
 
 Appearance parse_appearance(const std::string& name) {
@@ -324,7 +363,7 @@ std::string appearance_name(Appearance appearance) {
 }
 
 Preset make_preset(const std::string& name, uint64_t seed, Appearance appearance) {
-  for (auto* make : {&facade, &street, &corridor}) {
+  for (auto* make : {&facade, &street, &corridor, &long_street}) {
     Preset p = make(seed, appearance);
     if (p.name != name) continue;
     if (appearance == Appearance::kTextured) weather(p);
