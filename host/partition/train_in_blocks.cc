@@ -38,7 +38,9 @@ TrainInBlocksReport train_in_blocks(const fs::path& scene, const fs::path& out, 
     blocks.push_back(
         {{"name", b.name},
          {"state", b.state},
-         {"seconds", b.seconds},
+         {"seconds", b.seconds},  // this run's: 0 for a block a rerun kept
+         // The block's training's own wall time, which a rerun keeps.
+         {"train_seconds", block_training_metric(dir / kBlocksDir / b.name, "wall_s")},
          {"views", planned.views.size()},
          {"map_points", planned.map_points.size()},
          {"gaussians", r.merge.blocks.at(k).gaussians},
