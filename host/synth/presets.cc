@@ -244,43 +244,41 @@ void street_motion(Preset& p, uint64_t seed) {
   p.lidar.range_max_m = 80;
 }
 
-Preset street(uint64_t seed, Appearance appearance) {
+// `blocks` of the street's 160 m block one after another on one ground, driven fast.
+Preset street_of_blocks(const std::string& name, const std::string& description, int blocks, uint64_t seed,
+                        Appearance appearance) {
   Preset p;
-  p.name = "street";
-  p.description = "a street between two facades with parked cars and posts, driven fast";
+  p.name = name;
+  p.description = description;
   World& w = p.world;
   w.sky_raw = 3010;
   const StreetTextures t = add_street_textures(w, seed);
-  add_ground(w, -30, -25, 160, 25, t.asphalt);
-  add_street_block(w, 0, t, appearance);
+  add_ground(w, -30, -25, 160.0 * blocks, 25, t.asphalt);
+  for (int k = 0; k < blocks; ++k) add_street_block(w, 160.0 * k, t, appearance);
   street_motion(p, seed);
   p.frames = 80;
-  p.max_frames = 220;  // 140 m of street
   p.map_voxel_m = 0.15;
+  return p;
+}
+
+Preset street(uint64_t seed, Appearance appearance) {
+  Preset p = street_of_blocks(
+      "street", "a street between two facades with parked cars and posts, driven fast", 1, seed, appearance);
+  p.max_frames = 220;  // 140 m of street
   return p;
 }
 
 // The street's block repeated ten times, about 1.6 km (issue 49's long scene: training in blocks). The
 // blocks are alike: the front end would find the same facades again, the training does not mind.
 Preset long_street(uint64_t seed, Appearance appearance) {
-  Preset p;
-  p.name = "long-street";
-  p.description = "the street, ten 160 m blocks long, driven fast (a scene for training in blocks)";
-  World& w = p.world;
-  w.sky_raw = 3010;
-  const StreetTextures t = add_street_textures(w, seed);
-  constexpr int kBlocks = 10;
-  add_ground(w, -30, -25, 160.0 * kBlocks, 25, t.asphalt);
-  for (int k = 0; k < kBlocks; ++k) add_street_block(w, 160.0 * k, t, appearance);
-  street_motion(p, seed);
-  p.lidar.range_max_m = 80;
-  p.frames = 80;
+  Preset p = street_of_blocks(
+      "long-street", "the street, ten 160 m blocks long, driven fast (a scene for training in blocks)", 10,
+      seed, appearance);
   p.max_frames = 2300;  // 1.4 km at 6 m/s on average, short of the street's end
   // An odometry's drift over a long drive: 0.5 % of the distance and 0.6 degrees of heading per km (the
   // short presets' 0.3 mrad/m would turn 20 degrees over the street).
   p.estimator.drift_m_per_m = 0.005;
   p.estimator.drift_rad_per_m = 0.00001;
-  p.map_voxel_m = 0.15;
   return p;
 }
 
