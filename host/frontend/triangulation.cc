@@ -76,7 +76,57 @@ Eigen::Vector3d refine(const std::vector<TriangulationView>& views, const std::v
   return X;
 }
 
+// The two-view or fitted point of the configured estimator.
+Eigen::Vector3d estimate(const std::vector<TriangulationView>& views, const std::vector<size_t>& use,
+                         const TriangulationOptions& o) {
+  return o.method == TriangulationMethod::kMidpoint ? triangulate_midpoint(views, use)
+                                                    : triangulate_linear(views, use);
+}
+
+struct Candidate {
+  size_t i, j;
+  double cos_angle;  // between the observed rays in the world
+};
+
+// Candidate pairs in the configured order, at most max_pairs_tried; `widest_cos` gets the cosine of the
+// widest observed ray angle over all pairs.
+std::vector<Candidate> candidate_pairs(const std::vector<TriangulationView>& views,
+                                       const TriangulationOptions& o, double& widest_cos) {
+  std::vector<Eigen::Vector3d> rays(views.size());
+  for (size_t k = 0; k < views.size(); ++k)
+    rays[k] = (views[k].R_cam_world.transpose() * views[k].xy.homogeneous()).normalized();
+  std::vector<Candidate> candidates;
+  widest_cos = 1;
+  for (size_t i = 0; i < views.size(); ++i)
+    for (size_t j = i + 1; j < views.size(); ++j) {
+      candidates.push_back({i, j, rays[i].dot(rays[j])});
+      widest_cos = std::min(widest_cos, candidates.back().cos_angle);
+    }
+  if (o.pair_order == PairOrder::kWidestRayAngle) {
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.cos_angle < b.cos_angle; });
+  } else {
+    // First with last, then inwards: the widest index gaps first.
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.j - a.i > b.j - b.i; });
+  }
+  candidates.resize(std::min(candidates.size(), o.max_pairs_tried));
+  return candidates;
+}
+
 }  // namespace
+
+TriangulationOptions TriangulationOptions::refinement() {
+  TriangulationOptions o;
+  o.method = TriangulationMethod::kMidpoint;
+  o.pair_order = PairOrder::kSpreadOverViews;
+  o.max_error_px = 4;
+  o.min_views = 2;
+  o.min_angle_deg = 1.0;
+  o.gauss_newton_iterations = 0;
+  o.max_pairs_tried = 12;
+  return o;
+}
 
 void TriangulationOptions::check() const {
   if (!(max_error_px > 0)) throw std::invalid_argument("triangulation: max_error_px must be > 0");
@@ -106,27 +156,33 @@ Eigen::Vector3d triangulate_linear(const std::vector<TriangulationView>& views,
   return h.head<3>() / h.w();
 }
 
+Eigen::Vector3d triangulate_midpoint(const std::vector<TriangulationView>& views,
+                                     const std::vector<size_t>& use) {
+  if (use.size() < 2) return Eigen::Vector3d::Constant(kNaN);
+  // Sum over the rays of (I - d d^T)(X - c) = 0.
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (size_t k : use) {
+    const TriangulationView& v = views[k];
+    const Eigen::Vector3d d = (v.R_cam_world.transpose() * v.xy.homogeneous()).normalized();
+    const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - d * d.transpose();
+    A += P;
+    b += P * centre(v);
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(A);
+  if (ldlt.info() != Eigen::Success) return Eigen::Vector3d::Constant(kNaN);
+  return ldlt.solve(b);
+}
+
 TriangulatedPoint triangulate(const std::vector<TriangulationView>& views, double fx, double fy,
                               const TriangulationOptions& o) {
   o.check();
   TriangulatedPoint out;
   if (views.size() < o.min_views) return out;
-  // Candidate pairs, widest ray angle first (ray angle from the observed directions in the world).
-  struct Candidate {
-    size_t i, j;
-    double cos_angle;
-  };
-  std::vector<Eigen::Vector3d> rays(views.size());
-  for (size_t k = 0; k < views.size(); ++k)
-    rays[k] = (views[k].R_cam_world.transpose() * views[k].xy.homogeneous()).normalized();
-  std::vector<Candidate> candidates;
-  for (size_t i = 0; i < views.size(); ++i)
-    for (size_t j = i + 1; j < views.size(); ++j) candidates.push_back({i, j, rays[i].dot(rays[j])});
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.cos_angle < b.cos_angle; });
-  candidates.resize(std::min(candidates.size(), o.max_pairs_tried));
+  double widest_cos = 1;
+  const std::vector<Candidate> candidates = candidate_pairs(views, o, widest_cos);
   // Rays that never part by the minimum angle (a pure rotation, a distant point): nothing to triangulate.
-  if (candidates.front().cos_angle > std::cos(o.min_angle_deg * M_PI / 180.0)) {
+  if (widest_cos > std::cos(o.min_angle_deg * M_PI / 180.0)) {
     out.outcome = TriangulationOutcome::kNoAngle;
     return out;
   }
@@ -135,7 +191,7 @@ TriangulatedPoint triangulate(const std::vector<TriangulationView>& views, doubl
   double best_sum = 0;
   Eigen::Vector3d best_X = Eigen::Vector3d::Constant(kNaN);
   for (const Candidate& c : candidates) {
-    const Eigen::Vector3d X = triangulate_linear(views, {c.i, c.j});
+    const Eigen::Vector3d X = estimate(views, {c.i, c.j}, o);
     if (!X.allFinite()) continue;
     double sum = 0;
     const std::vector<size_t> agree = agreeing_views(views, X, fx, fy, o.max_error_px, sum);
@@ -150,9 +206,10 @@ TriangulatedPoint triangulate(const std::vector<TriangulationView>& views, doubl
     return out;
   }
   // Fit over the agreeing views, refine, and take the views that agree with the refined point.
-  Eigen::Vector3d X = triangulate_linear(views, best_views);
+  Eigen::Vector3d X = estimate(views, best_views, o);
   if (!X.allFinite()) X = best_X;
-  X = refine(views, best_views, X, fx, fy, o.gauss_newton_iterations);
+  if (o.method == TriangulationMethod::kLinear)
+    X = refine(views, best_views, X, fx, fy, o.gauss_newton_iterations);
   double sum = 0;
   std::vector<size_t> agree = agreeing_views(views, X, fx, fy, o.max_error_px, sum);
   if (!X.allFinite() || agree.size() < o.min_views) {

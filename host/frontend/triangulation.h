@@ -1,6 +1,14 @@
-// A track's 3D point from known camera poses: two-view linear triangulation over candidate view pairs (the
-// robust choice: the pair whose point most views agree with), a linear fit over the agreeing views, a few
-// Gauss-Newton steps on the pixel reprojection error, then filters on error, angle and depth.
+// A track's 3D point from known camera poses, the one triangulation of the engine (the front end's tracks
+// and the refinement's re-triangulations). A consensus over candidate view pairs (the point most views
+// agree with), a fit over the agreeing views, then filters on error, depth and angle.
+//
+// Two estimators, chosen per caller:
+//  - kLinear (the front end): two-view DLT per pair, pairs by the widest observed ray angle, a DLT over the
+//    agreeing views and Gauss-Newton steps on the pixel error.
+//  - kMidpoint (the refinement): the point nearest to the rays in 3D, pairs spread over the views (first with
+//    last, then inwards). With priors far from the truth (a constant 0.5 m offset) the midpoint lands
+//    nearer to the LiDAR anchors the refinement gates on than the DLT does, and a wrong match cannot make
+//    its pair look widest (docs/experiments.md, "one triangulator").
 #pragma once
 
 #include <Eigen/Core>
@@ -15,7 +23,12 @@ struct TriangulationView {
   Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // normalized undistorted image coordinates (x/z, y/z)
 };
 
+enum class TriangulationMethod { kLinear, kMidpoint };
+enum class PairOrder { kWidestRayAngle, kSpreadOverViews };
+
 struct TriangulationOptions {
+  TriangulationMethod method = TriangulationMethod::kLinear;
+  PairOrder pair_order = PairOrder::kWidestRayAngle;
   double max_error_px = 2.0;  // a view agrees when its reprojection error is below this
   // Views that must agree. 3 by default: with prior-guided matching every match already lies on its
   // epipolar line, so a two-view point triangulates with no error whether its match is right or wrong;
@@ -24,9 +37,12 @@ struct TriangulationOptions {
   double min_angle_deg = 1.5;  // largest angle between the agreeing views' rays at the point
   double min_depth_m = 1e-3;   // in every agreeing view
   double max_depth_m = 1e4;
-  int gauss_newton_iterations = 5;
-  size_t max_pairs_tried = 40;  // candidate view pairs for the robust choice (widest baselines first)
-  void check() const;           // std::invalid_argument
+  int gauss_newton_iterations = 5;  // kLinear only
+  size_t max_pairs_tried = 40;      // candidate view pairs for the consensus
+  void check() const;               // std::invalid_argument
+
+  // The refinement's: kMidpoint, pairs spread over the track, 4 px, two views, 1 degree, 12 pairs.
+  static TriangulationOptions refinement();
 };
 
 enum class TriangulationOutcome { kOk, kTooFewViews, kNoAngle, kBadDepth, kLargeError };
@@ -45,5 +61,9 @@ TriangulatedPoint triangulate(const std::vector<TriangulationView>& views, doubl
 // Linear (DLT) triangulation from the given views; non-finite if degenerate.
 Eigen::Vector3d triangulate_linear(const std::vector<TriangulationView>& views,
                                    const std::vector<size_t>& use);
+
+// The least-squares point nearest to the given views' rays; non-finite if degenerate.
+Eigen::Vector3d triangulate_midpoint(const std::vector<TriangulationView>& views,
+                                     const std::vector<size_t>& use);
 
 }  // namespace litgs::host::frontend

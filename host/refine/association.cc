@@ -7,7 +7,7 @@
 #include <optional>
 #include <unordered_map>
 
-#include "host/refine/triangulation.h"
+#include "host/refine/triangulate_track.h"
 
 namespace litgs::host::refine {
 namespace {

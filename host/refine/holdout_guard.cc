@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "host/refine/bundle_adjustment.h"
-#include "host/refine/triangulation.h"
+#include "host/refine/triangulate_track.h"
 
 namespace litgs::host::refine {
 namespace {

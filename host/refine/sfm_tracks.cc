@@ -10,7 +10,7 @@ namespace litgs::host::refine {
 
 std::vector<TrackPoint> sfm_tracks(const io::SfmData& sfm, const io::CameraIntrinsics& camera,
                                    const std::vector<CameraPose>& priors, SfmTrackReport* report,
-                                   const TriangulationOptions& triangulation) {
+                                   const frontend::TriangulationOptions& triangulation) {
   SfmTrackReport r;
   std::vector<std::vector<Eigen::Vector2d>> undistorted;
   for (const auto& image : sfm.images)

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "host/refine/ba_types.h"
-#include "host/refine/triangulation.h"
+#include "host/refine/triangulate_track.h"
 #include "host/synth/geometry.h"
 
 namespace litgs::host::refine {
@@ -24,7 +24,7 @@ struct SyntheticTrackOptions {
   double max_range_m = 40;
   uint64_t seed = 7;
   std::set<size_t> frozen_frames;  // frames that repeat the previous image: observations copied from it
-  TriangulationOptions triangulation;
+  frontend::TriangulationOptions triangulation = frontend::TriangulationOptions::refinement();
 };
 
 // anchors_true: the true positions of anchors, each tracked as anchor_track_length says (so that the

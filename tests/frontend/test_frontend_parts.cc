@@ -96,6 +96,45 @@ TEST(FrontendTriangulation, PointBehindTheCamerasIsRejected) {
   EXPECT_NE(p.outcome, TriangulationOutcome::kOk);
 }
 
+// The refinement's estimator (the midpoint of the rays, pairs spread over the views) against the front
+// end's (DLT and Gauss-Newton) on one noisy track: both within the noise, and near each other.
+TEST(FrontendTriangulation, MidpointAndLinearAgreeWithinTheNoise) {
+  const Eigen::Vector3d X(0.3, -0.2, 6.0);
+  std::mt19937 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.5);  // pixels
+  std::vector<TriangulationView> views;
+  for (int i = 0; i < 6; ++i) {
+    views.push_back(look_at(Eigen::Vector3d(-1.5 + 0.6 * i, 0.1 * i, 0), X));
+    observe(views.back(), X, {noise(rng), noise(rng)});
+  }
+  const TriangulatedPoint linear = triangulate(views, kF, kF, {});
+  const TriangulatedPoint midpoint = triangulate(views, kF, kF, TriangulationOptions::refinement());
+  ASSERT_EQ(linear.outcome, TriangulationOutcome::kOk);
+  ASSERT_EQ(midpoint.outcome, TriangulationOutcome::kOk);
+  EXPECT_EQ(midpoint.views.size(), 6u);
+  EXPECT_LT((midpoint.xyz - X).norm(), 0.03);
+  EXPECT_LT((midpoint.xyz - linear.xyz).norm(), 0.02);
+  // Exact observations: the midpoint is the point itself.
+  for (auto& v : views) observe(v, X, {0, 0});
+  EXPECT_LT((triangulate_midpoint(views, {0, 5}) - X).norm(), 1e-9);
+}
+
+// A third of the views wrong: the refinement's pair order tries first and last, then inwards, so a pair of
+// right views is among its 12 tries whichever views are wrong, and the consensus drops the wrong ones.
+TEST(FrontendTriangulation, MidpointConsensusDropsAThirdOfWrongViews) {
+  const Eigen::Vector3d X(0, 0.5, 8);
+  std::vector<TriangulationView> views;
+  for (int i = 0; i < 9; ++i) {
+    views.push_back(look_at(Eigen::Vector3d(-2 + 0.5 * i, 0, 0), X));
+    observe(views.back(), X, {0, 0});
+  }
+  for (size_t wrong : {0u, 4u, 8u}) views[wrong].xy += Eigen::Vector2d(40, 25) / kF;
+  const TriangulatedPoint p = triangulate(views, kF, kF, TriangulationOptions::refinement());
+  ASSERT_EQ(p.outcome, TriangulationOutcome::kOk);
+  EXPECT_EQ(p.views, (std::vector<size_t>{1, 2, 3, 5, 6, 7}));
+  EXPECT_LT((p.xyz - X).norm(), 1e-6);
+}
+
 // A Gaussian blob centred between pixels: the detector's keypoint sits on it (pixel centres at integer
 // coordinates, the scene camera's convention) within a tenth of a pixel.
 TEST(FrontendFeatures, SiftKeypointsSitOnTheFeature) {

@@ -7,7 +7,7 @@
 #include "host/refine/ate.h"
 #include "host/refine/refine.h"
 #include "host/refine/synthetic_tracks.h"
-#include "host/refine/triangulation.h"
+#include "host/refine/triangulate_track.h"
 #include "host/refine/weights.h"
 #include "refine_test_scene.h"
 
