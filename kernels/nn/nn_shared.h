@@ -48,6 +48,27 @@ struct NnMapParams {
   uint count;  // out_channels * out_height * out_width
 };
 
+// ---- nn_keypoints.comp: XFeat's post-processing (kernels/nn/xfeat_keypoints_reference.h), one output
+// element per invocation but for NN_KEYPOINTS_DESCRIPTORS (one keypoint per invocation) ----
+#define NN_KEYPOINTS_HEATMAP 0  // out [H][W] = softmax over a's 65 bins, bin ky*8+kx at (8cy+ky, 8cx+kx)
+#define NN_KEYPOINTS_SCORES 1   // out [H][W] = heat a * reliability b (bilinear) at window maxima > threshold
+#define NN_KEYPOINTS_NORMALIZE 2    // out [C][h][w] = a divided by its L2 norm over the channels
+#define NN_KEYPOINTS_DESCRIPTORS 3  // out [count][C] = a bicubic at b's (x, y) pairs, L2-normalized
+#define NN_KEYPOINTS_BINDING_A 0
+#define NN_KEYPOINTS_BINDING_B 1
+#define NN_KEYPOINTS_BINDING_OUT 2
+#define NN_KEYPOINTS_BINDING_COUNT 3
+#define NN_KEYPOINTS_MAX_CHANNELS 64  // descriptors' channels (one invocation holds them)
+
+struct NnKeypointsParams {
+  uint op;
+  uint channels, map_height, map_width;  // the 1/8-resolution maps
+  uint height, width;                    // the image (8 map_height x 8 map_width)
+  uint window;                           // NMS window (odd)
+  uint count;                            // outputs (keypoints for NN_KEYPOINTS_DESCRIPTORS)
+  float threshold;
+};
+
 #ifdef __cplusplus
 }  // namespace litgs::kernels
 #endif

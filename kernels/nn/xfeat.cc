@@ -18,8 +18,20 @@ struct Map {
 
 }  // namespace
 
+struct XfeatNetwork::Pass {
+  explicit Pass(engine::Context& c) : context(c), sequence(c) {}
+  engine::Context& context;
+  engine::Sequence sequence;
+  std::vector<std::unique_ptr<engine::DeviceArray<float>>> pool;  // every map, alive until the pass ends
+  Map features, keypoints, heatmap;
+  Map make(const MapShape& shape, const char* name = "xfeat: feature map") {
+    pool.push_back(std::make_unique<engine::DeviceArray<float>>(context, name, shape.elements()));
+    return Map{pool.back().get(), shape};
+  }
+};
+
 XfeatNetwork::XfeatNetwork(engine::Context& context, const nn::XfeatWeights& weights)
-    : context_(&context), conv_(context), map_(context) {
+    : context_(&context), conv_(context), map_(context), keypoints_(context) {
   if (weights.convs.size() != 27)
     throw std::invalid_argument("XfeatNetwork: " + std::to_string(weights.convs.size()) +
                                 " convolutions, XFeat has 27");
@@ -40,19 +52,15 @@ XfeatNetwork::XfeatNetwork(engine::Context& context, const nn::XfeatWeights& wei
 
 XfeatNetwork::~XfeatNetwork() = default;
 
-XfeatDeviceOutputs XfeatNetwork::run(const std::vector<float>& image, uint32_t height, uint32_t width) const {
+void XfeatNetwork::forward(Pass& pass, const std::vector<float>& image, uint32_t height,
+                           uint32_t width) const {
   if (!height || !width || height % 32 || width % 32 || image.size() != size_t{height} * width)
     throw std::invalid_argument(
         "XfeatNetwork: a one-channel image whose sides are positive multiples of 32, not " +
         std::to_string(width) + "x" + std::to_string(height) + " with " + std::to_string(image.size()) +
         " values");
-  engine::Context& ctx = *context_;
-  engine::Sequence s(ctx);
-  std::vector<std::unique_ptr<engine::DeviceArray<float>>> pool;  // every map, alive until submit_and_wait
-  const auto make = [&](const MapShape& shape) {
-    pool.push_back(std::make_unique<engine::DeviceArray<float>>(ctx, "xfeat: feature map", shape.elements()));
-    return Map{pool.back().get(), shape};
-  };
+  engine::Sequence& s = pass.sequence;
+  const auto make = [&pass](const MapShape& shape) { return pass.make(shape); };
   // Layers first .. first + count - 1 in turn: ReLU after each but the last, `last` after the last.
   const auto layers = [&](const Map& in, size_t first, size_t count, uint32_t last) {
     Map x = in;
@@ -92,18 +100,55 @@ XfeatDeviceOutputs XfeatNetwork::run(const std::vector<float>& image, uint32_t h
   const Map fused34 = make(x3.shape), fused = make(x3.shape);
   map_.add(s, x3.buffer(), up4.buffer(), fused34.buffer(), x3.shape);
   map_.add(s, fused34.buffer(), up5.buffer(), fused.buffer(), x3.shape);
-  const Map features = layers(fused, 17, 3, NN_ACTIVATION_NONE);
-  const Map heatmap = layers(features, 20, 3, NN_ACTIVATION_SIGMOID);
+  pass.features = layers(fused, 17, 3, NN_ACTIVATION_NONE);
+  pass.heatmap = layers(pass.features, 20, 3, NN_ACTIVATION_SIGMOID);
   const Map cells = make({64, height / 8, width / 8});
   map_.unfold(s, input.buffer(), cells.buffer(), input.shape, 8);
-  const Map keypoints = layers(cells, 23, 4, NN_ACTIVATION_NONE);
-  s.submit_and_wait();
+  pass.keypoints = layers(cells, 23, 4, NN_ACTIVATION_NONE);
+}
+
+XfeatDeviceOutputs XfeatNetwork::run(const std::vector<float>& image, uint32_t height, uint32_t width) const {
+  Pass pass(*context_);
+  forward(pass, image, height, width);
+  pass.sequence.submit_and_wait();
   XfeatDeviceOutputs out;
-  out.height = features.shape.height;
-  out.width = features.shape.width;
-  out.features = features.data->download();
-  out.keypoints = keypoints.data->download();
-  out.heatmap = heatmap.data->download();
+  out.height = pass.features.shape.height;
+  out.width = pass.features.shape.width;
+  out.features = pass.features.data->download();
+  out.keypoints = pass.keypoints.data->download();
+  out.heatmap = pass.heatmap.data->download();
+  return out;
+}
+
+XfeatDetections XfeatNetwork::detect(const std::vector<float>& image, uint32_t height, uint32_t width,
+                                     const nn::XfeatKeypointOptions& o) const {
+  Pass pass(*context_);
+  forward(pass, image, height, width);
+  const uint32_t h = height / 8, w = width / 8;
+  const Map heat = pass.make({1, height, width}), scores = pass.make({1, height, width});
+  const Map normalized = pass.make(pass.features.shape);
+  keypoints_.heatmap(pass.sequence, pass.keypoints.buffer(), heat.buffer(), h, w);
+  keypoints_.scores(pass.sequence, heat.buffer(), pass.heatmap.buffer(), scores.buffer(), h, w,
+                    static_cast<float>(o.threshold), static_cast<uint32_t>(o.nms_window));
+  keypoints_.normalize(pass.sequence, pass.features.buffer(), normalized.buffer(), pass.features.shape);
+  pass.sequence.submit_and_wait();
+  XfeatDetections out;
+  out.height = height;
+  out.width = width;
+  out.keypoints = nn::top_keypoints(scores.data->download(), int(width), int(height), o.top_k);
+  if (out.keypoints.empty()) return out;
+  // The top-k choice is on the host: a second sequence samples the descriptors at the chosen pixels.
+  std::vector<float> xy;
+  for (const nn::ScoredKeypoint& k : out.keypoints) xy.insert(xy.end(), {k.x, k.y});
+  engine::DeviceArray<float> positions(*context_, "xfeat: keypoints", xy.size());
+  positions.upload(xy);
+  engine::DeviceArray<float> descriptors(*context_, "xfeat: descriptors",
+                                         out.keypoints.size() * pass.features.shape.channels);
+  engine::Sequence s(*context_);
+  keypoints_.descriptors(s, normalized.buffer(), positions.buffer(), descriptors.buffer(),
+                         pass.features.shape, static_cast<uint32_t>(out.keypoints.size()));
+  s.submit_and_wait();
+  out.descriptors = descriptors.download();
   return out;
 }
 

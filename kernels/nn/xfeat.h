@@ -1,7 +1,7 @@
 // XFeat's network on the Vulkan device (nn_conv2d.comp and nn_map.comp), the same dataflow as
-// kernels/nn/xfeat_reference.h, its CPU double reference. Weights are uploaded once; intermediate maps are
-// allocated for the size of each call. The post-processing (softmax, NMS, top-k, descriptor sampling) and the
-// matchers are not here yet (issue 47).
+// kernels/nn/xfeat_reference.h, its CPU double reference, and its post-processing (nn_keypoints.comp, as
+// kernels/nn/xfeat_keypoints_reference.h): keypoints and descriptors. Weights are uploaded once; intermediate
+// maps are allocated for the size of each call.
 #pragma once
 
 #include <memory>
@@ -10,7 +10,9 @@
 #include "engine/buffer.h"
 #include "engine/context.h"
 #include "kernels/nn/nn_conv.h"
+#include "kernels/nn/nn_keypoints.h"
 #include "kernels/nn/nn_weights.h"
+#include "kernels/nn/xfeat_keypoints_reference.h"
 
 namespace litgs::kernels {
 
@@ -21,6 +23,12 @@ struct XfeatDeviceOutputs {
   std::vector<float> heatmap;      // [height][width] reliability
 };
 
+struct XfeatDetections {
+  uint32_t height = 0, width = 0;             // of the image
+  std::vector<nn::ScoredKeypoint> keypoints;  // highest score first
+  std::vector<float> descriptors;             // keypoints.size() x 64, L2-normalized
+};
+
 class XfeatNetwork {
  public:
   // Uploads the weights (host/nn/xfeat_weights.h reads them); std::invalid_argument unless there are 27.
@@ -29,8 +37,15 @@ class XfeatNetwork {
   // `image`: height x width values, normalized to zero mean and unit variance; the sides positive multiples
   // of 32 (std::invalid_argument otherwise). Records, submits and waits.
   XfeatDeviceOutputs run(const std::vector<float>& image, uint32_t height, uint32_t width) const;
+  // The network and the post-processing: on the device but for the top-k choice, which reads back the
+  // score map. Deterministic: one image gives the same keypoints and descriptors on one device.
+  XfeatDetections detect(const std::vector<float>& image, uint32_t height, uint32_t width,
+                         const nn::XfeatKeypointOptions& options = {}) const;
 
  private:
+  struct Pass;
+  // Records the forward pass into pass's sequence; its maps live in the pass.
+  void forward(Pass& pass, const std::vector<float>& image, uint32_t height, uint32_t width) const;
   struct Layer {
     std::unique_ptr<engine::DeviceArray<float>> weight, bias;
     uint32_t in_channels, out_channels, kernel, stride, pad;
@@ -39,6 +54,7 @@ class XfeatNetwork {
   std::vector<Layer> layers_;
   Conv2dKernel conv_;
   MapKernel map_;
+  KeypointKernel keypoints_;
 };
 
 }  // namespace litgs::kernels
