@@ -30,7 +30,8 @@ NnKeypointsParams params(uint32_t op, uint32_t channels, uint32_t h, uint32_t w,
 
 KeypointKernel::KeypointKernel(engine::Context& context)
     : context_(&context),
-      kernel_(make_kernel(context, "nn/nn_keypoints", NN_KEYPOINTS_BINDING_COUNT, sizeof(NnKeypointsParams))) {}
+      kernel_(
+          make_kernel(context, "nn/nn_keypoints", NN_KEYPOINTS_BINDING_COUNT, sizeof(NnKeypointsParams))) {}
 
 KeypointKernel::~KeypointKernel() = default;
 
@@ -47,9 +48,9 @@ void KeypointKernel::heatmap(engine::Sequence& s, const engine::Buffer& logits, 
              p);
 }
 
-void KeypointKernel::scores(engine::Sequence& s, const engine::Buffer& heat, const engine::Buffer& reliability,
-                            const engine::Buffer& scores, uint32_t h, uint32_t w, float threshold,
-                            uint32_t window) const {
+void KeypointKernel::scores(engine::Sequence& s, const engine::Buffer& heat,
+                            const engine::Buffer& reliability, const engine::Buffer& scores, uint32_t h,
+                            uint32_t w, float threshold, uint32_t window) const {
   static const char* who = "KeypointKernel::scores";
   if (window % 2 == 0) throw std::invalid_argument(std::string(who) + ": the NMS window must be odd");
   NnKeypointsParams p = params(NN_KEYPOINTS_SCORES, 1, h, w, 64 * h * w);
@@ -79,13 +80,16 @@ void KeypointKernel::normalize(engine::Sequence& s, const engine::Buffer& featur
              p);
 }
 
-void KeypointKernel::descriptors(engine::Sequence& s, const engine::Buffer& normalized, const engine::Buffer& xy,
-                                 const engine::Buffer& out, const MapShape& shape, uint32_t count) const {
+void KeypointKernel::descriptors(engine::Sequence& s, const engine::Buffer& normalized,
+                                 const engine::Buffer& xy, const engine::Buffer& out, const MapShape& shape,
+                                 uint32_t count) const {
   static const char* who = "KeypointKernel::descriptors";
   if (!shape.channels || shape.channels > NN_KEYPOINTS_MAX_CHANNELS)
-    throw std::invalid_argument(std::string(who) + ": 1 to 64 channels, not " + std::to_string(shape.channels));
+    throw std::invalid_argument(std::string(who) + ": 1 to 64 channels, not " +
+                                std::to_string(shape.channels));
   if (!count) return;
-  const NnKeypointsParams p = params(NN_KEYPOINTS_DESCRIPTORS, shape.channels, shape.height, shape.width, count);
+  const NnKeypointsParams p =
+      params(NN_KEYPOINTS_DESCRIPTORS, shape.channels, shape.height, shape.width, count);
   check_binding(who, "normalized", normalized, shape.elements() * sizeof(float));
   check_binding(who, "xy", xy, uint64_t{2} * count * sizeof(float));
   check_binding(who, "out", out, uint64_t{count} * shape.channels * sizeof(float));

@@ -24,8 +24,8 @@ double tap(const FeatureMap& m, int c, int y, int x) {
 // Keys' cubic convolution weights with a = -0.75 for the taps at -1, 0, 1, 2 from floor(t).
 void cubic_weights(double t, double w[4]) {
   const double a = -0.75;
-  auto near = [a](double d) { return ((a + 2) * d - (a + 3)) * d * d + 1; };          // |d| <= 1
-  auto far = [a](double d) { return ((a * d - 5 * a) * d + 8 * a) * d - 4 * a; };     // 1 < |d| < 2
+  auto near = [a](double d) { return ((a + 2) * d - (a + 3)) * d * d + 1; };       // |d| <= 1
+  auto far = [a](double d) { return ((a * d - 5 * a) * d + 8 * a) * d - 4 * a; };  // 1 < |d| < 2
   w[0] = far(t + 1);
   w[1] = near(t);
   w[2] = near(1 - t);
@@ -36,7 +36,8 @@ void cubic_weights(double t, double w[4]) {
 
 FeatureMap keypoint_heatmap(const FeatureMap& logits) {
   if (logits.channels != kBins)
-    throw std::invalid_argument("keypoint_heatmap: 65 logits per cell, got " + std::to_string(logits.channels));
+    throw std::invalid_argument("keypoint_heatmap: 65 logits per cell, got " +
+                                std::to_string(logits.channels));
   FeatureMap heat(1, logits.height * kCell, logits.width * kCell);
   for (int cy = 0; cy < logits.height; ++cy)
     for (int cx = 0; cx < logits.width; ++cx) {
@@ -45,7 +46,8 @@ FeatureMap keypoint_heatmap(const FeatureMap& logits) {
       double sum = 0;
       for (int b = 0; b < kBins; ++b) sum += std::exp(logits.at(b, cy, cx) - top);
       for (int b = 0; b < kBins - 1; ++b)
-        heat.at(0, cy * kCell + b / kCell, cx * kCell + b % kCell) = std::exp(logits.at(b, cy, cx) - top) / sum;
+        heat.at(0, cy * kCell + b / kCell, cx * kCell + b % kCell) =
+            std::exp(logits.at(b, cy, cx) - top) / sum;
     }
   return heat;
 }
@@ -58,7 +60,8 @@ double sample_bilinear(const FeatureMap& m, int c, double x, double y, int width
          ty * ((1 - tx) * tap(m, c, y0 + 1, x0) + tx * tap(m, c, y0 + 1, x0 + 1));
 }
 
-FeatureMap keypoint_scores(const FeatureMap& heat, const FeatureMap& reliability, const XfeatKeypointOptions& o) {
+FeatureMap keypoint_scores(const FeatureMap& heat, const FeatureMap& reliability,
+                           const XfeatKeypointOptions& o) {
   if (heat.channels != 1 || reliability.channels != 1 || heat.width != reliability.width * kCell ||
       heat.height != reliability.height * kCell)
     throw std::invalid_argument("keypoint_scores: a heat map 8 times the reliability map's size");
@@ -90,12 +93,13 @@ std::vector<ScoredKeypoint> top_keypoints(const std::vector<float>& scores, int 
   for (size_t i = 0; i < scores.size(); ++i)
     if (scores[i] > 0) candidates.push_back(static_cast<uint32_t>(i));
   const size_t k = std::min<size_t>(top_k, candidates.size());
-  std::partial_sort(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(k), candidates.end(),
-                    [&](uint32_t a, uint32_t b) { return scores[a] > scores[b] || (scores[a] == scores[b] && a < b); });
+  std::partial_sort(
+      candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(k), candidates.end(),
+      [&](uint32_t a, uint32_t b) { return scores[a] > scores[b] || (scores[a] == scores[b] && a < b); });
   std::vector<ScoredKeypoint> out(k);
   for (size_t i = 0; i < k; ++i)
-    out[i] = {static_cast<float>(candidates[i] % uint32_t(width)), static_cast<float>(candidates[i] / uint32_t(width)),
-              scores[candidates[i]]};
+    out[i] = {static_cast<float>(candidates[i] % uint32_t(width)),
+              static_cast<float>(candidates[i] / uint32_t(width)), scores[candidates[i]]};
   return out;
 }
 
@@ -136,8 +140,8 @@ std::vector<double> sample_descriptors(const FeatureMap& m, const std::vector<Sc
   return out;
 }
 
-XfeatKeypoints detect_keypoints(const FeatureMap& features, const FeatureMap& logits, const FeatureMap& reliability,
-                                const XfeatKeypointOptions& o) {
+XfeatKeypoints detect_keypoints(const FeatureMap& features, const FeatureMap& logits,
+                                const FeatureMap& reliability, const XfeatKeypointOptions& o) {
   const FeatureMap heat = keypoint_heatmap(logits);
   const FeatureMap scores = keypoint_scores(heat, reliability, o);
   const std::vector<float> as_float(scores.values.begin(), scores.values.end());

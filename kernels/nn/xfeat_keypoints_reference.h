@@ -46,8 +46,8 @@ double sample_bilinear(const FeatureMap& map, int channel, double x, double y, i
 
 // The descriptors at the keypoints: bicubic (a = -0.75, as grid_sample) in the normalized features, then
 // L2-normalized. keypoints.size() rows of features.channels values.
-std::vector<double> sample_descriptors(const FeatureMap& normalized, const std::vector<ScoredKeypoint>& keypoints,
-                                       int width, int height);
+std::vector<double> sample_descriptors(const FeatureMap& normalized,
+                                       const std::vector<ScoredKeypoint>& keypoints, int width, int height);
 
 struct XfeatKeypoints {
   std::vector<ScoredKeypoint> keypoints;

@@ -37,7 +37,9 @@ FeatureMap random_map(int c, int h, int w, uint32_t seed, float sd) {
   return m;
 }
 
-std::vector<float> as_float(const FeatureMap& m) { return {m.values.begin(), m.values.end()}; }
+std::vector<float> as_float(const FeatureMap& m) {
+  return {m.values.begin(), m.values.end()};
+}
 
 FeatureMap as_map(const std::vector<float>& v, int c, int h, int w) {
   FeatureMap m(c, h, w);
@@ -96,7 +98,8 @@ TEST_F(NnKeypointsTest, EachOpMatchesItsReference) {
                   float(std::uniform_int_distribution<int>(0, H - 1)(rng)), 1});
   std::vector<float> xy;
   for (const auto& k : at) xy.insert(xy.end(), {k.x, k.y});
-  DeviceArray<float> d_xy(context(), "test: xy", xy.size()), d_desc(context(), "test: descriptors", at.size() * 64);
+  DeviceArray<float> d_xy(context(), "test: xy", xy.size()),
+      d_desc(context(), "test: descriptors", at.size() * 64);
   d_xy.upload(xy);
   engine::Sequence s2(context());
   kernel.descriptors(s2, d_norm.buffer(), d_xy.buffer(), d_desc.buffer(), {64, uint32_t(h), uint32_t(w)},
@@ -155,7 +158,8 @@ TEST_F(NnKeypointsTest, DetectionMatchesTheCpuNetworkAndPostProcessing) {
     ++common;
     const size_t j = size_t(it - cpu.keypoints.begin());
     EXPECT_NEAR(k.score, it->score, 1e-4);
-    for (int c = 0; c < 64; ++c) ASSERT_NEAR(device.descriptors[i * 64 + c], cpu.descriptors[j * 64 + c], 1e-3);
+    for (int c = 0; c < 64; ++c)
+      ASSERT_NEAR(device.descriptors[i * 64 + c], cpu.descriptors[j * 64 + c], 1e-3);
   }
   // float against double: a keypoint at a near-tie of the NMS or of the 200th score may differ.
   EXPECT_GE(double(common), 0.97 * double(cpu.keypoints.size()));

@@ -11,7 +11,7 @@ namespace litgs::kernels::nn {
 namespace {
 
 TEST(XfeatKeypointsReference, SoftmaxPutsEachBinAtItsPixelOfTheCell) {
-  FeatureMap logits(65, 2, 3);  // all zero logits but one
+  FeatureMap logits(65, 2, 3);            // all zero logits but one
   logits.at(19, 1, 2) = std::log(100.0);  // bin 19: row 2, column 3 of cell (1, 2)
   const FeatureMap heat = keypoint_heatmap(logits);
   ASSERT_EQ(heat.height, 16);
@@ -34,7 +34,7 @@ TEST(XfeatKeypointsReference, NmsKeepsWindowMaximaAboveTheThresholdTimesReliabil
   heat.at(0, 20, 10) = 0.3;
   heat.at(0, 20, 13) = 0.3;  // 3 px apart: outside each other's window
   heat.at(0, 26, 20) = 0.2;
-  heat.at(0, 26, 21) = 0.2;  // a tie within one window: both are its maximum, both kept
+  heat.at(0, 26, 21) = 0.2;   // a tie within one window: both are its maximum, both kept
   heat.at(0, 16, 24) = 0.04;  // below the threshold
   const FeatureMap s = keypoint_scores(heat, reliability, {});
   int kept = 0;
