@@ -4,6 +4,7 @@
 
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <set>
 
 #include "io/error.h"
@@ -106,12 +107,31 @@ const OnnxTensor& OnnxModel::initializer(const std::string& name) const {
   return it->second;
 }
 
+namespace {
+
+OnnxModel from_proto(const onnx::ModelProto& proto, const std::filesystem::path& path);
+
+}  // namespace
+
 OnnxModel read_onnx_model(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) fail(path, 0, "cannot open the model file");
   onnx::ModelProto proto;
   if (!proto.ParseFromIstream(&in))
     fail(path, 0, "not an ONNX model: the protobuf does not parse (a truncated or corrupt file?)");
+  return from_proto(proto, path);
+}
+
+OnnxModel parse_onnx_model(const void* bytes, size_t size, const std::string& name) {
+  onnx::ModelProto proto;
+  if (size > size_t(std::numeric_limits<int>::max()) || !proto.ParseFromArray(bytes, static_cast<int>(size)))
+    fail(name, 0, "not an ONNX model: the protobuf does not parse (a truncated or corrupt model?)");
+  return from_proto(proto, name);
+}
+
+namespace {
+
+OnnxModel from_proto(const onnx::ModelProto& proto, const std::filesystem::path& path) {
   if (!proto.has_graph() || proto.graph().node_size() == 0)
     fail(path, 0, "the ONNX model has no graph nodes");
   OnnxModel m;
@@ -168,4 +188,5 @@ OnnxModel read_onnx_model(const std::filesystem::path& path) {
   return m;
 }
 
+}  // namespace
 }  // namespace litgs::io

@@ -56,5 +56,7 @@ struct OnnxModel {
 };
 
 OnnxModel read_onnx_model(const std::filesystem::path& path);
+// The same from bytes in memory (a model embedded in the binary); `name` stands for the file in errors.
+OnnxModel parse_onnx_model(const void* bytes, size_t size, const std::string& name);
 
 }  // namespace litgs::io

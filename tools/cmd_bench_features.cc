@@ -1,7 +1,8 @@
 // `litgs-engine bench features [--image FILE] [--runs N] [--json]`: milliseconds per image for each detector
 // on one frame, in one run: ORB, SIFT and AKAZE (OpenCV, on the CPU, at the front end's defaults), XFeat's
-// network on the Vulkan device (upload, forward pass and download; the post-processing is not built yet)
-// and XFeat's double-precision CPU reference (one run). The frame is cropped to multiples of 32.
+// network on the Vulkan device (upload, forward pass and download), XFeat as the front end runs it (network,
+// keypoints and descriptors on the device, at match's defaults) and XFeat's double-precision CPU reference
+// of the network (one run). The frame is cropped to multiples of 32.
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <iomanip>
@@ -13,9 +14,10 @@
 #include "host/frontend/features.h"
 #include "host/frontend/intensity.h"
 #include "host/frontend/preprocess.h"
+#include "host/nn/xfeat_features.h"
+#include "host/nn/xfeat_model.h"
 #include "host/nn/xfeat_weights.h"
 #include "io/image.h"
-#include "io/onnx_model.h"
 #include "kernels/nn/xfeat.h"
 #include "kernels/nn/xfeat_reference.h"
 #include "tools/bench_stats.h"
@@ -27,7 +29,7 @@ namespace {
 
 struct BenchFeaturesOptions {
   std::filesystem::path image;  // empty: a 640x512 pattern
-  std::filesystem::path model = LITGS_XFEAT_MODEL;
+  std::filesystem::path model;  // empty: the embedded model
   uint32_t runs = 5;
   bool json = false;
 };
@@ -62,18 +64,6 @@ host::frontend::Gray8 load_frame(const std::filesystem::path& path) {
   return g;
 }
 
-// Zero mean, unit variance, as XFeat takes its input.
-std::vector<float> normalized(const host::frontend::Gray8& g) {
-  double mean = 0, variance = 0;
-  for (uint8_t p : g.pixels) mean += p;
-  mean /= double(g.pixels.size());
-  for (uint8_t p : g.pixels) variance += (p - mean) * (p - mean);
-  const double sd = std::max(std::sqrt(variance / double(g.pixels.size())), 1e-6);
-  std::vector<float> out;
-  for (uint8_t p : g.pixels) out.push_back(static_cast<float>((p - mean) / sd));
-  return out;
-}
-
 void run_bench_features(const BenchFeaturesOptions& o) {
   if (o.runs < 1) throw std::invalid_argument("--runs must be at least 1");
   const host::frontend::Gray8 frame = load_frame(o.image);
@@ -91,9 +81,10 @@ void run_bench_features(const BenchFeaturesOptions& o) {
     rows.push_back(
         {{"detector", name}, {"where", "CPU (OpenCV)"}, {"ms", median(ms)}, {"keypoints", keypoints}});
   }
-  const kernels::nn::XfeatWeights weights = host::nn::xfeat_weights(io::read_onnx_model(o.model));
-  const std::vector<float> input = normalized(frame);
-  engine::Context context;
+  const kernels::nn::XfeatWeights weights = host::nn::xfeat_weights(host::nn::xfeat_model(o.model));
+  const std::vector<float> input = host::nn::xfeat_input(frame);
+  const auto shared_context = std::make_shared<engine::Context>();
+  engine::Context& context = *shared_context;
   const kernels::XfeatNetwork network(context, weights);
   std::vector<double> ms;
   for (uint32_t r = 0; r <= o.runs; ++r) {
@@ -102,6 +93,19 @@ void run_bench_features(const BenchFeaturesOptions& o) {
   }
   rows.push_back(
       {{"detector", "xfeat network"}, {"where", "device: " + context.info().name}, {"ms", median(ms)}});
+  // What the front end pays per frame: normalization, network, keypoints, descriptors, grid bucketing.
+  const host::frontend::LearnedDetector xfeat =
+      host::nn::make_xfeat_detector(shared_context, weights, host::frontend::FeatureOptions{});
+  std::vector<double> detect_ms;
+  size_t xfeat_keypoints = 0;
+  for (uint32_t r = 0; r <= o.runs; ++r) {
+    const double t = time_ms([&] { xfeat_keypoints = xfeat(frame).keypoints.size(); });
+    if (r) detect_ms.push_back(t);
+  }
+  rows.push_back({{"detector", "xfeat"},
+                  {"where", "device: network, keypoints, descriptors"},
+                  {"ms", median(detect_ms)},
+                  {"keypoints", xfeat_keypoints}});
   kernels::nn::FeatureMap image(1, frame.height, frame.width);
   image.values.assign(input.begin(), input.end());
   const kernels::nn::XfeatReference reference(weights);
@@ -137,7 +141,8 @@ void add_bench_features_command(CLI::App& bench) {
       bench.add_subcommand("features", "Milliseconds per frame of each detector, XFeat on the device");
   cmd->add_option("--image", o->image, "A one-channel 8- or 16-bit frame (default: a 640x512 pattern)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--model", o->model, "XFeat's ONNX model")->capture_default_str();
+  cmd->add_option("--model", o->model, "XFeat's ONNX model (default: the one embedded in the binary)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--runs", o->runs, "Timed runs after one warm-up")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->callback([o] { run_bench_features(*o); });

@@ -6,17 +6,25 @@
 #include <sstream>
 
 #include "host/frontend/match_option_names.h"
+#include "host/nn/xfeat_features.h"
 namespace litgs::tools {
 
 host::frontend::FrontendOptions FrontendCli::resolved() const {
   host::frontend::FrontendOptions o = options;
   o.features.type = host::frontend::parse_feature_type(features);
+  if (matcher == "lighterglue")
+    throw std::invalid_argument("--matcher lighterglue is not built yet (issue 47): ratio or mnn");
+  o.match.matcher = matcher == "auto" ? (o.features.type == host::frontend::FeatureType::kXfeat
+                                             ? host::frontend::Matcher::kMnn
+                                             : host::frontend::Matcher::kRatio)
+                                      : host::frontend::parse_matcher(matcher);
   o.pairs = host::frontend::parse_pairs(pairs);
   o.preprocess.clahe = clahe;
   o.prior_epipolar = !no_prior_epipolar;
   if (poses != "estimated" && poses != "truth")
     throw std::invalid_argument("--poses " + poses + ": expected estimated or truth");
   o.true_poses = poses == "truth";
+  o = host::nn::with_learned_detector(o, model);
   o.check();
   return o;
 }
@@ -38,7 +46,12 @@ void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli
   cmd.add_option("--stretch-window", o.preprocess.stretch_window,
                  "16-bit stretch over the N frames around each frame (0: the whole sequence)")
       ->capture_default_str();
-  cmd.add_option("--ratio", o.match.ratio, "Ratio test bound")->capture_default_str();
+  cmd.add_option(M::kMatcher.flag, cli->matcher, M::kMatcher.help)->capture_default_str();
+  cmd.add_option("--ratio", o.match.ratio, "Ratio test bound (matcher ratio)")->capture_default_str();
+  cmd.add_option("--min-cosine", o.match.min_cosine, "Cosine similarity bound (matcher mnn)")
+      ->capture_default_str();
+  cmd.add_option("--model", cli->model, "XFeat's ONNX model (default: the one embedded in the binary)")
+      ->check(CLI::ExistingFile);
   cmd.add_option("--magsac-px", o.verify.max_error_px, "MAGSAC threshold, pixels")->capture_default_str();
   cmd.add_option("--prior-epipolar-px", o.verify.prior_epipolar_px,
                  "Reject matches this far from the prior poses' epipolar lines (pixels)")

@@ -1,6 +1,7 @@
 // The front end's command-line options and summary, shared by `match` and `bench frontend`.
 #pragma once
 
+#include <filesystem>
 #include <iosfwd>
 #include <memory>
 #include <string>
@@ -16,11 +17,14 @@ namespace litgs::tools {
 struct FrontendCli {
   host::frontend::FrontendOptions options;
   std::string features = "sift";
+  std::string matcher = "auto";  // ratio for the classical detectors, mnn for xfeat
+  std::filesystem::path model;   // xfeat's ONNX model (empty: the embedded one)
   std::string pairs = "covisible";
   bool clahe = true;
   bool no_prior_epipolar = false;
   std::string poses = "estimated";
-  // Parses the text options into `options`; std::invalid_argument on a bad value.
+  // Parses the text options into `options`, with the device detector when xfeat is asked for;
+  // std::invalid_argument on a bad value, io::IoError on a bad model file.
   host::frontend::FrontendOptions resolved() const;
 };
 

@@ -15,6 +15,8 @@ std::string feature_name(FeatureType type) {
       return "sift";
     case FeatureType::kAkaze:
       return "akaze";
+    case FeatureType::kXfeat:
+      return "xfeat";
   }
   return "?";
 }
@@ -23,7 +25,8 @@ FeatureType parse_feature_type(const std::string& name) {
   if (name == "orb") return FeatureType::kOrb;
   if (name == "sift") return FeatureType::kSift;
   if (name == "akaze") return FeatureType::kAkaze;
-  throw std::invalid_argument("unknown feature type '" + name + "' (orb, sift or akaze)");
+  if (name == "xfeat") return FeatureType::kXfeat;
+  throw std::invalid_argument("unknown feature type '" + name + "' (orb, sift, akaze or xfeat)");
 }
 
 void FeatureOptions::check() const {
@@ -80,6 +83,8 @@ cv::Ptr<cv::Feature2D> make_detector(const FeatureOptions& o) {
       return cv::SIFT::create(0, 3, 0.02, 10, 1.6);
     case FeatureType::kAkaze:
       return cv::AKAZE::create(cv::AKAZE::DESCRIPTOR_MLDB, 0, 3, 0.0005f, 4, 4, cv::KAZE::DIFF_PM_G2);
+    case FeatureType::kXfeat:
+      break;
   }
   throw std::invalid_argument("unknown feature type");
 }
@@ -88,6 +93,8 @@ cv::Ptr<cv::Feature2D> make_detector(const FeatureOptions& o) {
 
 ImageFeatures detect_features(const Gray8& image, const FeatureOptions& o) {
   o.check();
+  if (o.type == FeatureType::kXfeat)
+    throw std::invalid_argument("xfeat runs on the Vulkan device: the front end needs a learned detector");
   ImageFeatures f;
   f.float_descriptors = o.type == FeatureType::kSift;
   if (image.pixels.empty()) return f;

@@ -1,8 +1,10 @@
-// Keypoints and descriptors (ORB, SIFT or AKAZE through OpenCV) with a per-image budget spread over the
-// image by grid bucketing, so that low-texture thermal frames still get keypoints everywhere.
+// Keypoints and descriptors (ORB, SIFT or AKAZE through OpenCV; XFeat on the Vulkan device through a
+// LearnedDetector, host/nn/xfeat_features.h) with a per-image budget spread over the image by grid
+// bucketing, so that low-texture thermal frames still get keypoints everywhere.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -11,9 +13,10 @@
 
 namespace litgs::host::frontend {
 
-enum class FeatureType { kOrb, kSift, kAkaze };
+enum class FeatureType { kOrb, kSift, kAkaze, kXfeat };
 std::string feature_name(FeatureType type);
-FeatureType parse_feature_type(const std::string& name);  // "orb" | "sift" | "akaze"; invalid_argument
+FeatureType parse_feature_type(
+    const std::string& name);  // "orb" | "sift" | "akaze" | "xfeat"; invalid_argument
 
 struct FeatureOptions {
   FeatureType type = FeatureType::kSift;
@@ -31,8 +34,13 @@ struct ImageFeatures {
   bool float_descriptors = false;  // rows of float (SIFT) or bit strings (ORB, AKAZE)
 };
 
-// Detects and describes; an empty or uniform image gives no keypoints (not an error).
+// Detects and describes; an empty or uniform image gives no keypoints (not an error). kXfeat runs on the
+// device, which this library does not reach: std::invalid_argument (use a LearnedDetector).
 ImageFeatures detect_features(const Gray8& image, const FeatureOptions& options);
+
+// A detector that runs outside this library (a network on the Vulkan device), called once per kept frame,
+// possibly from several threads at once.
+using LearnedDetector = std::function<ImageFeatures(const Gray8&)>;
 
 // Indices of at most `budget` of the keypoints at (x, y) with `response`: per cell of the grid the
 // strongest budget / cells first, then the strongest of the rest. Ties keep the lower index. Sorted.

@@ -235,6 +235,8 @@ void summarize(FrontendResult& r, const Structure& s) {
 void FrontendOptions::check() const {
   preprocess.check();
   features.check();
+  if (features.type == FeatureType::kXfeat && !learned_detector)
+    throw std::invalid_argument("features xfeat: no learned detector was given (it runs on the device)");
   match.check();
   verify.check();
   pairs.check();
@@ -305,7 +307,8 @@ FrontendResult run_frontend(const std::filesystem::path& dir, const FrontendOpti
   const std::thread::id caller = std::this_thread::get_id();
   parallel_for(kept.size(), o.threads, [&](size_t k) {
     const uint32_t i = kept[k];
-    c.features[i] = detect_features(frames[i].image, o.features);
+    c.features[i] = o.features.type == FeatureType::kXfeat ? o.learned_detector(frames[i].image)
+                                                           : detect_features(frames[i].image, o.features);
     c.undistorted[i] = undistort_keypoints(cam, c.features[i].keypoints);
     std::lock_guard<std::mutex> lock(progress_mutex);
     ++features_done;
@@ -416,6 +419,7 @@ std::string frontend_json(const FrontendResult& r) {
       {"format", "litgs-frontend 1"},
       {"options",
        {{"features", feature_name(o.features.type)},
+        {"matcher", matcher_name(o.match.matcher)},
         {"max_keypoints", o.features.max_keypoints},
         {"grid", {o.features.grid_cols, o.features.grid_rows}},
         {"clahe", o.preprocess.clahe},

@@ -22,6 +22,7 @@ namespace litgs::host::frontend {
 struct FrontendOptions {
   PreprocessOptions preprocess;
   FeatureOptions features;
+  LearnedDetector learned_detector;  // required for FeatureType::kXfeat (host/nn/xfeat_features.h)
   MatchOptions match;
   VerifyOptions verify;
   bool prior_epipolar = true;  // reject matches far from the prior poses' epipolar lines

@@ -5,7 +5,12 @@
 
 namespace litgs::host::match_option {
 
-inline constexpr OptionName kFeatures{"features", "--features", "orb | sift | akaze"};
+inline constexpr OptionName kFeatures{"features", "--features",
+                                      "orb | sift | akaze | xfeat (XFeat on the Vulkan device)"};
+inline constexpr OptionName kMatcher{
+    "matcher", "--matcher",
+    "auto (ratio; mnn for xfeat) | ratio (mutual nearest + ratio test) | mnn "
+    "(mutual nearest + cosine bound)"};
 inline constexpr OptionName kClahe{"clahe", "!--no-clahe", "CLAHE before detection (--no-clahe: none)"};
 inline constexpr OptionName kPairs{
     "pairs", "--pairs",

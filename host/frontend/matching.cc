@@ -21,10 +21,33 @@ void check_same_kind(const ImageFeatures& a, const ImageFeatures& b, const char*
     throw std::invalid_argument(std::string(who) + ": the two images have different descriptor kinds");
 }
 
+// Whether the best match passes the second test: the ratio to the second best, or the cosine bound (unit
+// vectors: cosine = 1 - d^2 / 2).
+bool passes(double best, double second, const MatchOptions& o) {
+  if (o.matcher == Matcher::kMnn) return 1 - best * best / 2 > o.min_cosine;
+  return second == std::numeric_limits<double>::infinity() || best < o.ratio * second;
+}
+
+void check_matcher_kind(const ImageFeatures& a, const MatchOptions& o, const char* who) {
+  if (o.matcher == Matcher::kMnn && !a.float_descriptors)
+    throw std::invalid_argument(std::string(who) + ": the mnn matcher needs float descriptors (xfeat)");
+}
+
 }  // namespace
+
+std::string matcher_name(Matcher m) {
+  return m == Matcher::kMnn ? "mnn" : "ratio";
+}
+
+Matcher parse_matcher(const std::string& name) {
+  if (name == "ratio") return Matcher::kRatio;
+  if (name == "mnn") return Matcher::kMnn;
+  throw std::invalid_argument("unknown matcher '" + name + "' (ratio or mnn)");
+}
 
 void MatchOptions::check() const {
   if (!(ratio > 0 && ratio <= 1)) throw std::invalid_argument("match ratio must be in (0, 1]");
+  if (!(min_cosine >= -1 && min_cosine < 1)) throw std::invalid_argument("min_cosine must be in [-1, 1)");
 }
 
 std::vector<std::array<uint32_t, 2>> match_mutual(const ImageFeatures& a, const ImageFeatures& b,
@@ -33,6 +56,7 @@ std::vector<std::array<uint32_t, 2>> match_mutual(const ImageFeatures& a, const 
   std::vector<std::array<uint32_t, 2>> out;
   if (a.keypoints.empty() || b.keypoints.empty()) return out;
   check_same_kind(a, b, "match_mutual");
+  check_matcher_kind(a, o, "match_mutual");
   cv::BFMatcher matcher(a.float_descriptors ? cv::NORM_L2 : cv::NORM_HAMMING);
   const cv::Mat da = descriptor_mat(a), db = descriptor_mat(b);
   std::vector<std::vector<cv::DMatch>> ab, ba;
@@ -41,7 +65,8 @@ std::vector<std::array<uint32_t, 2>> match_mutual(const ImageFeatures& a, const 
   for (const auto& m : ab) {
     if (m.empty()) continue;
     const cv::DMatch& best = m[0];
-    if (m.size() > 1 && !(best.distance < o.ratio * m[1].distance)) continue;
+    if (!passes(best.distance, m.size() > 1 ? m[1].distance : std::numeric_limits<double>::infinity(), o))
+      continue;
     const auto& back = ba[static_cast<size_t>(best.trainIdx)];
     if (back.empty() || back[0].trainIdx != best.queryIdx) continue;
     out.push_back({static_cast<uint32_t>(best.queryIdx), static_cast<uint32_t>(best.trainIdx)});
@@ -56,6 +81,7 @@ std::vector<std::array<uint32_t, 2>> match_mutual_among(const ImageFeatures& a, 
   std::vector<std::array<uint32_t, 2>> out;
   if (a.keypoints.empty() || b.keypoints.empty()) return out;
   check_same_kind(a, b, "match_mutual_among");
+  check_matcher_kind(a, o, "match_mutual_among");
   if (allowed.size() != a.keypoints.size())
     throw std::invalid_argument("match_mutual_among: one candidate list per keypoint of a is needed");
   const size_t bytes = static_cast<size_t>(a.descriptor_bytes);
@@ -73,7 +99,7 @@ std::vector<std::array<uint32_t, 2>> match_mutual_among(const ImageFeatures& a, 
   std::vector<double> best_of_b(b.keypoints.size(), kInf);
   std::vector<int64_t> best_i_of_b(b.keypoints.size(), -1);
   std::vector<int64_t> best_j(a.keypoints.size(), -1);
-  std::vector<char> passes_ratio(a.keypoints.size(), 0);
+  std::vector<char> passes_test(a.keypoints.size(), 0);
   for (uint32_t i = 0; i < allowed.size(); ++i) {
     double first = kInf, second = kInf;
     for (uint32_t j : allowed[i]) {
@@ -90,10 +116,10 @@ std::vector<std::array<uint32_t, 2>> match_mutual_among(const ImageFeatures& a, 
         best_i_of_b[j] = i;
       }
     }
-    passes_ratio[i] = best_j[i] >= 0 && (second == kInf || first < o.ratio * second);
+    passes_test[i] = best_j[i] >= 0 && passes(first, second, o);
   }
   for (uint32_t i = 0; i < allowed.size(); ++i)
-    if (passes_ratio[i] && best_i_of_b[static_cast<size_t>(best_j[i])] == i)
+    if (passes_test[i] && best_i_of_b[static_cast<size_t>(best_j[i])] == i)
       out.push_back({i, static_cast<uint32_t>(best_j[i])});
   return out;
 }

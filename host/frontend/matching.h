@@ -1,21 +1,31 @@
-// Descriptor matching: mutual nearest neighbours that also pass the ratio test.
+// Descriptor matching: mutual nearest neighbours that also pass the ratio test (kRatio, for the classical
+// detectors) or whose cosine similarity exceeds a bound (kMnn, XFeat's matcher: unit-length float
+// descriptors).
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "host/frontend/features.h"
 
 namespace litgs::host::frontend {
 
+enum class Matcher { kRatio, kMnn };
+std::string matcher_name(Matcher matcher);
+Matcher parse_matcher(const std::string& name);  // "ratio" | "mnn"; invalid_argument
+
 struct MatchOptions {
-  double ratio = 0.8;  // best distance < ratio * second best (in a's search over b)
-  void check() const;  // std::invalid_argument
+  Matcher matcher = Matcher::kRatio;
+  double ratio = 0.8;        // kRatio: best distance < ratio * second best (in a's search over b)
+  double min_cosine = 0.82;  // kMnn: the pair's cosine similarity above this (XFeat's default)
+  void check() const;        // std::invalid_argument
 };
 
 // Pairs (index in a, index in b): b's nearest to a's keypoint is it, and a's nearest to that is the same,
-// and the ratio test holds. Empty if either side has no descriptors; invalid_argument if their kinds differ.
+// and the ratio test (kRatio) or the cosine bound (kMnn) holds. Empty if either side has no descriptors;
+// invalid_argument if their kinds differ, or kMnn is asked of bit-string descriptors.
 std::vector<std::array<uint32_t, 2>> match_mutual(const ImageFeatures& a, const ImageFeatures& b,
                                                   const MatchOptions& options);
 

@@ -19,6 +19,16 @@ void PreprocessOptions::check() const {
   if (!(frozen_threshold >= 0)) throw std::invalid_argument("preprocess: frozen_threshold must be >= 0");
 }
 
+Gray8 resize_gray8(const Gray8& image, int width, int height) {
+  if (width < 1 || height < 1 || image.pixels.size() != size_t(image.width) * size_t(image.height))
+    throw std::invalid_argument("resize_gray8: an empty image or size");
+  Gray8 out{width, height, std::vector<uint8_t>(size_t(width) * size_t(height))};
+  const cv::Mat in(image.height, image.width, CV_8UC1, const_cast<uint8_t*>(image.pixels.data()));
+  cv::Mat resized(height, width, CV_8UC1, out.pixels.data());
+  cv::resize(in, resized, cv::Size(width, height), 0, 0, cv::INTER_LINEAR);
+  return out;
+}
+
 Gray8 to_gray8(const io::Image& raw, const Stretch& stretch, const PreprocessOptions& o) {
   Gray8 g{raw.width, raw.height, std::vector<uint8_t>(static_cast<size_t>(raw.width) * raw.height)};
   const size_t channels = static_cast<size_t>(raw.channels);

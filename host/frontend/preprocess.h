@@ -39,6 +39,10 @@ struct PreprocessedFrame {
 std::vector<PreprocessedFrame> preprocess_frames(const std::filesystem::path& dir, const io::Scene& scene,
                                                  const PreprocessOptions& options);
 
+// An 8-bit image resized bilinearly with half-pixel centres (OpenCV's INTER_LINEAR, PyTorch's bilinear
+// without corner alignment), for a network that takes sides of given multiples.
+Gray8 resize_gray8(const Gray8& image, int width, int height);
+
 // One raw single-channel image to 8 bits with `stretch`, then CLAHE if asked (exposed for tests).
 Gray8 to_gray8(const io::Image& raw, const Stretch& stretch, const PreprocessOptions& options);
 

@@ -87,7 +87,9 @@ AblationStudy features_study(const RunConfig& base) {
   AblationStudy s{"features", {"features", "CLAHE"}, {}, {}, ""};
   // With oracle tracks refine (and so train) does not depend on the features: stop after match.
   const bool tracks_from_frontend = base.refine.tracks != "oracle";
-  for (const char* f : {"orb", "sift", "akaze"})
+  // XFeat runs on the device with its own matcher (mutual nearest neighbours over a cosine bound, `match
+  // --matcher auto`); the classical detectors with the ratio test.
+  for (const char* f : {"orb", "sift", "akaze", "xfeat"})
     for (const bool clahe : {false, true})
       s.variants.push_back({std::string(f) + (clahe ? "-clahe" : ""),
                             {f, clahe ? "yes" : "no"},
@@ -96,14 +98,17 @@ AblationStudy features_study(const RunConfig& base) {
                               c.match.clahe = clahe;
                             },
                             tracks_from_frontend ? "eval" : "match"});
-  s.measured = {column("inlier ratio", "match", "inlier_ratio", 3),
+  s.measured = {column("keypoints per image", "match", "keypoints_per_image", 0),
+                column("inlier ratio", "match", "inlier_ratio", 3),
                 {"verified / tried pairs",
                  [](const json& r) {
                    return fixed(metric(r, "match", "pairs_verified"), 0) + " / " +
                           fixed(metric(r, "match", "pairs_tried"), 0);
                  }},
                 column("points", "match", "points", 0),
-                column("mean track length", "match", "mean_track_length", 2)};
+                column("mean track length", "match", "mean_track_length", 2),
+                column("reprojection (px)", "match", "mean_reprojection_error_px", 2),
+                {"match (s)", [](const json& r) { return stage_seconds(r, "match"); }}};
   if (tracks_from_frontend) {
     s.measured.push_back(column("ATE (m)", "eval", "ate_m", 4));
     s.measured.push_back({"plane RMS after refinement (m)", [](const json& r) {

@@ -41,6 +41,7 @@ struct RunConfig {
   struct Match {
     bool enabled = true;
     std::string features = "sift";
+    std::string matcher = "auto";
     bool clahe = true;
     std::string pairs = "covisible";
     uint32_t max_keypoints = 3000;
@@ -123,6 +124,7 @@ void for_each_field(Config& c, F&& f) {
   f("map", "extra_args", c.map.extra_args, "more flags for `litgs-engine map`, as is");
   f("match", "enabled", c.match.enabled, "run the thermal front end (writes the scene's sfm/)");
   named("match", match_option::kFeatures, c.match.features);
+  named("match", match_option::kMatcher, c.match.matcher);
   named("match", match_option::kClahe, c.match.clahe);
   named("match", match_option::kPairs, c.match.pairs);
   named("match", match_option::kMaxKeypoints, c.match.max_keypoints);

@@ -18,8 +18,8 @@ StagePlan plan(const StageContext& c) {
   }
   plan_on_scene_copy(
       c, "match", SceneCopy{scene, {}, {"sfm"}},
-      option_flags(p.options, {match_option::kFeatures, match_option::kClahe, match_option::kPairs,
-                               match_option::kMaxKeypoints, match_option::kThreads}),
+      option_flags(p.options, {match_option::kFeatures, match_option::kMatcher, match_option::kClahe,
+                               match_option::kPairs, match_option::kMaxKeypoints, match_option::kThreads}),
       o.extra_args, p);
   return p;
 }
@@ -27,9 +27,10 @@ StagePlan plan(const StageContext& c) {
 nlohmann::json result(const StageContext& c) {
   const fs::path scene = c.stage_dir("match") / "scene";
   const nlohmann::json summary = read_stage_json(scene / "sfm" / "frontend.json").at("summary");
-  return {{"scene", scene.string()},
-          {"metrics", pick(summary, {"inlier_ratio", "pairs_tried", "pairs_verified", "tracks", "points",
-                                     "mean_track_length", "mean_reprojection_error_px"})}};
+  return {
+      {"scene", scene.string()},
+      {"metrics", pick(summary, {"keypoints_per_image", "inlier_ratio", "pairs_tried", "pairs_verified",
+                                 "tracks", "points", "mean_track_length", "mean_reprojection_error_px"})}};
 }
 
 }  // namespace

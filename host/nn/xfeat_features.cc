@@ -1,0 +1,103 @@
+#include "host/nn/xfeat_features.h"
+
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include "host/frontend/features.h"
+#include "host/frontend/preprocess.h"
+#include "host/nn/xfeat_model.h"
+#include "host/nn/xfeat_weights.h"
+#include "kernels/nn/xfeat.h"
+
+namespace litgs::host::nn {
+namespace {
+
+constexpr int kDescriptorFloats = 64;
+constexpr float kCellPx = 8;  // the network's cell: the keypoint's scale as the front end records it
+
+// The network on one context; the device's queue takes one detection at a time.
+struct XfeatDetector {
+  std::shared_ptr<engine::Context> context;
+  std::unique_ptr<kernels::XfeatNetwork> network;
+  frontend::FeatureOptions options;
+  std::mutex device;
+
+  frontend::ImageFeatures operator()(const frontend::Gray8& frame) {
+    frontend::ImageFeatures f;
+    f.float_descriptors = true;
+    f.descriptor_bytes = kDescriptorFloats * int(sizeof(float));
+    if (frame.pixels.empty()) return f;
+    const int width = frame.width / 32 * 32, height = frame.height / 32 * 32;
+    if (!width || !height)
+      throw std::invalid_argument("xfeat: a " + std::to_string(frame.width) + "x" +
+                                  std::to_string(frame.height) + " frame is smaller than 32x32");
+    const bool resized = width != frame.width || height != frame.height;
+    const std::vector<float> input =
+        xfeat_input(resized ? frontend::resize_gray8(frame, width, height) : frame);
+    kernels::nn::XfeatKeypointOptions k;
+    // Candidates beyond the budget, so that the grid bucketing has some to spread.
+    k.top_k = static_cast<uint32_t>(4 * options.max_keypoints);
+    kernels::XfeatDetections d;
+    {
+      const std::lock_guard<std::mutex> lock(device);
+      d = network->detect(input, uint32_t(height), uint32_t(width), k);
+    }
+    std::vector<float> x, y, score;
+    for (const auto& p : d.keypoints) {
+      x.push_back(p.x);
+      y.push_back(p.y);
+      score.push_back(p.score);
+    }
+    // Back to the frame's pixels, centres at integers on both sides of the half-pixel resize.
+    const float sx = float(frame.width) / float(width), sy = float(frame.height) / float(height);
+    for (size_t i : frontend::bucket_keypoints(x, y, score, width, height, options.max_keypoints,
+                                               options.grid_cols, options.grid_rows)) {
+      f.keypoints.push_back({(x[i] + 0.5f) * sx - 0.5f, (y[i] + 0.5f) * sy - 0.5f, kCellPx * sx, -1});
+      const size_t at = f.descriptors.size();
+      f.descriptors.resize(at + size_t(f.descriptor_bytes));
+      std::memcpy(f.descriptors.data() + at, d.descriptors.data() + i * kDescriptorFloats,
+                  size_t(f.descriptor_bytes));
+    }
+    return f;
+  }
+};
+
+}  // namespace
+
+std::vector<float> xfeat_input(const frontend::Gray8& image) {
+  double mean = 0, variance = 0;
+  for (uint8_t p : image.pixels) mean += p / 255.0;
+  mean /= double(std::max<size_t>(image.pixels.size(), 1));
+  for (uint8_t p : image.pixels) variance += (p / 255.0 - mean) * (p / 255.0 - mean);
+  variance /= double(std::max<size_t>(image.pixels.size(), 1));
+  const double scale = 1 / std::sqrt(variance + 1e-5);
+  std::vector<float> out;
+  out.reserve(image.pixels.size());
+  for (uint8_t p : image.pixels) out.push_back(static_cast<float>((p / 255.0 - mean) * scale));
+  return out;
+}
+
+frontend::LearnedDetector make_xfeat_detector(std::shared_ptr<engine::Context> context,
+                                              const kernels::nn::XfeatWeights& weights,
+                                              const frontend::FeatureOptions& options) {
+  options.check();
+  auto detector = std::make_shared<XfeatDetector>();
+  detector->network = std::make_unique<kernels::XfeatNetwork>(*context, weights);
+  detector->context = std::move(context);
+  detector->options = options;
+  return [detector](const frontend::Gray8& frame) { return (*detector)(frame); };
+}
+
+frontend::FrontendOptions with_learned_detector(frontend::FrontendOptions options,
+                                                const std::filesystem::path& model) {
+  if (options.features.type != frontend::FeatureType::kXfeat) return options;
+  const kernels::nn::XfeatWeights weights = xfeat_weights(xfeat_model(model));
+  options.learned_detector =
+      make_xfeat_detector(std::make_shared<engine::Context>(), weights, options.features);
+  return options;
+}
+
+}  // namespace litgs::host::nn
