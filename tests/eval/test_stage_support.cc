@@ -115,7 +115,7 @@ TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
   ASSERT_EQ(all.size(), 4u);
   ASSERT_EQ(all[0].variants.size(), 3u);  // input, refined, true poses
   EXPECT_EQ(all[1].variants.size(), 5u);  // lambda_geo 0 .. 0.8
-  EXPECT_EQ(all[2].variants.size(), 6u);  // 3 feature types x CLAHE
+  ASSERT_EQ(all[2].variants.size(), 8u);  // 4 feature types x CLAHE
   ASSERT_EQ(all[3].variants.size(), 6u);  // adc, mcmc x 3 budgets
   RunConfig c = base;
   all[0].variants[0].apply(c);
@@ -135,6 +135,11 @@ TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
   // The default tracks (auto) are the front end's: each feature type runs through eval. With oracle
   // tracks refine and train do not depend on the features, so the study stops after match.
   EXPECT_EQ(all[2].variants[0].until, "eval");
+  c = base;
+  all[2].variants[7].apply(c);  // XFeat on the device with CLAHE, its own matcher (auto: mnn)
+  EXPECT_EQ(c.match.features, "xfeat");
+  EXPECT_TRUE(c.match.clahe);
+  EXPECT_EQ(c.match.matcher, "auto");
   base.refine.tracks = "oracle";
   EXPECT_EQ(ablation_studies("features", base)[0].variants[0].until, "match");
   EXPECT_THROW(ablation_studies("colour", base), std::invalid_argument);
