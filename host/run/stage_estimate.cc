@@ -22,7 +22,12 @@ constexpr double kSynthSecondsPerMpx = 1.4;    // rendering frames, scans and th
 constexpr double kImportSecondsPerMpx = 0.05;  // reading and converting recorded frames
 constexpr double kEvalSecondsPerMpx = 0.05;    // rendering and scoring the held-out views
 constexpr double kMapSecondsPerScanMb = 0.026;
-constexpr double kMatchSecondsPerMpx = 0.8;        // on 2 threads
+constexpr double kMatchSecondsPerMpx = 0.8;  // on 2 threads
+// XFeat (match.features xfeat): its network on the device, and matching and tracks over its 3,000 keypoints
+// per frame with more conflicts (DUNR's 45 frames at 640x512: 56 s of features on lavapipe, 34 s of the
+// rest).
+constexpr double kXfeatCpuDeviceSecondsPerMpx = 3.8;
+constexpr double kXfeatMatchSecondsPerMpx = 2.3;
 constexpr double kRefineSecondsPerMpxLidar = 4.5;  // with the LiDAR point-to-plane term
 constexpr double kRefineSecondsPerMpxNoLidar = 0.4;
 // Training on a CPU device (lavapipe, 2 cores): per iteration (a + b per thousand Gaussians) at 320x256,
@@ -179,8 +184,13 @@ std::optional<StageEstimate> estimate_stage(const std::string& stage, InputKind 
     e = fixed(0, "refine.enabled is false");
   } else if (stage == "match") {
     const double threads = c.match.threads ? c.match.threads : cores;
-    e = fixed(1.0 + kMatchSecondsPerMpx * mpx * thread_factor(threads),
-              size_text(s) + " on " + std::to_string(static_cast<int>(threads)) + " threads");
+    if (c.match.features == "xfeat")
+      e = fixed(1.0 + ((d.cpu ? kXfeatCpuDeviceSecondsPerMpx : 0.0) + kXfeatMatchSecondsPerMpx) * mpx *
+                          thread_factor(threads),
+                size_text(s) + ", XFeat on " + (d.name.empty() ? std::string("the device") : d.name));
+    else
+      e = fixed(1.0 + kMatchSecondsPerMpx * mpx * thread_factor(threads),
+                size_text(s) + " on " + std::to_string(static_cast<int>(threads)) + " threads");
   } else if (stage == "refine") {
     const bool planes = s.lidar_map && c.refine.planes;
     e = fixed(1.0 + (planes ? kRefineSecondsPerMpxLidar : kRefineSecondsPerMpxNoLidar) * mpx,

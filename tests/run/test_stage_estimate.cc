@@ -54,6 +54,12 @@ TEST(StageEstimate, GrowsWithFramesPixelsIterationsAndBudget) {
   // device up.
   EXPECT_LT(seconds("train", small, c, {"NVIDIA H200", false, 16}), 0.2 * base);
   EXPECT_LT(seconds("train", small, c, {"llvmpipe", true, 16}), base);
+  // XFeat's network runs on the device: on a CPU device it costs more than SIFT, on a GPU less than there.
+  RunConfig xfeat = c;
+  xfeat.match.features = "xfeat";
+  EXPECT_GT(seconds("match", larger, xfeat, cpu_device()), 3 * seconds("match", larger, c, cpu_device()));
+  EXPECT_LT(seconds("match", larger, xfeat, {"NVIDIA H200", false, 2}),
+            seconds("match", larger, xfeat, cpu_device()));
 }
 
 TEST(StageEstimate, AGrownBudgetIsARangeAndStagesWithoutAModelSayWhy) {
