@@ -1,6 +1,7 @@
 #include "calib/board_in_image.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <limits>
 #include <opencv2/calib3d.hpp>
@@ -24,28 +25,40 @@ namespace {
 bool hole_centroid(const cv::Mat& values, const std::vector<cv::Point>& contour, Eigen::Vector2d& centre) {
   const double area = cv::contourArea(contour);
   const int margin = std::max(2, static_cast<int>(std::lround(0.25 * std::sqrt(area / M_PI))));
-  cv::Mat hole = cv::Mat::zeros(values.size(), CV_8U);
-  cv::drawContours(hole, std::vector<std::vector<cv::Point>>{contour}, 0, 255, cv::FILLED);
+  // Only the pixels around the hole: its bounding box grown past the window's reach (the margin's dilation),
+  // so that every pixel the masks can mark lies inside; sums run over the same pixels in the same order.
+  const cv::Rect box = cv::boundingRect(contour);
+  const int pad = margin + 3;
+  const cv::Rect roi = cv::Rect(box.x - pad, box.y - pad, box.width + 2 * pad, box.height + 2 * pad) &
+                       cv::Rect(0, 0, values.cols, values.rows);
+  cv::Mat hole = cv::Mat::zeros(roi.size(), CV_8U);
+  cv::drawContours(hole, std::vector<std::vector<cv::Point>>{contour}, 0, 255, cv::FILLED, cv::LINE_8,
+                   cv::noArray(), INT_MAX, cv::Point(-roi.x, -roi.y));
   cv::Mat inner, near, window;
   cv::erode(hole, inner, cv::Mat(), cv::Point(-1, -1), 2);
   cv::dilate(hole, near, cv::Mat(), cv::Point(-1, -1), 2);
   cv::dilate(hole, window,
              cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin + 1, 2 * margin + 1)));
+  // Calls f(x, y) for each window pixel, in image coordinates, row by row.
+  const auto for_window = [&](auto&& f) {
+    for (int r = 0; r < roi.height; ++r)
+      for (int c = 0; c < roi.width; ++c)
+        if (window.at<uint8_t>(r, c))
+          f(c + roi.x, r + roi.y, inner.at<uint8_t>(r, c) != 0, near.at<uint8_t>(r, c) != 0);
+  };
   std::vector<double> inside;
   Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
   Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
   size_t ring = 0;
-  for (int y = 0; y < values.rows; ++y)
-    for (int x = 0; x < values.cols; ++x) {
-      if (!window.at<uint8_t>(y, x)) continue;
-      if (inner.at<uint8_t>(y, x)) inside.push_back(values.at<double>(y, x));
-      if (!near.at<uint8_t>(y, x)) {
-        const Eigen::Vector3d a(1, x, y);
-        AtA += a * a.transpose();
-        Atb += a * values.at<double>(y, x);
-        ++ring;
-      }
+  for_window([&](int x, int y, bool in, bool by) {
+    if (in) inside.push_back(values.at<double>(y, x));
+    if (!by) {
+      const Eigen::Vector3d a(1, x, y);
+      AtA += a * a.transpose();
+      Atb += a * values.at<double>(y, x);
+      ++ring;
     }
+  });
   if (inside.empty() || ring < 12) return false;
   const Eigen::Vector3d board = AtA.ldlt().solve(Atb);
   const auto board_level = [&](int x, int y) { return board(0) + board(1) * x + board(2) * y; };
@@ -55,24 +68,21 @@ bool hole_centroid(const cv::Mat& values, const std::vector<cv::Point>& contour,
   // A dead band of two noise sigmas (the ring's spread about its plane), so that the board's own noise does
   // not weigh in and pull the centroid towards the window's centre.
   std::vector<double> spread;
-  for (int y = 0; y < values.rows; ++y)
-    for (int x = 0; x < values.cols; ++x)
-      if (window.at<uint8_t>(y, x) && !near.at<uint8_t>(y, x))
-        spread.push_back(std::abs(values.at<double>(y, x) - board_level(x, y)));
+  for_window([&](int x, int y, bool, bool by) {
+    if (!by) spread.push_back(std::abs(values.at<double>(y, x) - board_level(x, y)));
+  });
   // On a noisy frame the band stops at half the way to full weight, not to lose the hole.
   const double full = 0.5 * std::abs(contrast), floor = std::min(2 * 1.4826 * median(spread), 0.5 * full);
   if (!(full > 0)) return false;
   const double sign = contrast > 0 ? 1 : -1;
   double w = 0, sx = 0, sy = 0;
-  for (int y = 0; y < values.rows; ++y)
-    for (int x = 0; x < values.cols; ++x) {
-      if (!window.at<uint8_t>(y, x)) continue;
-      const double t = std::clamp(
-          (sign * (values.at<double>(y, x) - board_level(x, y)) - floor) / (full - floor), 0.0, 1.0);
-      w += t;
-      sx += t * x;
-      sy += t * y;
-    }
+  for_window([&](int x, int y, bool, bool) {
+    const double t =
+        std::clamp((sign * (values.at<double>(y, x) - board_level(x, y)) - floor) / (full - floor), 0.0, 1.0);
+    w += t;
+    sx += t * x;
+    sy += t * y;
+  });
   if (!(w > 0)) return false;
   centre = {sx / w, sy / w};
   return true;
