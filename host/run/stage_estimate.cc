@@ -85,6 +85,11 @@ std::optional<StageEstimate> estimate_train(const RunSize& s, const RunConfig::T
     why = "no Vulkan device answered `litgs-engine info`";
     return std::nullopt;
   }
+  if (t.blocks != "1") {
+    why =
+        "trained in blocks (train.blocks " + t.blocks + "): the blocks' views are known after the partition";
+    return std::nullopt;
+  }
   double low = 0, high = 0;
   if (t.max_gaussians == "grow") {
     low = train_defaults::kGrowthStart;

@@ -79,6 +79,10 @@ TEST(StageEstimate, AGrownBudgetIsARangeAndStagesWithoutAModelSayWhy) {
   c.train.max_gaussians = "40000";
   EXPECT_FALSE(estimate_stage("train", InputKind::kSynthetic, s, c, EstimateDevice{}, &why).has_value());
   EXPECT_NE(why.find("no Vulkan device"), std::string::npos) << why;
+  RunConfig blocks = c;  // one whole training's figure would mislead: the blocks' views overlap
+  blocks.train.blocks = "auto";
+  EXPECT_FALSE(estimate_stage("train", InputKind::kSynthetic, s, blocks, cpu_device(), &why).has_value());
+  EXPECT_NE(why.find("blocks"), std::string::npos) << why;
   EXPECT_FALSE(estimate_stage("no-such-stage", InputKind::kSynthetic, s, c, cpu_device(), &why).has_value());
   EXPECT_NE(why.find("no-such-stage"), std::string::npos) << why;
 
