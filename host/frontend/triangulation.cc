@@ -208,8 +208,7 @@ TriangulatedPoint triangulate(const std::vector<TriangulationView>& views, doubl
   // Fit over the agreeing views, refine, and take the views that agree with the refined point.
   Eigen::Vector3d X = estimate(views, best_views, o);
   if (!X.allFinite()) X = best_X;
-  if (o.method == TriangulationMethod::kLinear)
-    X = refine(views, best_views, X, fx, fy, o.gauss_newton_iterations);
+  X = refine(views, best_views, X, fx, fy, o.gauss_newton_iterations);
   double sum = 0;
   std::vector<size_t> agree = agreeing_views(views, X, fx, fy, o.max_error_px, sum);
   if (!X.allFinite() || agree.size() < o.min_views) {

@@ -37,7 +37,7 @@ struct TriangulationOptions {
   double min_angle_deg = 1.5;  // largest angle between the agreeing views' rays at the point
   double min_depth_m = 1e-3;   // in every agreeing view
   double max_depth_m = 1e4;
-  int gauss_newton_iterations = 5;  // kLinear only
+  int gauss_newton_iterations = 5;  // on the pixel error after the fit (the refinement's options: none)
   size_t max_pairs_tried = 40;      // candidate view pairs for the consensus
   void check() const;               // std::invalid_argument
 

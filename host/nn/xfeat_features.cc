@@ -53,13 +53,14 @@ struct XfeatDetector {
     }
     // Back to the frame's pixels, centres at integers on both sides of the half-pixel resize.
     const float sx = float(frame.width) / float(width), sy = float(frame.height) / float(height);
-    for (size_t i : frontend::bucket_keypoints(x, y, score, width, height, options.max_keypoints,
-                                               options.grid_cols, options.grid_rows)) {
+    const std::vector<size_t> kept = frontend::bucket_keypoints(
+        x, y, score, width, height, options.max_keypoints, options.grid_cols, options.grid_rows);
+    f.descriptors.resize(kept.size() * size_t(f.descriptor_bytes));
+    for (size_t n = 0; n < kept.size(); ++n) {
+      const size_t i = kept[n];
       f.keypoints.push_back({(x[i] + 0.5f) * sx - 0.5f, (y[i] + 0.5f) * sy - 0.5f, kCellPx * sx, -1});
-      const size_t at = f.descriptors.size();
-      f.descriptors.resize(at + size_t(f.descriptor_bytes));
-      std::memcpy(f.descriptors.data() + at, d.descriptors.data() + i * kDescriptorFloats,
-                  size_t(f.descriptor_bytes));
+      std::memcpy(f.descriptors.data() + n * size_t(f.descriptor_bytes),
+                  d.descriptors.data() + i * kDescriptorFloats, size_t(f.descriptor_bytes));
     }
     return f;
   }
