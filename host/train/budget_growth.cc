@@ -122,7 +122,7 @@ void BudgetGrowth::end_phase(uint32_t step, uint32_t gaussians, const std::vecto
   last_scored_ = views;
   last_training_ = training;
   last_scored_budget_ = budget_;
-  const uint64_t next = static_cast<uint64_t>(std::ceil(budget_ * options_.factor));
+  const uint64_t next = next_budget();
   if (!gained) {
     p.decision = "stop: " + why_not;
     if (options_.roll_back && previous_budget > 0 && previous_budget < budget_) {
@@ -151,6 +151,12 @@ void BudgetGrowth::end_phase(uint32_t step, uint32_t gaussians, const std::vecto
   }
   if (p.decision.rfind("stop", 0) == 0) stop_reason_ = p.decision;
   phases_.push_back(p);
+}
+
+uint64_t BudgetGrowth::next_budget() const {
+  double rung = options_.start;
+  while (rung <= budget_) rung = std::ceil(rung * options_.factor);
+  return static_cast<uint64_t>(rung);
 }
 
 double BudgetGrowth::extrapolated_gain(double last_gain) const {

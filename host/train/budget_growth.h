@@ -1,12 +1,12 @@
 // `train --max-gaussians grow` (MCMC): the Gaussian budget grown inside one training, instead of one training
 // per budget tried (`search`, host/train/budget_search.h). The model starts at a small budget; at the end of
 // each phase (BudgetGrowthOptions), once MCMC's growth has filled the budget, the validation views are
-// scored, and the budget rises by `factor` while the validation PSNR, paired view by view with the last
-// measurement, still gains more than min_gain_db (and, if asked, noise_multiple standard errors). Then it
-// stops (with roll_back, back at the last budget that paid: the caller shrinks the model to budget()), the
-// validation views rejoin the training views, and the remaining iterations train at that size. Decisions end
-// by until_fraction of the iterations. The state is a small JSON document that checkpoints carry, so a
-// training interrupted during growth resumes with the same budget, views and decisions.
+// scored, and the budget climbs the ladder start x factor^k while the validation PSNR, paired view by view
+// with the last measurement, still gains more than min_gain_db (and, if asked, noise_multiple standard
+// errors). Then it stops (with roll_back, back at the last budget that paid: the caller shrinks the model to
+// budget()), the validation views rejoin the training views, and the remaining iterations train at that size.
+// Decisions end by until_fraction of the iterations. The state is a small JSON document that checkpoints
+// carry, so a training interrupted during growth resumes with the same budget, views and decisions.
 #pragma once
 
 #include <cmath>
@@ -69,6 +69,10 @@ class BudgetGrowth {
   static BudgetGrowth from_json(const BudgetGrowthOptions& options, const nlohmann::json& j);
 
  private:
+  // The budget after the current one: the next rung of start x factor^k, where fixed budgets and the search
+  // are measured, so that an initialization between two rungs climbs to the next rung rather than doubling
+  // past it (docs/budget.md: doubling from the initialization overshot the facade's best fixed budget).
+  uint64_t next_budget() const;
   // The next doubling's gain from the last one (not yet in phases_) and the one before: last * (last /
   // before) when the gains fall, else half the last; NaN unless the last gained.
   double extrapolated_gain(double last_gain) const;

@@ -174,13 +174,34 @@ TEST(BudgetGrowth, WaitsUntilTheModelFillsItsBudgetButNotPastTheWindow) {
 
 TEST(BudgetGrowth, ABudgetAboveWhatTheDeviceHoldsIsNeverSet) {
   BudgetGrowthOptions o;
-  BudgetGrowth g(o, 300000, 699050, kViews.size());  // lavapipe's 128 MiB over 48 floats per Gaussian
-  g.end_phase(600, 300000, kViews, kViews, true, 1);
-  EXPECT_EQ(g.budget(), 600000u);
-  g.end_phase(900, 600000, shifted(kViews, 1), shifted(kViews, 1), true, 2);
+  BudgetGrowth g(o, 320000, 699050, kViews.size());  // lavapipe's 128 MiB over 48 floats per Gaussian
+  g.end_phase(600, 320000, kViews, kViews, true, 1);
+  EXPECT_EQ(g.budget(), 640000u);
+  g.end_phase(900, 640000, shifted(kViews, 1), shifted(kViews, 1), true, 2);
   EXPECT_FALSE(g.growing());
-  EXPECT_EQ(g.budget(), 600000u);
-  EXPECT_NE(g.stop_reason().find("above the ceiling of 699050"), std::string::npos) << g.stop_reason();
+  EXPECT_EQ(g.budget(), 640000u);
+  EXPECT_NE(g.stop_reason().find("the next budget, 1280000, is above the ceiling of 699050"),
+            std::string::npos)
+      << g.stop_reason();
+}
+
+// Budgets climb the ladder start x 2^k where the fixed budgets are measured: an initialization between two
+// rungs (the facade's 20,934 LiDAR points) goes to the next rung, not to twice its own size.
+TEST(BudgetGrowth, AnInitializationBetweenTwoRungsClimbsToTheNextRung) {
+  BudgetGrowthOptions o;
+  BudgetGrowth g(o, 20934, 4000000, kViews.size());
+  EXPECT_EQ(g.budget(), 20934u);
+  g.end_phase(600, 20934, kViews, kViews, true, 1);
+  EXPECT_EQ(g.budget(), 40000u);
+  g.end_phase(900, 40000, shifted(kViews, 1), kViews, true, 2);
+  EXPECT_EQ(g.budget(), 80000u);
+  g.end_phase(1200, 80000, shifted(kViews, 1.01), kViews, true, 3);  // no gain: back to the last rung
+  EXPECT_EQ(g.budget(), 40000u);
+  o.start = 5000;
+  o.factor = 3;
+  BudgetGrowth thirds(o, 20934, 4000000, kViews.size());
+  thirds.end_phase(600, 20934, kViews, kViews, true, 1);
+  EXPECT_EQ(thirds.budget(), 45000u);  // 5k, 15k, 45k
 }
 
 TEST(BudgetGrowth, OneValidationViewCannotJudgeAndTheBudgetStaysAtItsStart) {
