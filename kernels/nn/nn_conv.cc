@@ -47,9 +47,16 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
   p.stride = c.stride;
   p.pad = c.pad;
   p.activation = c.activation;
-  p.count = static_cast<uint32_t>(uint64_t{(c.out_channels + NN_CONV_OUTPUTS - 1) / NN_CONV_OUTPUTS} *
-                                  c.out_height() * c.out_width());
-  s.dispatch(*kernel_, elementwise_groups(*context_, p.count, who),
+  const uint64_t tiles =
+      uint64_t{c.out_height()} * ((c.out_width() + NN_CONV_RUN - 1) / NN_CONV_RUN) * NN_CONV_LANES;
+  const uint64_t groups_x = (tiles + NN_CONV_GROUP_SIZE - 1) / NN_CONV_GROUP_SIZE;
+  const uint32_t channel_blocks = (c.out_channels + NN_CONV_OUTPUTS - 1) / NN_CONV_OUTPUTS;
+  const uint32_t* limit = context_->info().max_compute_workgroup_count;
+  if (groups_x > limit[0] || channel_blocks > limit[1])
+    throw std::length_error(std::string(who) + ": " + std::to_string(groups_x) + " x " +
+                            std::to_string(channel_blocks) + " workgroups exceed the device's grid");
+  p.count = static_cast<uint32_t>(tiles);
+  s.dispatch(*kernel_, engine::Groups{static_cast<uint32_t>(groups_x), channel_blocks, 1},
              {{NN_CONV_BINDING_IN, &in, engine::Access::kRead},
               {NN_CONV_BINDING_WEIGHT, &weight, engine::Access::kRead},
               {NN_CONV_BINDING_BIAS, &bias, engine::Access::kRead},

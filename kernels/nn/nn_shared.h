@@ -9,9 +9,14 @@ namespace litgs::kernels {
 using uint = uint32_t;
 #endif
 
-// ---- nn_conv2d.comp: one invocation per NN_CONV_OUTPUTS output channels at one pixel (each input value
-// loaded once for all of them) ----
+// ---- nn_conv2d.comp: one invocation per NN_CONV_OUTPUTS output channels at NN_CONV_PIXELS neighbouring
+// pixels of a row (a register tile: each weight loaded once for the pixels, each input value for the
+// channels) ----
 #define NN_CONV_OUTPUTS 8
+#define NN_CONV_PIXELS 4
+#define NN_CONV_LANES 8  // invocations that interleave their pixels over one run of a row
+#define NN_CONV_RUN (NN_CONV_LANES * NN_CONV_PIXELS)
+#define NN_CONV_GROUP_SIZE 64     // tiles of one channel block per workgroup; the grid's y is the block
 #define NN_CONV_BINDING_IN 0      // [C_in][H_in][W_in]
 #define NN_CONV_BINDING_WEIGHT 1  // [C_out][C_in][k][k]
 #define NN_CONV_BINDING_BIAS 2    // [C_out]
@@ -27,7 +32,7 @@ struct NnConvParams {
   uint out_channels, out_height, out_width;
   uint kernel, stride, pad;
   uint activation;  // NN_ACTIVATION_* on the output
-  uint count;       // out_channels * out_height * out_width
+  uint count;       // invocations per channel block: out_height * runs per row * NN_CONV_LANES
 };
 
 // ---- nn_map.comp: one invocation per output element; p.op chooses what it computes ----
