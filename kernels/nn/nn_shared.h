@@ -74,6 +74,65 @@ struct NnKeypointsParams {
   float threshold;
 };
 
+// ---- The attention matcher (LighterGlue; kernels/nn/attention_reference.h): matrices are row-major, one
+// row per keypoint ----
+
+// nn_linear.comp: y = [a | b] w + bias (+ r): one invocation per row and NN_LINEAR_OUTPUTS outputs.
+#define NN_LINEAR_OUTPUTS 8
+#define NN_LINEAR_BINDING_A 0     // [rows][a_cols]
+#define NN_LINEAR_BINDING_B 1     // [rows][b_cols], concatenated after a's columns (bound to a without)
+#define NN_LINEAR_BINDING_W 2     // [a_cols + b_cols][out]
+#define NN_LINEAR_BINDING_BIAS 3  // [out] (bound to w without)
+#define NN_LINEAR_BINDING_R 4     // [rows][out], added (bound to a without)
+#define NN_LINEAR_BINDING_Y 5     // [rows][out] (out)
+#define NN_LINEAR_BINDING_COUNT 6
+
+struct NnLinearParams {
+  uint rows, a_cols, b_cols, outputs;
+  uint has_bias, has_residual;
+  uint count;  // rows * ceil(out / NN_LINEAR_OUTPUTS)
+};
+
+// nn_matmul.comp: y = scale a b^T (a [n][k], b [m][k]; NN_MATMUL_TRANSPOSED) or y = a b (a [n][k], b [k][m]):
+// one invocation per row of y and NN_MATMUL_OUTPUTS of its columns.
+#define NN_MATMUL_OUTPUTS 4
+#define NN_MATMUL_BINDING_A 0
+#define NN_MATMUL_BINDING_B 1
+#define NN_MATMUL_BINDING_Y 2
+#define NN_MATMUL_BINDING_COUNT 3
+
+struct NnMatmulParams {
+  uint n, m, k;
+  uint transposed;  // 1: a b^T
+  float scale;
+  uint count;                         // n * ceil(m / NN_MATMUL_OUTPUTS)
+  uint a_offset, b_offset, y_offset;  // in floats: both images' rows share one buffer
+};
+
+// nn_rows.comp: one invocation per row (or column, or element) of a; p.op chooses what it computes.
+#define NN_ROWS_LAYER_NORM_GELU 0  // a[r] = gelu(layer_norm(a[r]) * b + c) in place (b: scale, c: bias)
+#define NN_ROWS_SOFTMAX 1          // a[r] = softmax(a[r]) in place
+#define NN_ROWS_LOG_SUM_EXP 2      // out[r] = log sum exp a[r]
+#define NN_COLUMNS_LOG_SUM_EXP 3   // out[c] = log sum exp of a's column c
+// out[i][j] = (a[i][j] - b[i]) + (a[i][j] - b[rows + j]) + log sigmoid c[i] + log sigmoid c[rows + j] (b: the
+// row and column log-sum-exps, c: the two images' matchability logits)
+#define NN_ROWS_ASSIGNMENT 4
+// From a [rows][3 dim] (q, k, v interleaved per channel) and the keypoints b [rows][2] with the rotary
+// weights c [2][dim / 2]: out [3][rows][dim] = q and k rotated, v. One invocation per row and channel pair.
+#define NN_ROWS_SPLIT_ROTARY 5
+#define NN_ROWS_BINDING_A 0
+#define NN_ROWS_BINDING_B 1
+#define NN_ROWS_BINDING_C 2
+#define NN_ROWS_BINDING_OUT 3
+#define NN_ROWS_BINDING_COUNT 4
+
+struct NnRowsParams {
+  uint op;
+  uint rows, cols;
+  uint count;     // invocations
+  float epsilon;  // the layer norm's
+};
+
 #ifdef __cplusplus
 }  // namespace litgs::kernels
 #endif

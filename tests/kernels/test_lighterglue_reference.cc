@@ -15,6 +15,7 @@
 #include "host/nn/lighterglue_weights.h"
 #include "io/error.h"
 #include "kernels/nn/lighterglue_reference.h"
+#include "tests/support/lighterglue_inputs.h"
 
 namespace litgs::kernels::nn {
 namespace {
@@ -22,38 +23,7 @@ namespace {
 const std::string kModel = std::string(LITGS_NN_MODELS) + "/lighterglue/lighterglue_L3.onnx";
 const std::string kReference = std::string(LITGS_TEST_DATA_DIR) + "/lighterglue/reference.json";
 
-// make_reference.js's inputs.
-constexpr int kN0 = 40, kN1 = 48, kDim = 64;
-double keypoint0(int i, int c) {
-  const double t = 0.37 * i, r = 0.9 * (0.2 + 0.8 * double((i * 7) % kN0) / kN0);
-  return c == 0 ? r * std::cos(t) : r * std::sin(t) * 0.8;
-}
-int source(int j) {
-  return (j * 13) % kN0;
-}
-double keypoint1(int j, int c) {
-  if (j < kN0) return keypoint0(source(j), c) + (c == 0 ? 0.05 : -0.03);
-  return c == 0 ? -0.8 + 0.2 * (j - kN0) : 0.7 - 0.15 * (j - kN0);
-}
-double descriptor0(int i, int d) {
-  return std::sin(1.3 * i + 0.71 * d + 0.05 * i * d) + 0.3 * std::cos(2.1 * d - i);
-}
-double descriptor1(int j, int d) {
-  if (j < kN0) return descriptor0(source(j), d) + 0.25 * std::sin(5.1 * j + 1.7 * d);
-  return std::cos(0.9 * j + 1.9 * d) + 0.2 * std::sin(d * j);
-}
-// As the script feeds them: float32 values.
-template <class F>
-Matrix rows(int n, int cols, F f, bool normalize) {
-  Matrix m(n, cols);
-  for (int i = 0; i < n; ++i) {
-    double norm = 0;
-    for (int c = 0; c < cols; ++c) norm += f(i, c) * f(i, c);
-    norm = normalize ? std::sqrt(norm) : 1.0;
-    for (int c = 0; c < cols; ++c) m.at(i, c) = double(float(f(i, c) / norm));
-  }
-  return m;
-}
+using namespace testing::lighterglue_inputs;
 
 LighterGlueWeights load() {
   return host::nn::lighterglue_weights(io::read_onnx_model(kModel));
@@ -132,8 +102,7 @@ TEST(LighterGlueReference, MatchesOnnxRuntime) {
   ASSERT_TRUE(file) << kReference;
   const nlohmann::json ref = nlohmann::json::parse(file);
   const LighterGlueOutputs out =
-      lighterglue(load(), rows(kN0, 2, keypoint0, false), rows(kN0, kDim, descriptor0, true),
-                  rows(kN1, 2, keypoint1, false), rows(kN1, kDim, descriptor1, true));
+      lighterglue(load(), keypoints0(), descriptors0(), keypoints1(), descriptors1());
   const std::vector<double> scores = ref["scores"]["values"].get<std::vector<double>>();
   ASSERT_EQ(scores.size(), out.scores.values.size());
   double worst = 0;
@@ -152,8 +121,8 @@ TEST(LighterGlueReference, MatchesOnnxRuntime) {
 
 TEST(LighterGlueReference, AnImageWithoutKeypointsGivesNoMatches) {
   const LighterGlueWeights w = load();
-  const LighterGlueOutputs out = lighterglue(w, Matrix(0, 2), Matrix(0, kDim), rows(kN1, 2, keypoint1, false),
-                                             rows(kN1, kDim, descriptor1, true));
+  const LighterGlueOutputs out =
+      lighterglue(w, Matrix(0, 2), Matrix(0, kDescriptor), keypoints1(), descriptors1());
   EXPECT_TRUE(out.matches.empty());
   EXPECT_THROW(lighterglue(w, Matrix(3, 2), Matrix(3, 32), Matrix(3, 2), Matrix(3, 32)),
                std::invalid_argument);

@@ -1,0 +1,155 @@
+#include "kernels/nn/attention.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "kernels/elementwise.h"
+#include "kernels/loss/loss_sum.h"
+#include "kernels/nn/nn_shared.h"
+#include "kernels/subgroup_kernel.h"
+
+namespace litgs::kernels {
+
+using loss_detail::check_binding;
+
+AttentionKernels::AttentionKernels(engine::Context& context)
+    : context_(&context),
+      linear_(make_kernel(context, "nn/nn_linear", NN_LINEAR_BINDING_COUNT, sizeof(NnLinearParams))),
+      matmul_(make_kernel(context, "nn/nn_matmul", NN_MATMUL_BINDING_COUNT, sizeof(NnMatmulParams))),
+      rows_(make_kernel(context, "nn/nn_rows", NN_ROWS_BINDING_COUNT, sizeof(NnRowsParams))) {}
+
+AttentionKernels::~AttentionKernels() = default;
+
+void AttentionKernels::linear(engine::Sequence& s, const engine::Buffer& a, uint32_t a_cols,
+                              const engine::Buffer* b, uint32_t b_cols, const engine::Buffer& w,
+                              const engine::Buffer* bias, const engine::Buffer* residual,
+                              const engine::Buffer& y, uint32_t rows, uint32_t out) const {
+  static const char* who = "AttentionKernels::linear";
+  if (!rows || !out || !a_cols || (b == nullptr) != (b_cols == 0))
+    throw std::invalid_argument(std::string(who) + ": empty rows, outputs or input, or b without its width");
+  const uint64_t in = uint64_t{a_cols} + b_cols;
+  check_binding(who, "a", a, uint64_t{rows} * a_cols * sizeof(float));
+  if (b) check_binding(who, "b", *b, uint64_t{rows} * b_cols * sizeof(float));
+  check_binding(who, "w", w, in * out * sizeof(float));
+  if (bias) check_binding(who, "bias", *bias, uint64_t{out} * sizeof(float));
+  if (residual) check_binding(who, "residual", *residual, uint64_t{rows} * out * sizeof(float));
+  check_binding(who, "y", y, uint64_t{rows} * out * sizeof(float));
+  NnLinearParams p{};
+  p.rows = rows;
+  p.a_cols = a_cols;
+  p.b_cols = b_cols;
+  p.outputs = out;
+  p.has_bias = bias != nullptr;
+  p.has_residual = residual != nullptr;
+  const uint64_t count = uint64_t{rows} * ((out + NN_LINEAR_OUTPUTS - 1) / NN_LINEAR_OUTPUTS);
+  p.count = static_cast<uint32_t>(count);
+  s.dispatch(*linear_, elementwise_groups(*context_, count, who),
+             {{NN_LINEAR_BINDING_A, &a, engine::Access::kRead},
+              {NN_LINEAR_BINDING_B, b ? b : &a, engine::Access::kRead},
+              {NN_LINEAR_BINDING_W, &w, engine::Access::kRead},
+              {NN_LINEAR_BINDING_BIAS, bias ? bias : &w, engine::Access::kRead},
+              {NN_LINEAR_BINDING_R, residual ? residual : &a, engine::Access::kRead},
+              {NN_LINEAR_BINDING_Y, &y, engine::Access::kWrite}},
+             p);
+}
+
+void AttentionKernels::matmul(engine::Sequence& s, const RowBlock& a, const RowBlock& b,
+                              const engine::Buffer& y, uint32_t y_first, bool transposed, float scale) const {
+  static const char* who = "AttentionKernels: matrix product";
+  if (!a.buffer || !b.buffer || !a.rows || !b.rows || !a.cols || !b.cols)
+    throw std::invalid_argument(std::string(who) + ": an empty operand");
+  if (transposed ? a.cols != b.cols : a.cols != b.rows)
+    throw std::invalid_argument(std::string(who) + ": inner sizes differ (" + std::to_string(a.cols) +
+                                " and " + std::to_string(transposed ? b.cols : b.rows) + ")");
+  const uint32_t m = transposed ? b.rows : b.cols;
+  check_binding(who, "a", *a.buffer, (uint64_t{a.first} + a.rows) * a.cols * sizeof(float));
+  check_binding(who, "b", *b.buffer, (uint64_t{b.first} + b.rows) * b.cols * sizeof(float));
+  check_binding(who, "y", y, (uint64_t{y_first} + a.rows) * m * sizeof(float));
+  NnMatmulParams p{};
+  p.n = a.rows;
+  p.m = m;
+  p.k = a.cols;
+  p.transposed = transposed;
+  p.scale = scale;
+  const uint64_t count = uint64_t{a.rows} * ((m + NN_MATMUL_OUTPUTS - 1) / NN_MATMUL_OUTPUTS);
+  p.count = static_cast<uint32_t>(count);
+  p.a_offset = a.first * a.cols;
+  p.b_offset = b.first * b.cols;
+  p.y_offset = y_first * m;
+  s.dispatch(*matmul_, elementwise_groups(*context_, count, who),
+             {{NN_MATMUL_BINDING_A, a.buffer, engine::Access::kRead},
+              {NN_MATMUL_BINDING_B, b.buffer, engine::Access::kRead},
+              {NN_MATMUL_BINDING_Y, &y, engine::Access::kWrite}},
+             p);
+}
+
+void AttentionKernels::multiply_transposed(engine::Sequence& s, const RowBlock& a, const RowBlock& b,
+                                           const engine::Buffer& y, float scale) const {
+  matmul(s, a, b, y, 0, true, scale);
+}
+
+void AttentionKernels::multiply(engine::Sequence& s, const RowBlock& a, const RowBlock& b,
+                                const engine::Buffer& y, uint32_t y_first) const {
+  matmul(s, a, b, y, y_first, false, 1.0f);
+}
+
+void AttentionKernels::rows_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a,
+                               const engine::Buffer& b, const engine::Buffer& c, const engine::Buffer& out,
+                               uint32_t rows, uint32_t cols, uint64_t count, float epsilon) const {
+  if (!rows || !cols) throw std::invalid_argument("AttentionKernels: an empty matrix");
+  NnRowsParams p{};
+  p.op = op;
+  p.rows = rows;
+  p.cols = cols;
+  p.count = static_cast<uint32_t>(count);
+  p.epsilon = epsilon;
+  s.dispatch(*rows_, elementwise_groups(*context_, count, "AttentionKernels"),
+             {{NN_ROWS_BINDING_A, &a, engine::Access::kReadWrite},
+              {NN_ROWS_BINDING_B, &b, engine::Access::kRead},
+              {NN_ROWS_BINDING_C, &c, engine::Access::kRead},
+              {NN_ROWS_BINDING_OUT, &out, engine::Access::kWrite}},
+             p);
+}
+
+void AttentionKernels::layer_norm_gelu(engine::Sequence& s, const engine::Buffer& a,
+                                       const engine::Buffer& scale, const engine::Buffer& bias, uint32_t rows,
+                                       uint32_t cols, float epsilon) const {
+  static const char* who = "AttentionKernels::layer_norm_gelu";
+  check_binding(who, "a", a, uint64_t{rows} * cols * sizeof(float));
+  check_binding(who, "scale", scale, uint64_t{cols} * sizeof(float));
+  check_binding(who, "bias", bias, uint64_t{cols} * sizeof(float));
+  rows_op(s, NN_ROWS_LAYER_NORM_GELU, a, scale, bias, a, rows, cols, rows, epsilon);
+}
+
+void AttentionKernels::softmax_rows(engine::Sequence& s, const engine::Buffer& a, uint32_t rows,
+                                    uint32_t cols) const {
+  check_binding("AttentionKernels::softmax_rows", "a", a, uint64_t{rows} * cols * sizeof(float));
+  rows_op(s, NN_ROWS_SOFTMAX, a, a, a, a, rows, cols, rows, 0.0f);
+}
+
+void AttentionKernels::assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
+                                  const engine::Buffer& lse, const engine::Buffer& out, uint32_t rows,
+                                  uint32_t cols) const {
+  static const char* who = "AttentionKernels::assignment";
+  check_binding(who, "sim", sim, uint64_t{rows} * cols * sizeof(float));
+  check_binding(who, "z", z, (uint64_t{rows} + cols) * sizeof(float));
+  check_binding(who, "lse", lse, (uint64_t{rows} + cols) * sizeof(float));
+  check_binding(who, "out", out, uint64_t{rows} * cols * sizeof(float));
+  rows_op(s, NN_ROWS_LOG_SUM_EXP, sim, sim, sim, lse, rows, cols, rows, 0.0f);
+  rows_op(s, NN_COLUMNS_LOG_SUM_EXP, sim, sim, sim, lse, rows, cols, cols, 0.0f);
+  rows_op(s, NN_ROWS_ASSIGNMENT, sim, lse, z, out, rows, cols, uint64_t{rows} * cols, 0.0f);
+}
+
+void AttentionKernels::split_rotary(engine::Sequence& s, const engine::Buffer& qkv,
+                                    const engine::Buffer& keypoints, const engine::Buffer& rotary,
+                                    const engine::Buffer& out, uint32_t rows, uint32_t dim) const {
+  static const char* who = "AttentionKernels::split_rotary";
+  if (dim % 2) throw std::invalid_argument(std::string(who) + ": an odd width");
+  check_binding(who, "qkv", qkv, uint64_t{rows} * 3 * dim * sizeof(float));
+  check_binding(who, "keypoints", keypoints, uint64_t{rows} * 2 * sizeof(float));
+  check_binding(who, "rotary", rotary, uint64_t{dim} * sizeof(float));
+  check_binding(who, "out", out, uint64_t{rows} * 3 * dim * sizeof(float));
+  rows_op(s, NN_ROWS_SPLIT_ROTARY, qkv, keypoints, rotary, out, rows, dim, uint64_t{rows} * (dim / 2), 0.0f);
+}
+
+}  // namespace litgs::kernels

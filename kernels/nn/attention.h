@@ -1,0 +1,61 @@
+// The attention matcher's operations on the device (nn_linear.comp, nn_matmul.comp, nn_rows.comp), each
+// tested against its CPU double reference in kernels/nn/attention_reference.h. Matrices are row-major float
+// arrays, one row per keypoint; both images' rows may share a buffer (the matrix products take offsets).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "engine/buffer.h"
+#include "engine/context.h"
+#include "engine/kernel.h"
+#include "engine/sequence.h"
+
+namespace litgs::kernels {
+
+// A block of rows inside a buffer: `rows` rows of `cols` floats from row `first`.
+struct RowBlock {
+  const engine::Buffer* buffer = nullptr;
+  uint32_t first = 0, rows = 0, cols = 0;
+};
+
+class AttentionKernels {
+ public:
+  explicit AttentionKernels(engine::Context& context);
+  ~AttentionKernels();
+  // y [rows][out] = [a | b] w + bias (+ residual); b, bias and residual may be null (b's columns then 0).
+  void linear(engine::Sequence& s, const engine::Buffer& a, uint32_t a_cols, const engine::Buffer* b,
+              uint32_t b_cols, const engine::Buffer& w, const engine::Buffer* bias,
+              const engine::Buffer* residual, const engine::Buffer& y, uint32_t rows, uint32_t out) const;
+  // y (its rows from y_first) = scale a b^T: [a.rows][b.rows], a and b of one width.
+  void multiply_transposed(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
+                           float scale) const;
+  // y (its rows from y_first, b.cols wide) = a b: a [a.rows][b.rows].
+  void multiply(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
+                uint32_t y_first) const;
+  // a [rows][cols] = gelu(layer_norm(a) * scale + bias), in place.
+  void layer_norm_gelu(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& scale,
+                       const engine::Buffer& bias, uint32_t rows, uint32_t cols, float epsilon) const;
+  // a [rows][cols] = its rows' softmax, in place.
+  void softmax_rows(engine::Sequence& s, const engine::Buffer& a, uint32_t rows, uint32_t cols) const;
+  // out [rows][cols]: the log assignment of sim [rows][cols] (its rows' and columns' log-sum-exps go to
+  // lse [rows + cols]) with the matchability logits z [rows + cols] (the first image's, then the second's).
+  void assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
+                  const engine::Buffer& lse, const engine::Buffer& out, uint32_t rows, uint32_t cols) const;
+  // out [3][rows][dim]: q and k rotated by the keypoints' frequencies, and v, from qkv [rows][3 dim]
+  // (interleaved per channel), keypoints [rows][2] and the rotary weights [2][dim / 2].
+  void split_rotary(engine::Sequence& s, const engine::Buffer& qkv, const engine::Buffer& keypoints,
+                    const engine::Buffer& rotary, const engine::Buffer& out, uint32_t rows,
+                    uint32_t dim) const;
+
+ private:
+  void rows_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a, const engine::Buffer& b,
+               const engine::Buffer& c, const engine::Buffer& out, uint32_t rows, uint32_t cols,
+               uint64_t count, float epsilon) const;
+  void matmul(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
+              uint32_t y_first, bool transposed, float scale) const;
+  engine::Context* context_;
+  std::unique_ptr<engine::Kernel> linear_, matmul_, rows_;
+};
+
+}  // namespace litgs::kernels

@@ -1,0 +1,37 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
+// y = [a | b] w + bias (+ r), as kernels/nn/attention_reference.cc's linear (concat_columns, add): an
+// invocation computes NN_LINEAR_OUTPUTS neighbouring outputs of one row, each input value loaded once for
+// all of them; each output summed over the inputs in order.
+#include "limits.h"
+#include "nn/nn_shared.h"
+#include "elementwise.glsl"
+
+layout(std430, binding = NN_LINEAR_BINDING_A) readonly buffer A { float a[]; };
+layout(std430, binding = NN_LINEAR_BINDING_B) readonly buffer B { float b[]; };
+layout(std430, binding = NN_LINEAR_BINDING_W) readonly buffer W { float w[]; };
+layout(std430, binding = NN_LINEAR_BINDING_BIAS) readonly buffer Bias { float bias[]; };
+layout(std430, binding = NN_LINEAR_BINDING_R) readonly buffer R { float r[]; };
+layout(std430, binding = NN_LINEAR_BINDING_Y) writeonly buffer Y { float y[]; };
+layout(push_constant) uniform Push { NnLinearParams p; };
+
+void main() {
+  const uint e = elementwise_index();
+  if (e >= p.count) return;
+  const uint blocks = (p.outputs + NN_LINEAR_OUTPUTS - 1u) / NN_LINEAR_OUTPUTS;
+  const uint row = e / blocks, o0 = (e % blocks) * NN_LINEAR_OUTPUTS;
+  float sum[NN_LINEAR_OUTPUTS];
+  [[unroll]] for (uint j = 0u; j < NN_LINEAR_OUTPUTS; ++j)
+    sum[j] = p.has_bias != 0u ? bias[min(o0 + j, p.outputs - 1u)] : 0.0;
+  for (uint i = 0u; i < p.a_cols + p.b_cols; ++i) {
+    const float v = i < p.a_cols ? a[row * p.a_cols + i] : b[row * p.b_cols + i - p.a_cols];
+    // A block past the last output reads the last one's weights again and never writes them.
+    [[unroll]] for (uint j = 0u; j < NN_LINEAR_OUTPUTS; ++j) sum[j] += v * w[i * p.outputs + min(o0 + j, p.outputs - 1u)];
+  }
+  for (uint j = 0u; j < NN_LINEAR_OUTPUTS; ++j) {
+    const uint o = o0 + j;
+    if (o >= p.outputs) break;
+    y[row * p.outputs + o] = p.has_residual != 0u ? sum[j] + r[row * p.outputs + o] : sum[j];
+  }
+}

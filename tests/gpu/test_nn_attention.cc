@@ -1,0 +1,223 @@
+// The attention matcher on the device (kernels/nn/attention.h, lighterglue.h) against its double-precision
+// CPU references (kernels/nn/attention_reference.h, lighterglue_reference.h), validation layer on: each
+// operation on random inputs (linear with a concatenated input, bias and residual; the matrix products at
+// row offsets; layer norm with GELU; softmax; the log assignment; q, k, v split with the rotary encoding),
+// then the whole matcher on the inputs of tests/data/lighterglue/ (the same matches; scores within the
+// float32 spread measured against onnxruntime there), bit-identical twice, and the hard cases: an image
+// without keypoints, wrong sizes. Tolerances (float against double): each operation within 1e-5 of its
+// largest output (GELU's erf approximation: 1.5e-7).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "engine/buffer.h"
+#include "engine/sequence.h"
+#include "gpu_test.h"
+#include "host/nn/lighterglue_weights.h"
+#include "io/onnx_model.h"
+#include "kernels/nn/attention.h"
+#include "kernels/nn/lighterglue.h"
+#include "kernels/nn/lighterglue_reference.h"
+#include "tests/support/lighterglue_inputs.h"
+
+namespace litgs {
+namespace {
+
+using engine::DeviceArray;
+using kernels::RowBlock;
+using kernels::nn::Matrix;
+
+Matrix random_matrix(size_t rows, size_t cols, uint32_t seed, double spread = 1.0) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> n(0.0f, static_cast<float>(spread));
+  Matrix m(rows, cols);
+  for (double& v : m.values) v = n(rng);  // float values, as the device holds them
+  return m;
+}
+
+std::vector<float> floats(const Matrix& m) {
+  return std::vector<float>(m.values.begin(), m.values.end());
+}
+std::vector<float> floats(const std::vector<double>& v) {
+  return std::vector<float>(v.begin(), v.end());
+}
+
+// The largest difference over the largest reference magnitude.
+double relative_error(const std::vector<float>& device, const std::vector<double>& reference) {
+  EXPECT_EQ(device.size(), reference.size());
+  double worst = 0, largest = 1e-30;
+  for (size_t i = 0; i < device.size() && i < reference.size(); ++i) {
+    worst = std::max(worst, std::abs(double(device[i]) - reference[i]));
+    largest = std::max(largest, std::abs(reference[i]));
+  }
+  return worst / largest;
+}
+
+kernels::nn::LighterGlueWeights weights() {
+  return host::nn::lighterglue_weights(
+      io::read_onnx_model(std::string(LITGS_NN_MODELS) + "/lighterglue/lighterglue_L3.onnx"));
+}
+
+class NnAttentionTest : public testing::GpuTest {
+ protected:
+  std::unique_ptr<DeviceArray<float>> upload(const std::vector<float>& v, const char* name = "test: array") {
+    auto a = std::make_unique<DeviceArray<float>>(context(), name, v.size());
+    a->upload(v);
+    return a;
+  }
+};
+
+TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
+  kernels::AttentionKernels ops(context());
+  // Linear over [a | b] with a bias and a residual; 13 outputs: a partial block of NN_LINEAR_OUTPUTS.
+  const Matrix a = random_matrix(7, 5, 1), b = random_matrix(7, 3, 2), r = random_matrix(7, 13, 3);
+  kernels::nn::LinearWeights w{8, 13, floats(random_matrix(8, 13, 4).values),
+                               floats(random_matrix(1, 13, 5).values)};
+  const Matrix expected = kernels::nn::add(kernels::nn::linear(kernels::nn::concat_columns(a, b), w), r);
+  auto da = upload(floats(a)), db = upload(floats(b)), dr = upload(floats(r)), dw = upload(w.weight),
+       dbias = upload(w.bias);
+  DeviceArray<float> y(context(), "test: y", 7 * 13);
+  {
+    engine::Sequence s(context());
+    ops.linear(s, da->buffer(), 5, &db->buffer(), 3, dw->buffer(), &dbias->buffer(), &dr->buffer(),
+               y.buffer(), 7, 13);
+    s.submit_and_wait();
+  }
+  EXPECT_LT(relative_error(y.download(), expected.values), 1e-5);
+
+  // Products at row offsets: rows 2..6 of p against rows 1..4 of q (transposed), then against q's rows as b.
+  const Matrix p = random_matrix(9, 6, 6), q = random_matrix(8, 6, 7), v = random_matrix(8, 5, 8);
+  Matrix p_rows(5, 6), q_rows(4, 6), v_rows(4, 5);
+  for (size_t i = 0; i < 5; ++i)
+    for (size_t k = 0; k < 6; ++k) p_rows.at(i, k) = p.at(2 + i, k);
+  for (size_t i = 0; i < 4; ++i) {
+    for (size_t k = 0; k < 6; ++k) q_rows.at(i, k) = q.at(1 + i, k);
+    for (size_t k = 0; k < 5; ++k) v_rows.at(i, k) = v.at(3 + i, k);
+  }
+  const Matrix sim = kernels::nn::multiply_transposed(p_rows, q_rows, 0.3);
+  const Matrix product = kernels::nn::multiply(sim, v_rows);
+  auto dp = upload(floats(p)), dq = upload(floats(q)), dv = upload(floats(v));
+  DeviceArray<float> dsim(context(), "test: sim", 5 * 4), dproduct(context(), "test: product", 7 * 5);
+  {
+    engine::Sequence s(context());
+    ops.multiply_transposed(s, RowBlock{&dp->buffer(), 2, 5, 6}, RowBlock{&dq->buffer(), 1, 4, 6},
+                            dsim.buffer(), 0.3f);
+    ops.multiply(s, RowBlock{&dsim.buffer(), 0, 5, 4}, RowBlock{&dv->buffer(), 3, 4, 5}, dproduct.buffer(),
+                 2);
+    s.submit_and_wait();
+  }
+  EXPECT_LT(relative_error(dsim.download(), sim.values), 1e-5);
+  const std::vector<float> product_rows = dproduct.download(2 * 5, 5 * 5);  // written from row 2
+  EXPECT_LT(relative_error(product_rows, product.values), 1e-5);
+
+  // Layer norm then GELU, and softmax, in place.
+  Matrix h = random_matrix(6, 192, 9, 3.0);
+  const kernels::nn::LayerNormWeights norm{floats(random_matrix(1, 192, 10).values),
+                                           floats(random_matrix(1, 192, 11).values), 1e-5};
+  auto dh = upload(floats(h)), dscale = upload(norm.scale), dshift = upload(norm.bias);
+  Matrix soft = random_matrix(5, 37, 12, 20.0);  // spread 20: the largest must be subtracted
+  auto dsoft = upload(floats(soft));
+  {
+    engine::Sequence s(context());
+    ops.layer_norm_gelu(s, dh->buffer(), dscale->buffer(), dshift->buffer(), 6, 192, 1e-5f);
+    ops.softmax_rows(s, dsoft->buffer(), 5, 37);
+    s.submit_and_wait();
+  }
+  kernels::nn::layer_norm(h, norm);
+  kernels::nn::gelu(h);
+  kernels::nn::softmax_rows(soft);
+  EXPECT_LT(relative_error(dh->download(), h.values), 1e-5);
+  EXPECT_LT(relative_error(dsoft->download(), soft.values), 1e-5);
+
+  // The log assignment of a 6 x 9 similarity with matchability logits.
+  const Matrix s69 = random_matrix(6, 9, 13, 5.0), z = random_matrix(15, 1, 14, 2.0);
+  const Matrix rows = kernels::nn::log_softmax_rows(s69), cols = kernels::nn::log_softmax_columns(s69);
+  const auto log_sigmoid = [](double x) { return -std::log1p(std::exp(-x)); };
+  Matrix assignment(6, 9);
+  for (size_t i = 0; i < 6; ++i)
+    for (size_t j = 0; j < 9; ++j)
+      assignment.at(i, j) =
+          rows.at(i, j) + cols.at(i, j) + log_sigmoid(z.values[i]) + log_sigmoid(z.values[6 + j]);
+  auto dsim69 = upload(floats(s69)), dz = upload(floats(z));
+  DeviceArray<float> lse(context(), "test: lse", 15), dassign(context(), "test: assignment", 54);
+  // Rotary: q, k, v interleaved per channel, 10 rows of width 8.
+  const Matrix qkv = random_matrix(10, 24, 15), points = random_matrix(10, 2, 16, 0.5);
+  const std::vector<float> rotary = floats(random_matrix(1, 8, 17, 3.0).values);
+  auto dqkv = upload(floats(qkv)), dpoints = upload(floats(points)), drotary = upload(rotary);
+  DeviceArray<float> dsplit(context(), "test: split", 10 * 24);
+  {
+    engine::Sequence s(context());
+    ops.assignment(s, dsim69->buffer(), dz->buffer(), lse.buffer(), dassign.buffer(), 6, 9);
+    ops.split_rotary(s, dqkv->buffer(), dpoints->buffer(), drotary->buffer(), dsplit.buffer(), 10, 8);
+    s.submit_and_wait();
+  }
+  EXPECT_LT(relative_error(dassign.download(), assignment.values), 1e-5);
+  {
+    auto l = lse.download();
+    for (size_t i = 0; i < 15; ++i) printf("lse %zu %g\n", i, l[i]);
+    for (size_t i = 0; i < 6; ++i) {
+      double m = -1e30, sum = 0;
+      for (size_t j = 0; j < 9; ++j) m = std::max(m, s69.at(i, j));
+      for (size_t j = 0; j < 9; ++j) sum += std::exp(s69.at(i, j) - m);
+      printf("ref row %zu %g\n", i, m + std::log(sum));
+    }
+  }
+  Matrix qs(10, 8), ks(10, 8), vs(10, 8);
+  for (size_t row = 0; row < 10; ++row)
+    for (size_t d = 0; d < 8; ++d) {
+      qs.at(row, d) = qkv.at(row, 3 * d);
+      ks.at(row, d) = qkv.at(row, 3 * d + 1);
+      vs.at(row, d) = qkv.at(row, 3 * d + 2);
+    }
+  const Matrix f = kernels::nn::rotary_frequencies(points, rotary);
+  kernels::nn::apply_rotary(qs, f);
+  kernels::nn::apply_rotary(ks, f);
+  std::vector<double> split_expected = qs.values;
+  split_expected.insert(split_expected.end(), ks.values.begin(), ks.values.end());
+  split_expected.insert(split_expected.end(), vs.values.begin(), vs.values.end());
+  EXPECT_LT(relative_error(dsplit.download(), split_expected), 1e-5);
+}
+
+TEST_F(NnAttentionTest, LighterGlueMatchesTheReferenceAndIsDeterministic) {
+  namespace in = testing::lighterglue_inputs;
+  const kernels::nn::LighterGlueWeights w = weights();
+  const kernels::nn::LighterGlueOutputs ref =
+      kernels::nn::lighterglue(w, in::keypoints0(), in::descriptors0(), in::keypoints1(), in::descriptors1());
+  const kernels::LighterGlueNetwork network(context(), w);
+  const auto run = [&] {
+    return network.match(floats(in::keypoints0()), floats(in::descriptors0()), floats(in::keypoints1()),
+                         floats(in::descriptors1()));
+  };
+  const kernels::LighterGlueMatches out = run();
+  ASSERT_EQ(out.scores.size(), ref.scores.values.size());
+  double worst = 0;
+  for (size_t i = 0; i < out.scores.size(); ++i)
+    worst = std::max(worst, std::abs(out.scores[i] - ref.scores.values[i]) /
+                                std::max(1.0, std::abs(ref.scores.values[i])));
+  EXPECT_LT(worst, 3e-3) << "onnxruntime's float32 spread (tests/data/lighterglue)";
+  EXPECT_EQ(out.matches, ref.matches);
+  const kernels::LighterGlueMatches again = run();
+  EXPECT_EQ(again.scores, out.scores) << "not bit-identical";
+}
+
+TEST_F(NnAttentionTest, NoKeypointsGiveNoMatchesAndWrongSizesAreRefused) {
+  namespace in = testing::lighterglue_inputs;
+  const kernels::LighterGlueNetwork network(context(), weights());
+  const kernels::LighterGlueMatches none =
+      network.match({}, {}, floats(in::keypoints1()), floats(in::descriptors1()));
+  EXPECT_TRUE(none.matches.empty());
+  EXPECT_THROW(
+      network.match({0.1f, 0.2f}, std::vector<float>(32, 0.1f), {0.1f, 0.2f}, std::vector<float>(64, 0.1f)),
+      std::invalid_argument);
+  kernels::AttentionKernels ops(context());
+  DeviceArray<float> small(context(), "test: small", 4);
+  engine::Sequence s(context());
+  EXPECT_THROW(ops.multiply_transposed(s, RowBlock{&small.buffer(), 0, 2, 3},
+                                       RowBlock{&small.buffer(), 0, 2, 2}, small.buffer(), 1.0f),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace litgs
