@@ -12,8 +12,6 @@ namespace litgs::tools {
 host::frontend::FrontendOptions FrontendCli::resolved() const {
   host::frontend::FrontendOptions o = options;
   o.features.type = host::frontend::parse_feature_type(features);
-  if (matcher == "lighterglue")
-    throw std::invalid_argument("--matcher lighterglue is not built yet (issue 47): ratio or mnn");
   o.match.matcher = matcher == "auto" ? (o.features.type == host::frontend::FeatureType::kXfeat
                                              ? host::frontend::Matcher::kMnn
                                              : host::frontend::Matcher::kRatio)

@@ -89,12 +89,16 @@ void match_pairs(const Context& c, const std::vector<ImagePair>& pairs, std::vec
   parallel_for(pairs.size(), c.o.threads, [&](size_t p) {
     const auto [a, b] = pairs[p];
     const std::optional<RelativePose> prior = relative_prior(c, a, b);
-    // With a prior, descriptors are compared only along the prior's epipolar band (guided matching).
-    const auto mutual = prior ? match_mutual_among(c.features[a], c.features[b],
-                                                   prior_candidates(c.undistorted[a], c.undistorted[b], c.K,
-                                                                    *prior, c.o.verify.prior_epipolar_px),
-                                                   c.o.match)
-                              : match_mutual(c.features[a], c.features[b], c.o.match);
+    // With a prior, descriptors are compared only along the prior's epipolar band (guided matching); a
+    // learned matcher sees all of both images' keypoints, and the verification below applies the band.
+    const auto mutual =
+        c.o.match.matcher == Matcher::kLighterGlue
+            ? c.o.learned_matcher(c.features[a], c.features[b], c.camera.width, c.camera.height)
+        : prior ? match_mutual_among(c.features[a], c.features[b],
+                                     prior_candidates(c.undistorted[a], c.undistorted[b], c.K, *prior,
+                                                      c.o.verify.prior_epipolar_px),
+                                     c.o.match)
+                : match_mutual(c.features[a], c.features[b], c.o.match);
     Verification v = verify_pair(c.undistorted[a], c.undistorted[b], mutual, c.K, prior, c.o.verify);
     const size_t rejected_by_lidar = reject_by_lidar(c, a, b, mutual, v);
     io::SfmPairMatches& m = out[first + p];
@@ -238,6 +242,11 @@ void FrontendOptions::check() const {
   if (features.type == FeatureType::kXfeat && !learned_detector)
     throw std::invalid_argument("features xfeat: no learned detector was given (it runs on the device)");
   match.check();
+  if (match.matcher == Matcher::kLighterGlue && features.type != FeatureType::kXfeat)
+    throw std::invalid_argument("matcher lighterglue: it matches XFeat's descriptors (features xfeat), not " +
+                                feature_name(features.type) + "'s");
+  if (match.matcher == Matcher::kLighterGlue && !learned_matcher)
+    throw std::invalid_argument("matcher lighterglue: no learned matcher was given (it runs on the device)");
   verify.check();
   pairs.check();
   triangulation.check();

@@ -24,6 +24,7 @@ struct FrontendOptions {
   FeatureOptions features;
   LearnedDetector learned_detector;  // required for FeatureType::kXfeat (host/nn/xfeat_features.h)
   MatchOptions match;
+  LearnedMatcher learned_matcher;  // required for Matcher::kLighterGlue (host/nn/lighterglue_matcher.h)
   VerifyOptions verify;
   bool prior_epipolar = true;  // reject matches far from the prior poses' epipolar lines
   // Reject verified matches the LiDAR map contradicts (lidar_depth_check.h); not with true_poses, whose

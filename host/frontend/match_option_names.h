@@ -10,7 +10,7 @@ inline constexpr OptionName kFeatures{"features", "--features",
 inline constexpr OptionName kMatcher{
     "matcher", "--matcher",
     "auto (ratio; mnn for xfeat) | ratio (mutual nearest + ratio test) | mnn "
-    "(mutual nearest + cosine bound)"};
+    "(mutual nearest + cosine bound) | lighterglue (XFeat's learned matcher on the device; xfeat only)"};
 inline constexpr OptionName kClahe{"clahe", "!--no-clahe", "CLAHE before detection (--no-clahe: none)"};
 inline constexpr OptionName kPairs{
     "pairs", "--pairs",

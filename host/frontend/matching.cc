@@ -36,18 +36,20 @@ void check_matcher_kind(const ImageFeatures& a, const MatchOptions& o, const cha
 }  // namespace
 
 std::string matcher_name(Matcher m) {
-  return m == Matcher::kMnn ? "mnn" : "ratio";
+  return m == Matcher::kMnn ? "mnn" : m == Matcher::kLighterGlue ? "lighterglue" : "ratio";
 }
 
 Matcher parse_matcher(const std::string& name) {
   if (name == "ratio") return Matcher::kRatio;
   if (name == "mnn") return Matcher::kMnn;
-  throw std::invalid_argument("unknown matcher '" + name + "' (ratio or mnn)");
+  if (name == "lighterglue") return Matcher::kLighterGlue;
+  throw std::invalid_argument("unknown matcher '" + name + "' (ratio, mnn or lighterglue)");
 }
 
 void MatchOptions::check() const {
   if (!(ratio > 0 && ratio <= 1)) throw std::invalid_argument("match ratio must be in (0, 1]");
   if (!(min_cosine >= -1 && min_cosine < 1)) throw std::invalid_argument("min_cosine must be in [-1, 1)");
+  if (!(min_score >= 0 && min_score < 1)) throw std::invalid_argument("min_score must be in [0, 1)");
 }
 
 std::vector<std::array<uint32_t, 2>> match_mutual(const ImageFeatures& a, const ImageFeatures& b,

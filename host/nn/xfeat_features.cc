@@ -8,7 +8,9 @@
 
 #include "host/frontend/features.h"
 #include "host/frontend/preprocess.h"
-#include "host/nn/xfeat_model.h"
+#include "host/nn/embedded_models.h"
+#include "host/nn/lighterglue_matcher.h"
+#include "host/nn/lighterglue_weights.h"
 #include "host/nn/xfeat_weights.h"
 #include "kernels/nn/xfeat.h"
 
@@ -93,11 +95,17 @@ frontend::LearnedDetector make_xfeat_detector(std::shared_ptr<engine::Context> c
 }
 
 frontend::FrontendOptions with_learned_detector(frontend::FrontendOptions options,
-                                                const std::filesystem::path& model) {
-  if (options.features.type != frontend::FeatureType::kXfeat) return options;
-  const kernels::nn::XfeatWeights weights = xfeat_weights(xfeat_model(model));
-  options.learned_detector =
-      make_xfeat_detector(std::make_shared<engine::Context>(), weights, options.features);
+                                                const std::filesystem::path& model,
+                                                const std::filesystem::path& lighterglue) {
+  const bool learned_matcher = options.match.matcher == frontend::Matcher::kLighterGlue;
+  if (options.features.type != frontend::FeatureType::kXfeat && !learned_matcher) return options;
+  auto context = std::make_shared<engine::Context>();
+  if (options.features.type == frontend::FeatureType::kXfeat)
+    options.learned_detector =
+        make_xfeat_detector(context, xfeat_weights(xfeat_model(model)), options.features);
+  if (learned_matcher)
+    options.learned_matcher = make_lighterglue_matcher(
+        context, lighterglue_weights(lighterglue_model(lighterglue)), options.match.min_score);
   return options;
 }
 

@@ -24,10 +24,11 @@ frontend::LearnedDetector make_xfeat_detector(std::shared_ptr<engine::Context> c
                                               const kernels::nn::XfeatWeights& weights,
                                               const frontend::FeatureOptions& options);
 
-// `options` with a learned detector when its features ask for one (a Vulkan context of its own; the
-// embedded model, or the file at `model` if given: io::IoError naming a missing or wrong file), else
-// unchanged.
+// `options` with a learned detector when its features ask for one, and a learned matcher when its matcher
+// is lighterglue (one Vulkan context of their own; the embedded models, or the files at `model` (XFeat) and
+// `lighterglue` if given: io::IoError naming a missing or wrong file), else unchanged.
 frontend::FrontendOptions with_learned_detector(frontend::FrontendOptions options,
-                                                const std::filesystem::path& model = {});
+                                                const std::filesystem::path& model = {},
+                                                const std::filesystem::path& lighterglue = {});
 
 }  // namespace litgs::host::nn

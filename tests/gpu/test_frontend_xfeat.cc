@@ -2,7 +2,7 @@
 // layer on: a camera translating over a textured plane gives verified matches and points on the plane (the
 // frames are 320x240, not a multiple of 32: resized as XFeat does, keypoints mapped back); a uniform frame
 // gives no keypoints and no NaN; xfeat without a detector, and the mnn matcher on bit strings, are clear
-// errors.
+// errors. The same plane matched by LighterGlue.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -61,6 +61,41 @@ TEST_F(FrontendXfeat, TranslationOverATexturedPlaneGivesPointsOnThePlane) {
       ASSERT_GE(k.y, -0.5f);
       ASSERT_LT(k.y, 239.5f);
     }
+}
+
+// LighterGlue on the device as the matcher (`--matcher lighterglue`): the same plane, the same bounds as the
+// mnn matcher's above; a bit-string descriptor is refused with a message naming xfeat.
+TEST_F(FrontendXfeat, LighterGlueMatchesTheTranslationOverAPlane) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < 4; ++i) poses.push_back(testing::plane_view({0.4 * i, 0.05 * i, 0}));
+  testing::write_rendered_plane_scene(dir_, testing::PlaneCamera{}, poses);
+  FrontendOptions o = options();
+  o.features.max_keypoints = 600;  // attention is quadratic in the keypoints: lavapipe's time
+  o.match.matcher = Matcher::kLighterGlue;
+  o = nn::with_learned_detector(o);
+  const FrontendResult r = run_frontend(dir_, o);
+  EXPECT_GE(r.summary.pairs_verified, 5u);
+  ASSERT_GT(r.summary.points, 100u);
+  EXPECT_LT(r.summary.mean_error_px, 1.5);
+  std::vector<double> off;
+  for (const auto& p : r.data.points) off.push_back(std::abs(p.xyz.z() - testing::kPlaneZ));
+  std::sort(off.begin(), off.end());
+  const size_t far = size_t(off.end() - std::upper_bound(off.begin(), off.end(), 0.15));
+  EXPECT_LT(off[off.size() / 2], 0.015);
+  EXPECT_LT(far, off.size() / 20);
+  std::printf("lighterglue over a plane: %zu points, inlier ratio %.3f, median %.4f m off the plane\n",
+              off.size(), r.summary.inlier_ratio, off[off.size() / 2]);
+
+  ImageFeatures bits;
+  bits.keypoints = {{10, 10, 4, 0}};
+  bits.descriptors.assign(32, 0);
+  bits.descriptor_bytes = 32;
+  try {
+    o.learned_matcher(bits, bits, 320, 240);
+    ADD_FAILURE() << "bit strings were matched by lighterglue";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("xfeat"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(FrontendXfeat, AUniformFrameGivesNoKeypointsAndMissingPiecesAreClearErrors) {
