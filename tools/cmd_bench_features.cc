@@ -4,6 +4,7 @@
 // keypoints and descriptors on the device, at match's defaults) and XFeat's double-precision CPU reference
 // of the network (one run). The frame is cropped to multiples of 32.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -15,6 +16,8 @@
 #include "host/frontend/intensity.h"
 #include "host/frontend/preprocess.h"
 #include "host/nn/embedded_models.h"
+#include "host/nn/lighterglue_matcher.h"
+#include "host/nn/lighterglue_weights.h"
 #include "host/nn/xfeat_features.h"
 #include "host/nn/xfeat_weights.h"
 #include "io/image.h"
@@ -106,6 +109,27 @@ void run_bench_features(const BenchFeaturesOptions& o) {
                   {"where", "device: network, keypoints, descriptors"},
                   {"ms", median(detect_ms)},
                   {"keypoints", xfeat_keypoints}});
+  // LighterGlue per pair of frames: attention is quadratic in the keypoints, so at 1000 and at all of them
+  // (the frame matched with itself: the time does not depend on the content).
+  const host::frontend::ImageFeatures detected = xfeat(frame);
+  const host::frontend::LearnedMatcher lighterglue = host::nn::make_lighterglue_matcher(
+      shared_context, host::nn::lighterglue_weights(host::nn::lighterglue_model()), 0.1);
+  for (const size_t n : {size_t{1000}, detected.keypoints.size()}) {
+    host::frontend::ImageFeatures f = detected;
+    f.keypoints.resize(std::min(n, f.keypoints.size()));
+    f.descriptors.resize(f.keypoints.size() * size_t(f.descriptor_bytes));
+    std::vector<double> pair_ms;
+    size_t matches = 0;
+    for (uint32_t r = 0; r <= o.runs; ++r) {
+      const double t = time_ms([&] { matches = lighterglue(f, f, frame.width, frame.height).size(); });
+      if (r) pair_ms.push_back(t);
+    }
+    rows.push_back({{"detector", "lighterglue"},
+                    {"where", "device: one pair, " + std::to_string(f.keypoints.size()) + " keypoints each"},
+                    {"ms", median(pair_ms)},
+                    {"matches", matches}});
+    if (f.keypoints.size() == detected.keypoints.size()) break;
+  }
   kernels::nn::FeatureMap image(1, frame.height, frame.width);
   image.values.assign(input.begin(), input.end());
   const kernels::nn::XfeatReference reference(weights);

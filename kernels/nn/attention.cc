@@ -71,7 +71,8 @@ void AttentionKernels::matmul(engine::Sequence& s, const RowBlock& a, const RowB
   p.k = a.cols;
   p.transposed = transposed;
   p.scale = scale;
-  const uint64_t count = uint64_t{a.rows} * ((m + NN_MATMUL_OUTPUTS - 1) / NN_MATMUL_OUTPUTS);
+  const uint64_t count = uint64_t{(a.rows + NN_MATMUL_ROWS - 1) / NN_MATMUL_ROWS} *
+                         ((m + NN_MATMUL_RUN - 1) / NN_MATMUL_RUN) * NN_MATMUL_LANES;
   p.count = static_cast<uint32_t>(count);
   p.a_offset = a.first * a.cols;
   p.b_offset = b.first * b.cols;

@@ -2,8 +2,10 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 // y = scale a b^T or y = a b (kernels/nn/attention_reference.cc's multiply_transposed, multiply): an
-// invocation computes NN_MATMUL_OUTPUTS neighbouring columns of one row of y, each value of a's row loaded
-// once for all of them; each output summed over k in order.
+// invocation computes a register tile of NN_MATMUL_ROWS rows x NN_MATMUL_OUTPUTS columns of y, so that each
+// value of a serves all the tile's columns and each value of b all its rows; the columns of NN_MATMUL_LANES
+// neighbouring invocations interleave (column q of lane l: l + q NN_MATMUL_LANES), so that their loads of
+// b's rows are contiguous in y = a b. Each output summed over k in order.
 #include "limits.h"
 #include "nn/nn_shared.h"
 #include "elementwise.glsl"
@@ -16,21 +18,31 @@ layout(push_constant) uniform Push { NnMatmulParams p; };
 void main() {
   const uint e = elementwise_index();
   if (e >= p.count) return;
-  const uint blocks = (p.m + NN_MATMUL_OUTPUTS - 1u) / NN_MATMUL_OUTPUTS;
-  const uint row = e / blocks, c0 = (e % blocks) * NN_MATMUL_OUTPUTS;
-  float sum[NN_MATMUL_OUTPUTS];
-  [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) sum[j] = 0.0;
+  const uint runs = (p.m + NN_MATMUL_RUN - 1u) / NN_MATMUL_RUN;
+  const uint run = e / NN_MATMUL_LANES;
+  const uint c0 = (run % runs) * NN_MATMUL_RUN + e % NN_MATMUL_LANES;
+  const uint r0 = (run / runs) * NN_MATMUL_ROWS;
+  float sum[NN_MATMUL_ROWS][NN_MATMUL_OUTPUTS];
+  [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i)
+    [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) sum[i][j] = 0.0;
   for (uint k = 0u; k < p.k; ++k) {
-    const float v = a[p.a_offset + row * p.k + k];
-    // A block past the last column reads the last one again and never writes it.
+    // Rows and columns past the edges read the last one again and are never written.
+    float va[NN_MATMUL_ROWS], vb[NN_MATMUL_OUTPUTS];
+    [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i) va[i] = a[p.a_offset + min(r0 + i, p.n - 1u) * p.k + k];
     [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) {
-      const uint c = min(c0 + j, p.m - 1u);
-      sum[j] += v * b[p.b_offset + (p.transposed != 0u ? c * p.k + k : k * p.m + c)];
+      const uint c = min(c0 + j * NN_MATMUL_LANES, p.m - 1u);
+      vb[j] = b[p.b_offset + (p.transposed != 0u ? c * p.k + k : k * p.m + c)];
     }
+    [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i)
+      [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) sum[i][j] += va[i] * vb[j];
   }
-  for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) {
-    const uint c = c0 + j;
-    if (c >= p.m) break;
-    y[p.y_offset + row * p.m + c] = p.transposed != 0u ? p.scale * sum[j] : sum[j];
+  for (uint i = 0u; i < NN_MATMUL_ROWS; ++i) {
+    const uint row = r0 + i;
+    if (row >= p.n) break;
+    for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) {
+      const uint c = c0 + j * NN_MATMUL_LANES;
+      if (c >= p.m) break;
+      y[p.y_offset + row * p.m + c] = p.transposed != 0u ? p.scale * sum[i][j] : sum[i][j];
+    }
   }
 }

@@ -93,9 +93,13 @@ struct NnLinearParams {
   uint count;  // rows * ceil(out / NN_LINEAR_OUTPUTS)
 };
 
-// nn_matmul.comp: y = scale a b^T (a [n][k], b [m][k]; NN_MATMUL_TRANSPOSED) or y = a b (a [n][k], b [k][m]):
-// one invocation per row of y and NN_MATMUL_OUTPUTS of its columns.
+// nn_matmul.comp: y = scale a b^T (a [n][k], b [m][k]; transposed) or y = a b (a [n][k], b [k][m]): one
+// invocation per tile of NN_MATMUL_ROWS rows x NN_MATMUL_OUTPUTS columns, the columns interleaved over
+// NN_MATMUL_LANES neighbouring invocations.
+#define NN_MATMUL_ROWS 8
 #define NN_MATMUL_OUTPUTS 4
+#define NN_MATMUL_LANES 8
+#define NN_MATMUL_RUN (NN_MATMUL_LANES * NN_MATMUL_OUTPUTS)
 #define NN_MATMUL_BINDING_A 0
 #define NN_MATMUL_BINDING_B 1
 #define NN_MATMUL_BINDING_Y 2
@@ -105,7 +109,7 @@ struct NnMatmulParams {
   uint n, m, k;
   uint transposed;  // 1: a b^T
   float scale;
-  uint count;                         // n * ceil(m / NN_MATMUL_OUTPUTS)
+  uint count;                         // ceil(n / ROWS) ceil(m / RUN) LANES
   uint a_offset, b_offset, y_offset;  // in floats: both images' rows share one buffer
 };
 
