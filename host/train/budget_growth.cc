@@ -154,8 +154,10 @@ void BudgetGrowth::end_phase(uint32_t step, uint32_t gaussians, const std::vecto
 }
 
 uint64_t BudgetGrowth::next_budget() const {
+  // At least sqrt(factor) above the current size: a phase spent on a small step (15.7k to 20k) is one of
+  // the few the decisions' window holds.
   double rung = options_.start;
-  while (rung <= budget_) rung = std::ceil(rung * options_.factor);
+  while (rung < budget_ * std::sqrt(options_.factor)) rung = std::ceil(rung * options_.factor);
   return static_cast<uint64_t>(rung);
 }
 

@@ -69,9 +69,10 @@ class BudgetGrowth {
   static BudgetGrowth from_json(const BudgetGrowthOptions& options, const nlohmann::json& j);
 
  private:
-  // The budget after the current one: the next rung of start x factor^k, where fixed budgets and the search
-  // are measured, so that an initialization between two rungs climbs to the next rung rather than doubling
-  // past it (docs/budget.md: doubling from the initialization overshot the facade's best fixed budget).
+  // The budget after the current one: the first rung of start x factor^k at least sqrt(factor) above it,
+  // where fixed budgets and the search are measured, so that an initialization between two rungs climbs to
+  // a rung rather than doubling past it (docs/budget.md: doubling from the initialization overshot the
+  // facade's best fixed budget), nor spends a phase on a small step.
   uint64_t next_budget() const;
   // The next doubling's gain from the last one (not yet in phases_) and the one before: last * (last /
   // before) when the gains fall, else half the last; NaN unless the last gained.

@@ -186,7 +186,8 @@ TEST(BudgetGrowth, ABudgetAboveWhatTheDeviceHoldsIsNeverSet) {
 }
 
 // Budgets climb the ladder start x 2^k where the fixed budgets are measured: an initialization between two
-// rungs (the facade's 20,934 LiDAR points) goes to the next rung, not to twice its own size.
+// rungs (the facade's 20,934 LiDAR points) goes to the next rung, not to twice its own size, unless that rung
+// is less than sqrt(2) above it.
 TEST(BudgetGrowth, AnInitializationBetweenTwoRungsClimbsToTheNextRung) {
   BudgetGrowthOptions o;
   BudgetGrowth g(o, 20934, 4000000, kViews.size());
@@ -197,11 +198,15 @@ TEST(BudgetGrowth, AnInitializationBetweenTwoRungsClimbsToTheNextRung) {
   EXPECT_EQ(g.budget(), 80000u);
   g.end_phase(1200, 80000, shifted(kViews, 1.01), kViews, true, 3);  // no gain: back to the last rung
   EXPECT_EQ(g.budget(), 40000u);
+  // Less than sqrt(2) to the next rung (the street's 15,716 LiDAR points, 20k): the rung after it.
+  BudgetGrowth close(o, 15716, 4000000, kViews.size());
+  close.end_phase(600, 15716, kViews, kViews, true, 1);
+  EXPECT_EQ(close.budget(), 40000u);
   o.start = 5000;
   o.factor = 3;
   BudgetGrowth thirds(o, 20934, 4000000, kViews.size());
   thirds.end_phase(600, 20934, kViews, kViews, true, 1);
-  EXPECT_EQ(thirds.budget(), 45000u);  // 5k, 15k, 45k
+  EXPECT_EQ(thirds.budget(), 45000u);  // 5k, 15k, 45k: the first at least sqrt(3) x 20,934
 }
 
 TEST(BudgetGrowth, OneValidationViewCannotJudgeAndTheBudgetStaysAtItsStart) {
