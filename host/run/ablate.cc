@@ -88,16 +88,24 @@ AblationStudy features_study(const RunConfig& base) {
   // With oracle tracks refine (and so train) does not depend on the features: stop after match.
   const bool tracks_from_frontend = base.refine.tracks != "oracle";
   // XFeat runs on the device with its own matcher (mutual nearest neighbours over a cosine bound, `match
-  // --matcher auto`); the classical detectors with the ratio test.
-  for (const char* f : {"orb", "sift", "akaze", "xfeat"})
+  // --matcher auto`) and with LighterGlue (`--matcher lighterglue`); the classical detectors with the ratio
+  // test.
+  struct Detector {
+    const char *name, *features, *matcher;
+  };
+  for (const Detector d :
+       {Detector{"orb", "orb", "auto"}, Detector{"sift", "sift", "auto"}, Detector{"akaze", "akaze", "auto"},
+        Detector{"xfeat", "xfeat", "auto"}, Detector{"xfeat-lighterglue", "xfeat", "lighterglue"}})
     for (const bool clahe : {false, true})
-      s.variants.push_back({std::string(f) + (clahe ? "-clahe" : ""),
-                            {f, clahe ? "yes" : "no"},
-                            [f, clahe](RunConfig& c) {
-                              c.match.features = f;
-                              c.match.clahe = clahe;
-                            },
-                            tracks_from_frontend ? "eval" : "match"});
+      s.variants.push_back(
+          {std::string(d.name) + (clahe ? "-clahe" : ""),
+           {std::string(d.matcher) == "auto" ? d.features : "xfeat + lighterglue", clahe ? "yes" : "no"},
+           [d, clahe](RunConfig& c) {
+             c.match.features = d.features;
+             c.match.matcher = d.matcher;
+             c.match.clahe = clahe;
+           },
+           tracks_from_frontend ? "eval" : "match"});
   s.measured = {column("keypoints per image", "match", "keypoints_per_image", 0),
                 column("inlier ratio", "match", "inlier_ratio", 3),
                 {"verified / tried pairs",

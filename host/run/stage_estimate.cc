@@ -187,6 +187,11 @@ std::optional<StageEstimate> estimate_stage(const std::string& stage, InputKind 
     e = fixed(0, "match.enabled is false");
   } else if (stage == "refine" && !c.refine.enabled) {
     e = fixed(0, "refine.enabled is false");
+  } else if (stage == "match" && c.match.matcher == "lighterglue") {
+    // Each pair costs the square of its keypoints, and the pairs are known after pair selection.
+    reason =
+        "LighterGlue's time grows with the pairs and the square of the keypoints per frame (`bench "
+        "features` times one pair)";
   } else if (stage == "match") {
     const double threads = c.match.threads ? c.match.threads : cores;
     if (c.match.features == "xfeat")

@@ -113,9 +113,14 @@ TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
   base.train.max_gaussians = "8000";
   const auto all = ablation_studies("all", base);
   ASSERT_EQ(all.size(), 4u);
-  ASSERT_EQ(all[0].variants.size(), 3u);  // input, refined, true poses
-  EXPECT_EQ(all[1].variants.size(), 5u);  // lambda_geo 0 .. 0.8
-  ASSERT_EQ(all[2].variants.size(), 8u);  // 4 feature types x CLAHE
+  ASSERT_EQ(all[0].variants.size(), 3u);   // input, refined, true poses
+  EXPECT_EQ(all[1].variants.size(), 5u);   // lambda_geo 0 .. 0.8
+  ASSERT_EQ(all[2].variants.size(), 10u);  // orb, sift, akaze, xfeat (mnn), xfeat + lighterglue x CLAHE
+  RunConfig lighterglue = base;
+  all[2].variants[9].apply(lighterglue);
+  EXPECT_EQ(lighterglue.match.features, "xfeat");
+  EXPECT_EQ(lighterglue.match.matcher, "lighterglue");
+  EXPECT_TRUE(lighterglue.match.clahe);
   ASSERT_EQ(all[3].variants.size(), 6u);  // adc, mcmc x 3 budgets
   RunConfig c = base;
   all[0].variants[0].apply(c);

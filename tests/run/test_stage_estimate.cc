@@ -83,6 +83,12 @@ TEST(StageEstimate, AGrownBudgetIsARangeAndStagesWithoutAModelSayWhy) {
   blocks.train.blocks = "auto";
   EXPECT_FALSE(estimate_stage("train", InputKind::kSynthetic, s, blocks, cpu_device(), &why).has_value());
   EXPECT_NE(why.find("blocks"), std::string::npos) << why;
+  RunConfig lighterglue = c;  // the pairs are known after pair selection; each costs keypoints squared
+  lighterglue.match.features = "xfeat";
+  lighterglue.match.matcher = "lighterglue";
+  EXPECT_FALSE(
+      estimate_stage("match", InputKind::kSynthetic, s, lighterglue, cpu_device(), &why).has_value());
+  EXPECT_NE(why.find("LighterGlue"), std::string::npos) << why;
   EXPECT_FALSE(estimate_stage("no-such-stage", InputKind::kSynthetic, s, c, cpu_device(), &why).has_value());
   EXPECT_NE(why.find("no-such-stage"), std::string::npos) << why;
 
