@@ -50,8 +50,13 @@ uint32_t BudgetGrowth::decisions_until(const TrainOptions& t) const {
 }
 
 double BudgetGrowth::mcmc_growth_while_growing(double mcmc_growth) const {
-  // Filled means kFilled of the budget: (1 + g)^phase >= factor * kFilled, with a 1 % margin.
-  const double fill = std::pow(options_.factor * kFilled, 1.0 / options_.phase_refinements) * 1.01 - 1;
+  // The step to fill: from the model's size at the last phase's end to the budget (a climb to a rung can be
+  // up to factor^1.5); before any phase, one factor. Filled means kFilled of the budget: (1 + g)^phase >=
+  // step * kFilled, with a 1 % margin.
+  double step = options_.factor;
+  if (!phases_.empty() && phases_.back().gaussians > 0)
+    step = std::max(1.0, double(budget_) / double(phases_.back().gaussians));
+  const double fill = std::pow(step * kFilled, 1.0 / options_.phase_refinements) * 1.01 - 1;
   return std::max(mcmc_growth, fill);
 }
 

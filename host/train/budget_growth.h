@@ -57,8 +57,9 @@ class BudgetGrowth {
                  const std::vector<double>& training_psnr_db, bool another_phase_fits, double wall_s);
   // Stops growing for a reason found outside the rule (the device's limits).
   void stop(const std::string& reason);
-  // MCMC's growth per refinement while it grows: at least `mcmc_growth`, and enough that a budget raised by
-  // `factor` fills within a phase's refinements.
+  // MCMC's growth per refinement while it grows: at least `mcmc_growth`, and enough that the model fills the
+  // current budget from its size at the last phase's end (a budget raised by `factor` before any) within a
+  // phase's refinements. Changes with each phase: the caller sets it again after end_phase.
   double mcmc_growth_while_growing(double mcmc_growth) const;
   // The first step at which no phase ends any more: the densification window's end or until_fraction of the
   // iterations, whichever comes first.

@@ -339,6 +339,8 @@ TrainReport train(engine::Context& ctx, const TrainingData& data, const kernels:
       growth->end_phase(step, static_cast<uint32_t>(model.size()), scores(*validator), scores(*probe),
                         growth->another_phase_fits(step, o), secs);
       density_control.set_budget(growth->budget());
+      if (growth->growing())
+        density_control.set_mcmc_growth(static_cast<float>(growth->mcmc_growth_while_growing(o.mcmc_growth)));
       if (model.size() > growth->budget())  // a doubling rolled back
         model.load_state(keep_most_opaque(model.download_state(), growth->budget()));
       notice("budget growth at iteration " + std::to_string(step) + ": " + growth->phases().back().decision);

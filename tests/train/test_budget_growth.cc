@@ -5,6 +5,7 @@
 // from its JSON state deciding as the uninterrupted run.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "host/train/budget_growth.h"
@@ -19,6 +20,13 @@ std::vector<double> shifted(const std::vector<double>& v, double by) {
 }
 
 const std::vector<double> kViews = {30.0, 31.2, 29.5, 32.4, 30.8};
+
+// A doubling from a filled budget: MCMC's default growth of 0.3 per refinement already fills it.
+double g_after_doubling() {
+  BudgetGrowth g(BudgetGrowthOptions{}, 20000, 4000000, kViews.size());
+  g.end_phase(600, 20000, kViews, kViews, true, 1);
+  return g.mcmc_growth_while_growing(0.3);
+}
 const std::vector<double> kNoise = {-0.9, 1.1, -0.7, 0.8, 0.0};  // mean 0.06, spread ~0.9 dB
 
 TEST(BudgetGrowth, PhasesEndEveryFewRefinementsInsideTheWindow) {
@@ -198,10 +206,15 @@ TEST(BudgetGrowth, AnInitializationBetweenTwoRungsClimbsToTheNextRung) {
   EXPECT_EQ(g.budget(), 80000u);
   g.end_phase(1200, 80000, shifted(kViews, 1.01), kViews, true, 3);  // no gain: back to the last rung
   EXPECT_EQ(g.budget(), 40000u);
-  // Less than sqrt(2) to the next rung (the street's 15,716 LiDAR points, 20k): the rung after it.
+  // Less than sqrt(2) to the next rung (the street's 15,716 LiDAR points, 20k): the rung after it, and MCMC
+  // grows fast enough to fill that 2.5x step within the phase's three refinements (0.3 fills a doubling).
   BudgetGrowth close(o, 15716, 4000000, kViews.size());
   close.end_phase(600, 15716, kViews, kViews, true, 1);
   EXPECT_EQ(close.budget(), 40000u);
+  const double rate = close.mcmc_growth_while_growing(0.3);
+  EXPECT_GT(15716 * std::pow(1 + rate, o.phase_refinements), 0.98 * 40000) << rate;
+  EXPECT_LT(rate, 0.4);
+  EXPECT_DOUBLE_EQ(g_after_doubling(), 0.3);
   o.start = 5000;
   o.factor = 3;
   BudgetGrowth thirds(o, 20934, 4000000, kViews.size());
