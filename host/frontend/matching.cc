@@ -62,7 +62,8 @@ std::vector<std::array<uint32_t, 2>> match_mutual(const ImageFeatures& a, const 
   cv::BFMatcher matcher(a.float_descriptors ? cv::NORM_L2 : cv::NORM_HAMMING);
   const cv::Mat da = descriptor_mat(a), db = descriptor_mat(b);
   std::vector<std::vector<cv::DMatch>> ab, ba;
-  matcher.knnMatch(da, db, ab, 2);
+  // The second neighbour serves only the ratio test.
+  matcher.knnMatch(da, db, ab, o.matcher == Matcher::kRatio ? 2 : 1);
   matcher.knnMatch(db, da, ba, 1);
   for (const auto& m : ab) {
     if (m.empty()) continue;
