@@ -1,4 +1,5 @@
-// `litgs-engine ablate INPUT --out DIR --study refine|lambda|features|strategy|all [--config run.yaml]`: the
+// `litgs-engine ablate INPUT --out DIR --study refine|lambda|features|strategy|all [--variants A,B]
+// [--config run.yaml]`: the
 // method's ablations as runs of the pipeline that share their common stages (host/run/ablate.h).
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -11,7 +12,7 @@ namespace litgs::tools {
 
 void add_ablate_command(CLI::App& app) {
   struct Options {
-    std::string input, out, study = "all", config, calib;
+    std::string input, out, study = "all", variants, config, calib;
   };
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -21,6 +22,9 @@ void add_ablate_command(CLI::App& app) {
   cmd->add_option("--study", o->study,
                   "refine | lambda | features | strategy | all, or several: refine,features")
       ->capture_default_str();
+  cmd->add_option("--variants", o->variants,
+                  "Only these runs of the studies, by name: sift-clahe,xfeat (default: all; a wrong name "
+                  "lists them)");
   cmd->add_option("--config", o->config,
                   "run.yaml: the settings every run starts from (run's defaults, but max_gaussians 40000)")
       ->check(CLI::ExistingFile);
@@ -31,12 +35,15 @@ void add_ablate_command(CLI::App& app) {
     a.input = o->input;
     a.out_dir = std::filesystem::absolute(o->out);
     a.study = o->study;
+    a.variants = o->variants;
     if (!o->config.empty())
       a.config = host::run::read_run_config(o->config, host::run::ablation_base_config());
     if (!o->calib.empty()) a.config.import.calib = o->calib;
     a.engine = this_executable();
     std::string line = "litgs-engine ablate " + o->input + " --out " + o->out + " --study " + o->study;
+    if (!o->variants.empty()) line += " --variants " + o->variants;
     if (!o->config.empty()) line += " --config " + o->config;
+    if (!o->calib.empty()) line += " --calib " + o->calib;
     host::run::run_ablation(a, line, std::cout);
   });
 }

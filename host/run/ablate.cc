@@ -234,8 +234,35 @@ std::vector<AblationStudy> ablation_studies(const std::string& names, const RunC
   return studies;
 }
 
+std::vector<AblationStudy> keep_variants(std::vector<AblationStudy> studies, const std::string& names) {
+  if (names.empty()) return studies;
+  const std::vector<std::string> wanted = split_commas(names);
+  std::string known;
+  for (const AblationStudy& s : studies)
+    for (const AblationVariant& v : s.variants) known += (known.empty() ? "" : ", ") + v.name;
+  for (const std::string& name : wanted) {
+    const bool found = std::any_of(studies.begin(), studies.end(), [&](const AblationStudy& s) {
+      return std::any_of(s.variants.begin(), s.variants.end(),
+                         [&](const AblationVariant& v) { return v.name == name; });
+    });
+    if (!found)
+      throw std::invalid_argument("--variants " + names + ": '" + name +
+                                  "' is not a variant of the studies asked for (" + known + ")");
+  }
+  for (AblationStudy& s : studies)
+    s.variants.erase(std::remove_if(s.variants.begin(), s.variants.end(),
+                                    [&](const AblationVariant& v) {
+                                      return std::find(wanted.begin(), wanted.end(), v.name) == wanted.end();
+                                    }),
+                     s.variants.end());
+  studies.erase(std::remove_if(studies.begin(), studies.end(),
+                               [](const AblationStudy& s) { return s.variants.empty(); }),
+                studies.end());
+  return studies;
+}
+
 std::string run_ablation(const AblateOptions& o, const std::string& command_line, std::ostream& out) {
-  const std::vector<AblationStudy> studies = ablation_studies(o.study, o.config);
+  const std::vector<AblationStudy> studies = keep_variants(ablation_studies(o.study, o.config), o.variants);
   size_t total = 0, done = 0;
   for (const auto& s : studies) total += s.variants.size();
   std::string md = "Made by `" + command_line + "`.\n";

@@ -40,6 +40,11 @@ struct AblationStudy {
 // std::invalid_argument for another name.
 std::vector<AblationStudy> ablation_studies(const std::string& names, const RunConfig& base);
 
+// Only the variants named in `names` (a comma-separated list of AblationVariant::name, e.g.
+// "sift-clahe,xfeat"; empty: all), studies left without any dropped. std::invalid_argument naming a name that
+// is no variant of `studies`, with the names there are.
+std::vector<AblationStudy> keep_variants(std::vector<AblationStudy> studies, const std::string& names);
+
 // The settings every variant starts from: run's defaults, but a fixed budget of 40k Gaussians (run's default
 // grows it). Each variant then differs from the others in its studied option only, where a budget grown (or
 // searched) per variant would move with the studied option and be a second difference between the rows.
@@ -49,6 +54,7 @@ struct AblateOptions {
   std::string input;
   std::filesystem::path out_dir;
   std::string study = "all";
+  std::string variants;  // keep_variants: empty, all of each study's
   RunConfig config = ablation_base_config();
   std::filesystem::path engine;
 };

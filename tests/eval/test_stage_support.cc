@@ -166,6 +166,31 @@ TEST(AblationStudies, ACommaSeparatedListRunsEachStudyOnceInItsOrder) {
   EXPECT_THROW(ablation_studies("refine,", base), std::invalid_argument);  // an empty name
 }
 
+TEST(AblationStudies, NamedVariantsKeepTheirStudiesOrderAndABadNameListsTheOthers) {
+  RunConfig base;
+  base.train.max_gaussians = "8000";
+  const auto kept = keep_variants(ablation_studies("refine,features", base), "xfeat-clahe,off,sift");
+  ASSERT_EQ(kept.size(), 2u);
+  ASSERT_EQ(kept[0].variants.size(), 1u);
+  EXPECT_EQ(kept[0].variants[0].name, "off");
+  ASSERT_EQ(kept[1].variants.size(), 2u);  // in the study's order, not the list's
+  EXPECT_EQ(kept[1].variants[0].name, "sift");
+  EXPECT_EQ(kept[1].variants[1].name, "xfeat-clahe");
+  const auto one_study = keep_variants(ablation_studies("refine,features", base), "on");
+  ASSERT_EQ(one_study.size(), 1u);  // the features study had none left
+  EXPECT_EQ(one_study[0].name, "refine");
+  EXPECT_EQ(keep_variants(ablation_studies("lambda", base), "").at(0).variants.size(), 5u);
+  try {
+    keep_variants(ablation_studies("features", base), "sift,surf");
+    FAIL() << "a name that is no variant was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("'surf' is not a variant"), std::string::npos) << what;
+    EXPECT_NE(what.find("xfeat-lighterglue-clahe"), std::string::npos) << what;
+  }
+  EXPECT_THROW(keep_variants(ablation_studies("refine", base), "sift"), std::invalid_argument);
+}
+
 TEST(AblationStudies, TheStrategyStudyComparesADerivedBudgetWithFixedOnes) {
   RunConfig base;
   base.train.max_gaussians = "auto";
