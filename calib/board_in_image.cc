@@ -10,8 +10,8 @@
 
 #include "calib/circle_grid.h"
 #include "calib/layout_fit.h"
-#include "calib/robust_stats.h"
 #include "io/lens_distortion.h"
+#include "io/robust_stats.h"
 
 namespace litgs::calib {
 namespace {
@@ -64,7 +64,7 @@ bool hole_centroid(const cv::Mat& values, const std::vector<cv::Point>& contour,
   const auto board_level = [&](int x, int y) { return board(0) + board(1) * x + board(2) * y; };
   const Eigen::Vector2d middle = Eigen::Vector2d(AtA(0, 1), AtA(0, 2)) / AtA(0, 0);
   const double contrast =
-      median(inside) - board_level(static_cast<int>(middle.x()), static_cast<int>(middle.y()));
+      io::median(inside) - board_level(static_cast<int>(middle.x()), static_cast<int>(middle.y()));
   // A dead band of two noise sigmas (the ring's spread about its plane), so that the board's own noise does
   // not weigh in and pull the centroid towards the window's centre.
   std::vector<double> spread;
@@ -72,7 +72,7 @@ bool hole_centroid(const cv::Mat& values, const std::vector<cv::Point>& contour,
     if (!by) spread.push_back(std::abs(values.at<double>(y, x) - board_level(x, y)));
   });
   // On a noisy frame the band stops at half the way to full weight, not to lose the hole.
-  const double full = 0.5 * std::abs(contrast), floor = std::min(2 * 1.4826 * median(spread), 0.5 * full);
+  const double full = 0.5 * std::abs(contrast), floor = std::min(2 * 1.4826 * io::median(spread), 0.5 * full);
   if (!(full > 0)) return false;
   const double sign = contrast > 0 ? 1 : -1;
   double w = 0, sx = 0, sy = 0;

@@ -8,7 +8,7 @@
 #include <stdexcept>
 
 #include "calib/layout_fit.h"
-#include "calib/robust_stats.h"
+#include "io/robust_stats.h"
 
 namespace litgs::calib {
 namespace {
@@ -65,7 +65,7 @@ std::vector<std::vector<size_t>> segments(const std::vector<Eigen::Vector3d>& p,
   for (size_t r = 1; r < rings.size(); ++r) ring_steps.push_back(rings[r].elevation - rings[r - 1].elevation);
   for (const Ring& r : rings)
     for (size_t k = 1; k < r.azimuth.size(); ++k) az_steps.push_back(r.azimuth[k] - r.azimuth[k - 1]);
-  const double step = std::max(median(ring_steps), median(az_steps));
+  const double step = std::max(io::median(ring_steps), io::median(az_steps));
   const auto near = [&](size_t a, size_t b) { return (p[a] - p[b]).norm() < 3 * step * p[a].norm() + 0.05; };
   UnionFind uf(p.size());
   for (size_t r = 0; r < rings.size(); ++r) {
@@ -215,7 +215,7 @@ BoardInScan find_board_in_scan(const std::vector<Eigen::Vector3d>& p, const Hole
     if (az.size() < 4) continue;
     std::vector<double> steps;
     for (size_t k = 1; k < az.size(); ++k) steps.push_back(az[k] - az[k - 1]);
-    const double step = median(steps);
+    const double step = io::median(steps);
     // The edge lies past the last return by half a step on average, less the half divergence with which a
     // beam still touching the board returns from it.
     const double shift = step / 2 - o.beam_divergence_rad / 2;

@@ -8,8 +8,8 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "calib/robust_stats.h"
 #include "io/lens_distortion.h"
+#include "io/robust_stats.h"
 
 namespace litgs::calib {
 namespace {
@@ -161,12 +161,10 @@ ExtrinsicResult solve_extrinsic(const std::vector<ExtrinsicView>& views, const i
   Solution s = solve(all, K);
   view_errors(s.T, all);
   // Outlier views left out, then solved again.
-  std::vector<double> errors, deviations;
+  std::vector<double> errors;
   for (const auto& r : result.views)
     if (r.rms_px >= 0) errors.push_back(r.rms_px);
-  const double mid = median(errors);
-  for (double e : errors) deviations.push_back(std::abs(e - mid));
-  const double bound = std::max(1.0, mid + options.outlier_k * 1.4826 * median(deviations));
+  const double bound = io::robust_upper_bound(errors, options.outlier_k, 1.0);
   std::vector<Pair> kept;
   for (const Pair& p : all)
     if (result.views[p.view].rms_px <= bound) kept.push_back(p);

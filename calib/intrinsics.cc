@@ -6,7 +6,7 @@
 #include <opencv2/calib3d.hpp>
 #include <stdexcept>
 
-#include "calib/robust_stats.h"
+#include "io/robust_stats.h"
 
 namespace litgs::calib {
 namespace {
@@ -115,10 +115,7 @@ IntrinsicsResult calibrate_intrinsics(const std::vector<CalibrationView>& views,
   };
   Solve s = run(candidates);
   // Views whose error is an outlier against the others' are left out, and the camera is calibrated again.
-  std::vector<double> deviation;
-  const double m = median(s.per_view_rms);
-  for (double e : s.per_view_rms) deviation.push_back(std::abs(e - m));
-  const double bound = std::max(0.5, m + o.outlier_k * 1.4826 * median(deviation));
+  const double bound = io::robust_upper_bound(s.per_view_rms, o.outlier_k, 0.5);
   std::vector<size_t> kept;
   for (size_t k = 0; k < candidates.size(); ++k) {
     if (s.per_view_rms[k] <= bound) {

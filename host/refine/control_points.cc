@@ -4,6 +4,7 @@
 
 #include "host/refine/bundle_adjustment.h"
 #include "host/refine/weights.h"
+#include "io/robust_stats.h"
 
 namespace litgs::host::refine {
 
@@ -43,8 +44,8 @@ ControlPointErrors control_point_errors(const io::MetashapeDocument& doc,
     throw std::invalid_argument(
         "control points: no marker observation matches a surveyed point and a frame of the scene");
   r.observations = before.size();
-  r.median_prior_px = median(before);
-  r.median_refined_px = median(after);
+  r.median_prior_px = io::median(before);
+  r.median_refined_px = io::median(after);
   return r;
 }
 

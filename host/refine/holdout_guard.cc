@@ -8,6 +8,7 @@
 
 #include "host/refine/bundle_adjustment.h"
 #include "host/refine/triangulate_track.h"
+#include "io/robust_stats.h"
 
 namespace litgs::host::refine {
 namespace {
@@ -40,12 +41,6 @@ std::optional<Eigen::Vector3d> fit_point(const std::vector<Observation>& obs,
   }
   if (!X.allFinite()) return std::nullopt;
   return X;
-}
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
 }
 
 }  // namespace
@@ -99,8 +94,8 @@ HoldoutVerdict judge_on_held_out(const std::vector<TrackPoint>& held_out,
     ++v.tracks_used;
   }
   v.observations = e_prior.size();
-  v.prior_median_px = median_of(e_prior);
-  v.refined_median_px = median_of(e_refined);
+  v.prior_median_px = io::median(e_prior);
+  v.refined_median_px = io::median(e_refined);
   v.measured = v.tracks_used >= o.min_tracks;
   v.keep_refined = !v.measured || v.refined_median_px <= (1 + o.tolerance) * v.prior_median_px;
   char text[320];

@@ -8,17 +8,10 @@
 #include <stdexcept>
 
 #include "host/refine/weights.h"
+#include "io/robust_stats.h"
 
 namespace litgs::host::refine {
 namespace {
-
-// median + k * 1.4826 * MAD, at least floor.
-double robust_bound(const std::vector<double>& v, double k, double floor) {
-  const double m = median(v);
-  std::vector<double> dev;
-  for (double x : v) dev.push_back(std::abs(x - m));
-  return std::max(floor, m + k * 1.4826 * median(dev));
-}
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -115,7 +108,7 @@ ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::v
   }
   if (!e.empty()) {
     s.reprojection_rms_px = std::sqrt(sum2 / static_cast<double>(e.size()));
-    s.reprojection_median_px = median(e);
+    s.reprojection_median_px = io::median(e);
   }
   if (s.anchored_observations)
     s.anchored_reprojection_rms_px = std::sqrt(anchored2 / static_cast<double>(s.anchored_observations));
@@ -190,7 +183,7 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
   if (report.fewest_frame_observations == SIZE_MAX) report.fewest_frame_observations = 0;
   if (n > 0) {
     std::vector<double> counts(per_frame.begin(), per_frame.end());
-    report.median_frame_observations = median(counts);
+    report.median_frame_observations = io::median(counts);
   }
   if (in.points.empty()) {
     report.status = "stopped: no tracks (the front end found none to refine with); poses kept as the priors";
@@ -271,8 +264,8 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
           if (ob.active) e.push_back(reprojection_error_px(poses[ob.frame], in.camera, p.X, ob.uv));
         if (p.has_plane) d.push_back(std::abs(p.plane.n.dot(p.X - p.plane.l)));
       }
-      rr.reject_bound_px = robust_bound(e, o.reject_k, o.reject_floor_px);
-      rr.reject_bound_m = robust_bound(d, o.reject_k, o.reject_floor_m);
+      rr.reject_bound_px = io::robust_upper_bound(e, o.reject_k, o.reject_floor_px);
+      rr.reject_bound_m = io::robust_upper_bound(d, o.reject_k, o.reject_floor_m);
       for (auto& p : in.points) {
         if (!p.active) continue;
         for (auto& ob : p.obs)

@@ -6,22 +6,18 @@
 #include <limits>
 #include <stdexcept>
 
-namespace litgs::host::refine {
+#include "io/robust_stats.h"
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+namespace litgs::host::refine {
 
 namespace {
 
 // (x - median) / (1.4826 MAD), with the scale floored at `floor` so that a constant sequence gives zeros.
 std::vector<double> standardize(const std::vector<double>& x, double floor) {
-  const double m = median(x);
+  const double m = io::median(x);
   std::vector<double> dev;
   for (double v : x) dev.push_back(std::abs(v - m));
-  const double scale = std::max(1.4826 * median(dev), floor);
+  const double scale = std::max(1.4826 * io::median(dev), floor);
   std::vector<double> z;
   for (double v : x) z.push_back((v - m) / scale);
   return z;
@@ -83,7 +79,7 @@ AnchorWeights anchor_weights(const std::vector<AnchorPoint>& anchors, const Weig
     w.guarded += raised;
     raw.push_back(1.0 / std::sqrt(c.determinant()));
   }
-  w.median_raw = median(raw);
+  w.median_raw = io::median(raw);
   for (double r : raw) w.weights.push_back(w.median_raw > 0 ? r / w.median_raw : 1.0);
   return w;
 }

@@ -24,8 +24,6 @@ struct WeightOptions {
 
 // Linear and angular speed per frame (central differences, one-sided at the ends), standardized by the
 // sequence's median and 1.4826 * MAD (a floor keeps a constant-speed sequence finite), averaged.
-// The upper median (0 for an empty set).
-double median(std::vector<double> values);
 
 std::vector<double> motion_scores(const std::vector<CameraPose>& poses);
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "host/train/point_kdtree.h"
+#include "io/robust_stats.h"
 
 namespace litgs::host {
 
@@ -220,18 +221,11 @@ std::vector<float> PlaneDistance::distances(const std::vector<float>& means) con
 }
 
 float PlaneDistance::robust_bound(const std::vector<float>& d, double k, double floor_m) {
-  std::vector<float> v;
+  std::vector<double> v;
   for (float x : d)
     if (std::isfinite(x)) v.push_back(x);
   if (v.empty()) return std::numeric_limits<float>::infinity();
-  auto median = [](std::vector<float> a) {
-    std::nth_element(a.begin(), a.begin() + static_cast<long>(a.size() / 2), a.end());
-    return a[a.size() / 2];
-  };
-  const float med = median(v);
-  for (float& x : v) x = std::abs(x - med);
-  const float mad = median(v);
-  return static_cast<float>(std::max(floor_m, med + k * 1.4826 * mad));
+  return static_cast<float>(io::robust_upper_bound(v, k, floor_m));
 }
 
 }  // namespace litgs::host

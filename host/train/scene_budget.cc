@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "host/train/point_kdtree.h"
+#include "io/robust_stats.h"
 
 namespace litgs::host {
 namespace {
@@ -21,12 +22,6 @@ double finest_footprint_m(const Eigen::Vector3d& p, const std::vector<kernels::S
     best = std::min(best, q.z / std::sqrt(c.fx * c.fy));
   }
   return best;
-}
-
-double median_of(std::vector<double> v) {
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
 }
 
 }  // namespace
@@ -71,7 +66,7 @@ SceneBudget derive_scene_budget(const std::vector<Eigen::Vector3d>& points,
   if (seen.empty())
     throw std::invalid_argument("scene budget: none of the " + std::to_string(points.size()) +
                                 " points lies inside a training view: no surface to derive a budget from");
-  b.median_footprint_m = median_of(footprint);
+  b.median_footprint_m = io::median(footprint);
 
   // r_k of every seen point (itself is the first neighbour found). A lone point stands for one Gaussian.
   const size_t k = std::min<size_t>(o.neighbours, seen.size() - 1);
@@ -87,10 +82,7 @@ SceneBudget derive_scene_budget(const std::vector<Eigen::Vector3d>& points,
           tree.knnSearch(seen[i].data(), static_cast<uint32_t>(k + 1), idx.data(), d2.data());
       radius[i] = std::sqrt(d2[found - 1]);
     }
-    const double median = median_of(radius);
-    std::vector<double> deviation(radius.size());
-    for (size_t i = 0; i < radius.size(); ++i) deviation[i] = std::abs(radius[i] - median);
-    const double limit = median + o.outlier_mads * 1.4826 * median_of(deviation);
+    const double limit = io::robust_upper_bound(radius, o.outlier_mads, 0.0);
     for (double& r : radius) r = std::min(r, limit);
   }
 

@@ -1,9 +1,10 @@
-#include "calib/robust_stats.h"
+#include "io/robust_stats.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 
-namespace litgs::calib {
+namespace litgs::io {
 
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return 0;
@@ -20,4 +21,13 @@ double median(std::vector<double> v) {
   return *at;
 }
 
-}  // namespace litgs::calib
+double robust_upper_bound(const std::vector<double>& values, double k, double floor) {
+  if (values.empty()) return floor;
+  const double m = median(values);
+  std::vector<double> deviation;
+  deviation.reserve(values.size());
+  for (double x : values) deviation.push_back(std::abs(x - m));
+  return std::max(floor, m + k * 1.4826 * median(std::move(deviation)));
+}
+
+}  // namespace litgs::io
