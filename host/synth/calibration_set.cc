@@ -1,5 +1,6 @@
 #include "host/synth/calibration_set.h"
 
+#include <optional>
 #include <stdexcept>
 
 #include "host/synth/m2dgr_rig.h"
@@ -30,6 +31,33 @@ void check_shared_options(const SynthOptions& o) {
     throw std::invalid_argument("synth: " + problem);
 }
 
+// The scene preset made through M2DGR's calibration file (--rig), whose camera and extrinsics a board set
+// takes; none without --rig.
+std::optional<Preset> rig_preset(const SynthOptions& o) {
+  if (o.rig.empty()) return std::nullopt;
+  Preset p = make_preset(preset_names().front(), o.seed, Appearance::kTextured);
+  apply_m2dgr_rig({o.rig, o.rig_camera_block, o.rig_imu_block}, o.width, o.height, p);
+  return p;
+}
+
+// `camera` as the rig's thermal camera, or a default pinhole of --width x --height (320x256 unless given),
+// with the scene presets' optics blur and the sensor's noise times --sensor-noise.
+ThermalCameraOptions board_camera(const SynthOptions& o, ThermalCameraOptions camera,
+                                  const std::optional<Preset>& rig) {
+  if (rig) {
+    camera.calibrated = rig->camera.calibrated;
+    camera.width = rig->camera.width;
+    camera.height = rig->camera.height;
+  } else {
+    camera.width = o.width.value_or(320);
+    camera.height = o.height.value_or(256);
+  }
+  camera.blur_px = 0.5;  // the optics' blur of the scene presets' textured appearance
+  camera.temporal_noise_raw *= o.sensor_noise;
+  camera.fixed_pattern_raw *= o.sensor_noise;
+  return camera;
+}
+
 }  // namespace
 
 CalibrationSetReport generate_calibration_set(const SynthOptions& o, bool hot_circles) {
@@ -38,28 +66,19 @@ CalibrationSetReport generate_calibration_set(const SynthOptions& o, bool hot_ci
   check_shared_options(o);
 
   CircleGridViewOptions c;
-  if (!o.rig.empty()) {
-    Preset p = make_preset(preset_names().front(), o.seed, Appearance::kTextured);
-    apply_m2dgr_rig({o.rig, o.rig_camera_block, o.rig_imu_block}, o.width, o.height, p);
+  const std::optional<Preset> rig = rig_preset(o);
+  c.camera = board_camera(o, c.camera, rig);
+  if (rig) {
     // The board held nearer a wider lens, so that it fills about as much of the image as with the default.
     ThermalCameraOptions reference;
-    reference.width = p.camera.width;
-    reference.height = p.camera.height;
-    const double nearer = p.camera.calibrated->fx / reference.intrinsics().fx;
+    reference.width = c.camera.width;
+    reference.height = c.camera.height;
+    const double nearer = c.camera.calibrated->fx / reference.intrinsics().fx;
     c.min_distance_m *= nearer;
     c.max_distance_m *= nearer;
-    c.camera.calibrated = p.camera.calibrated;
-    c.camera.width = p.camera.width;
-    c.camera.height = p.camera.height;
-  } else {
-    c.camera.width = o.width.value_or(320);
-    c.camera.height = o.height.value_or(256);
   }
   if (o.range_noise_m)
     throw std::invalid_argument("synth: --range-noise applies to --preset holed-board only");
-  c.camera.blur_px = 0.5;  // the optics' blur of the scene presets' textured appearance
-  c.camera.temporal_noise_raw *= o.sensor_noise;
-  c.camera.fixed_pattern_raw *= o.sensor_noise;
   c.views = o.frames.value_or(40);
   c.seed = o.seed;
   c.hot_circles = hot_circles;
@@ -67,7 +86,7 @@ CalibrationSetReport generate_calibration_set(const SynthOptions& o, bool hot_ci
     throw std::invalid_argument("synth: circle grid: " + problem);
   prepare_synth_output(o.out, o.force, {"images", "truth.json"}, "images/ and truth.json");
   write_circle_grid_set(o.out, c, resolve_synth_threads(o.threads));
-  return {c.views, c.grid, c.camera.intrinsics().width, c.camera.intrinsics().height, !o.rig.empty()};
+  return {c.views, c.grid, c.camera.intrinsics().width, c.camera.intrinsics().height, rig.has_value()};
 }
 
 HoledBoardSetReport generate_holed_board_set(const SynthOptions& o) {
@@ -75,20 +94,9 @@ HoledBoardSetReport generate_holed_board_set(const SynthOptions& o) {
     throw std::invalid_argument("synth: generate_holed_board_set needs preset holed-board, got " + o.preset);
   check_shared_options(o);
   HoledBoardViewOptions h;
-  if (!o.rig.empty()) {
-    Preset p = make_preset(preset_names().front(), o.seed, Appearance::kTextured);
-    apply_m2dgr_rig({o.rig, o.rig_camera_block, o.rig_imu_block}, o.width, o.height, p);
-    h.camera.calibrated = p.camera.calibrated;
-    h.camera.width = p.camera.width;
-    h.camera.height = p.camera.height;
-    h.T_lidar_cam = p.T_imu_lidar.inverse() * p.T_imu_cam;
-  } else {
-    h.camera.width = o.width.value_or(320);
-    h.camera.height = o.height.value_or(256);
-  }
-  h.camera.blur_px = 0.5;  // the optics' blur of the scene presets' textured appearance
-  h.camera.temporal_noise_raw *= o.sensor_noise;
-  h.camera.fixed_pattern_raw *= o.sensor_noise;
+  const std::optional<Preset> rig = rig_preset(o);
+  h.camera = board_camera(o, h.camera, rig);
+  if (rig) h.T_lidar_cam = rig->T_imu_lidar.inverse() * rig->T_imu_cam;
   if (o.range_noise_m) h.lidar.range_noise_m = *o.range_noise_m;
   h.views = o.frames.value_or(40);
   h.seed = o.seed;
@@ -97,7 +105,7 @@ HoledBoardSetReport generate_holed_board_set(const SynthOptions& o) {
   prepare_synth_output(o.out, o.force, {"images", "scans", "board.yaml", "camera.yaml", "truth.json"},
                        "images/, scans/, board.yaml, camera.yaml and truth.json");
   write_holed_board_set(o.out, h, resolve_synth_threads(o.threads));
-  return {h.views, h.camera.intrinsics().width, h.camera.intrinsics().height, !o.rig.empty()};
+  return {h.views, h.camera.intrinsics().width, h.camera.intrinsics().height, rig.has_value()};
 }
 
 }  // namespace litgs::host::synth
