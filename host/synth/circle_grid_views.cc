@@ -29,11 +29,7 @@ World board_world(const CircleGridViewOptions& o) {
   board.circles.origin_v_m = margin;
   board.circles.raw = o.hot_circles ? std::abs(g.raw) : -std::abs(g.raw);
   const int board_texture = w.add_texture(board);
-  ThermalTexture wall;
-  wall.base_raw = 3300;
-  wall.noise_raw = 20;
-  wall.noise_scale_m = 1;
-  const int wall_texture = w.add_texture(wall);
+  const int wall_texture = w.add_texture(calibration_room_wall());
   Rect r;
   r.origin = Eigen::Vector3d(-margin, -margin, 0);
   r.u_axis = Eigen::Vector3d::UnitX();

@@ -28,10 +28,7 @@ World board_world(const HoledBoardViewOptions& o, const Eigen::Matrix3d& R_world
   board.noise_raw = 3;
   board.noise_scale_m = 0.2;
   const int board_texture = w.add_texture(board);
-  ThermalTexture wall;
-  wall.base_raw = 3300;
-  wall.noise_raw = 20;
-  wall.noise_scale_m = 1;
+  const ThermalTexture wall = calibration_room_wall();
   const int wall_texture = w.add_texture(wall);
   ThermalTexture ground = wall;
   ground.base_raw = 3450;

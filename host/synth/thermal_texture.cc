@@ -82,6 +82,14 @@ double circle_coverage(const CircleGridPattern& g, double u, double v, double fo
 
 }  // namespace
 
+ThermalTexture calibration_room_wall() {
+  ThermalTexture wall;
+  wall.base_raw = 3300;
+  wall.noise_raw = 20;
+  wall.noise_scale_m = 1;
+  return wall;
+}
+
 double thermal_radiance(const ThermalTexture& t, double u, double v, double footprint_m) {
   double raw = t.base_raw + t.gradient_v_raw_per_m * v;
   raw += t.noise_raw * value_noise(u / t.noise_scale_m, v / t.noise_scale_m, t.seed);

@@ -60,6 +60,10 @@ struct ThermalTexture {
   uint64_t seed = 0;          // varies the noise and per-cell offsets between surfaces
 };
 
+// The room's wall behind a calibration board: plaster at 3,300 counts with 20 counts of metre-sized
+// blotches, cooler than the board and than the scene presets' ground.
+ThermalTexture calibration_room_wall();
+
 // Radiance in raw counts at (u, v). `footprint_m` is the pixel's footprint on the surface: joints are box-
 // filtered over it, so distant brick walls fade to their mean instead of aliasing.
 double thermal_radiance(const ThermalTexture& texture, double u_m, double v_m, double footprint_m);
