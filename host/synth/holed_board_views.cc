@@ -33,7 +33,7 @@ World board_world(const HoledBoardViewOptions& o, const Eigen::Matrix3d& R_world
   ThermalTexture ground = wall;
   ground.base_raw = 3450;
   const int ground_texture = w.add_texture(ground);
-  const HoledBoardSpec& b = o.board;
+  const calib::HoledBoard& b = o.board;
   Rect r;
   r.origin = centre + R_world_board * Eigen::Vector3d(-b.width_m / 2, -b.height_m / 2, 0);
   r.u_axis = R_world_board.col(0);
@@ -94,8 +94,11 @@ std::string HoledBoardViewOptions::check() const {
   if (const std::string c = camera.check(); !c.empty()) return c;
   if (const std::string c = lidar.check(); !c.empty()) return "lidar: " + c;
   if (lidar.pattern != LidarPattern::kSpinning) return "lidar: a spinning pattern is needed (rings)";
-  if (!(board.width_m > 0 && board.height_m > 0 && board.hole_radius_m > 0) || board.holes.size() < 4)
-    return "board: positive sizes and at least 4 holes";
+  try {
+    board.check();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
   if (views < 1) return "views must be >= 1";
   if (!(min_distance_m > 0 && max_distance_m >= min_distance_m)) return "distances: 0 < min <= max";
   if (!(max_tilt_deg >= 0 && max_tilt_deg < 70)) return "max_tilt_deg must be in [0, 70)";
@@ -105,7 +108,7 @@ std::string HoledBoardViewOptions::check() const {
 std::vector<HoledBoardView> render_holed_board_views(const HoledBoardViewOptions& o, int threads) {
   if (const std::string c = o.check(); !c.empty()) throw std::invalid_argument("holed board views: " + c);
   const io::CameraIntrinsics K = o.camera.intrinsics();
-  const HoledBoardSpec& b = o.board;
+  const calib::HoledBoard& b = o.board;
   Rng rng(o.seed, Stream::kCalibration);
   std::vector<HoledBoardView> out;
   int attempts = 0;
@@ -183,13 +186,7 @@ void write_holed_board_set(const std::filesystem::path& dir, const HoledBoardVie
     io::write_pcd(dir / "scans" / (std::string(name) + ".pcd"), cloud);
     truth["views"].push_back({{"name", name}, {"T_cam_board", rows(views[i].T_cam_board.matrix())}});
   }
-  io::write_file_atomic(dir / "board.yaml", [&](std::ostream& s) {
-    s.precision(17);
-    s << "# The holed board of litgs-engine synth --preset holed-board (calib extrinsic's --board)\n"
-      << "width: " << o.board.width_m << "\nheight: " << o.board.height_m
-      << "\nhole_radius: " << o.board.hole_radius_m << "\nholes:\n";
-    for (const Eigen::Vector2d& h : o.board.holes) s << "  - [" << h.x() << ", " << h.y() << "]\n";
-  });
+  calib::write_holed_board(dir / "board.yaml", o.board);
   io::write_file_atomic(dir / "camera.yaml", [&](std::ostream& s) {
     s << "# The synthetic camera's true intrinsics\n" << io::camera_yaml_block(K);
   });

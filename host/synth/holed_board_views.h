@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "calib/holed_board.h"
 #include "host/synth/lidar_sim.h"
 #include "host/synth/thermal_camera.h"
 
@@ -17,16 +18,10 @@ namespace litgs::host::synth {
 
 inline constexpr const char* kHoledBoardPreset = "holed-board";
 
-// The board as calib/holed_board.h reads it from board.yaml: origin at its centre, x right, y down.
-struct HoledBoardSpec {
-  double width_m = 1.0, height_m = 0.8, hole_radius_m = 0.12;
-  std::vector<Eigen::Vector2d> holes = {{-0.25, -0.2}, {0.25, -0.2}, {0.25, 0.2}, {-0.25, 0.2}};
-};
-
 struct HoledBoardViewOptions {
   ThermalCameraOptions camera;
   LidarOptions lidar = velodyne_like();
-  HoledBoardSpec board;
+  calib::HoledBoard board;  // as calib extrinsic reads it from board.yaml
   // The rig: the camera's pose in the LiDAR frame (LiDAR x forward, y left, z up; camera z forward).
   Eigen::Isometry3d T_lidar_cam = default_rig();
   int views = 40;

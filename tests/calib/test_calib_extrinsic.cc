@@ -305,5 +305,15 @@ TEST(CalibExtrinsicBadInput, ABoardFileWithAnUnknownKeyOrOverlappingHolesIsRefus
   fs::remove_all(dir);
 }
 
+TEST(HoledBoardFile, TheSyntheticSetRefusesABoardTheSolverWouldRefuse) {
+  host::synth::HoledBoardViewOptions o;
+  EXPECT_EQ(o.check(), "");
+  o.board.holes[1] = o.board.holes[0] + Eigen::Vector2d(0.1, 0);  // within 2.5 radii of hole 1
+  EXPECT_NE(o.check().find("holes 1 and 2 are less than 2.5 radii apart"), std::string::npos) << o.check();
+  host::synth::HoledBoardViewOptions edge;
+  edge.board.holes[2].x() = 0.45;  // 0.45 + 0.12 reaches past the half width, 0.5
+  EXPECT_NE(edge.check().find("hole 3 reaches the board's edge"), std::string::npos) << edge.check();
+}
+
 }  // namespace
 }  // namespace litgs::calib
