@@ -21,6 +21,7 @@ struct Ring {
   std::vector<size_t> points;  // sorted by azimuth
   std::vector<double> azimuth;
   double elevation = 0;
+  double elevation_span = 0;  // highest minus lowest return's elevation
 };
 
 std::vector<Ring> split_rings(const std::vector<Eigen::Vector3d>& p, const BoardInScanOptions& o) {
@@ -38,6 +39,7 @@ std::vector<Ring> split_rings(const std::vector<Eigen::Vector3d>& p, const Board
   for (size_t k = 0; k < idx.size(); ++k) {
     if (k == 0 || el[idx[k]] - el[idx[k - 1]] > kRingSplitRad) rings.emplace_back();
     rings.back().points.push_back(idx[k]);
+    rings.back().elevation_span = el[idx[k]] - el[rings.back().points.front()];  // idx rises in elevation
   }
   for (Ring& r : rings) {
     std::sort(r.points.begin(), r.points.end(), [&](size_t a, size_t b) { return az[a] < az[b]; });
@@ -145,13 +147,7 @@ BoardInScan find_board_in_scan(const std::vector<Eigen::Vector3d>& p, const Hole
   // A spinning LiDAR's returns fall on a few dozen cones of one elevation each; a non-repetitive pattern's
   // (Livox) spread over the field of view.
   double widest = 0;
-  for (const Ring& r : rings) {
-    const auto [lo, hi] = std::minmax_element(r.points.begin(), r.points.end(), [&](size_t a, size_t b) {
-      return std::atan2(p[a].z(), p[a].head<2>().norm()) < std::atan2(p[b].z(), p[b].head<2>().norm());
-    });
-    widest = std::max(widest, std::atan2(p[*hi].z(), p[*hi].head<2>().norm()) -
-                                  std::atan2(p[*lo].z(), p[*lo].head<2>().norm()));
-  }
+  for (const Ring& r : rings) widest = std::max(widest, r.elevation_span);
   if (rings.size() > 512 || widest > 1 * kDeg) {
     out.why_not = "the returns form no rings of one elevation each (" + std::to_string(rings.size()) +
                   " groups, the widest over " + std::to_string(static_cast<int>(std::ceil(widest / kDeg))) +
