@@ -25,6 +25,9 @@ fs::path block_dir(const fs::path& dir, const std::string& name) {
 fs::path block_model(const fs::path& dir, const std::string& name) {
   return block_dir(dir, name) / kBlockTrainDir / "point_cloud.ply";
 }
+fs::path block_trace(const fs::path& dir, const std::string& name) {
+  return block_dir(dir, name) / kBlockTrainDir / kBlockTrace;
+}
 fs::path block_log(const fs::path& dir, const std::string& name) {
   return block_dir(dir, name) / "train.log";
 }
@@ -34,6 +37,7 @@ std::vector<std::string> train_command(const fs::path& dir, const std::string& n
   std::vector<std::string> args = {"train", block_dir(dir, name).string(), "--out",
                                    (block_dir(dir, name) / kBlockTrainDir).string()};
   args.insert(args.end(), extra.begin(), extra.end());
+  args.insert(args.end(), {"--trace", block_trace(dir, name).string()});
   return args;
 }
 
@@ -90,6 +94,7 @@ BlockTrainingReport train_local(const fs::path& dir, const fs::path& engine,
         b.state = "done before";
       } else {
         std::ostream quiet(nullptr);
+        fs::remove(block_trace(dir, b.name));  // a failed try's reports: train appends to the file
         const run::ChildResult c =
             run::run_child(engine, train_command(dir, b.name, o.train_args), b.log, quiet);
         b.seconds = c.seconds;
@@ -120,7 +125,10 @@ BlockTrainingReport train_slurm(const fs::path& dir, const fs::path& engine,
   BlockTrainingReport r;
   std::vector<std::string> pending;
   for (const auto& b : blocks)
-    if (!fs::exists(block_model(dir, b.name))) pending.push_back(b.name);
+    if (!fs::exists(block_model(dir, b.name))) {
+      pending.push_back(b.name);
+      fs::remove(block_trace(dir, b.name));  // a failed try's reports: train appends to the file
+    }
   if (!pending.empty()) {
     BlockTrainingOptions with_defaults = o;
     with_defaults.slurm = default_slurm_resources(dir, o.slurm);
@@ -190,6 +198,7 @@ std::string slurm_array_script(const fs::path& dir, const fs::path& engine,
     << "exec " << shell_quote(engine.string()) << " train \"$scene\" --out \"$scene/" << kBlockTrainDir
     << "\"";
   for (const auto& a : o.train_args) s << " " << shell_quote(a);
+  s << " --trace \"$scene/" << kBlockTrainDir << "/" << kBlockTrace << "\"";
   s << " >> \"$scene/train.log\" 2>&1\n";
   return s.str();
 }

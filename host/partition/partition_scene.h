@@ -20,7 +20,8 @@ namespace litgs::host::partition {
 
 inline constexpr const char* kPartitionFile = "partition.json";
 inline constexpr const char* kBlocksDir = "blocks";
-inline constexpr const char* kBlockTrainDir = "train";  // a block's training output, inside its scene
+inline constexpr const char* kBlockTrainDir = "train";     // a block's training output, inside its scene
+inline constexpr const char* kBlockTrace = "trace.jsonl";  // its progress reports, inside kBlockTrainDir
 
 struct PartitionReport {
   BlockPlan plan;

@@ -46,7 +46,10 @@ TrainInBlocksReport train_in_blocks(const fs::path& scene, const fs::path& out, 
          {"gaussians", r.merge.blocks.at(k).gaussians},
          {"kept", r.merge.blocks.at(k).kept},
          {"peak_device_bytes", block_training_metric(dir / kBlocksDir / b.name, "peak_device_bytes")},
-         {"log", b.log.string()}});
+         {"log", b.log.string()},
+         // Its loss curve, relative to `out` (the run report draws one per block).
+         {"trace",
+          (dir / kBlocksDir / b.name / kBlockTrainDir / kBlockTrace).lexically_relative(out).string()}});
   }
   const nlohmann::json metrics = {{"gaussians", r.merge.gaussians},
                                   {"wall_s", r.seconds},
@@ -54,7 +57,8 @@ TrainInBlocksReport train_in_blocks(const fs::path& scene, const fs::path& out, 
                                   {"columns", r.partition.plan.columns},
                                   {"rows", r.partition.plan.rows},
                                   {"blocks", blocks}};
-  // One training's loss curve has no meaning here; the run report reads an empty one.
+  // One training's loss curve has no meaning here (each block has its own: blocks[].trace); the run
+  // report reads an empty one.
   io::write_file_atomic(out / "trace.jsonl", [](std::ostream&) {});
   io::write_file_atomic(out / "metrics.json", [&](std::ostream& os) { os << metrics.dump(2) << "\n"; });
   return r;

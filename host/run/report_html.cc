@@ -202,14 +202,19 @@ const char* kChartsScript = R"(
       options:Object.assign({scales:scales}, common)}); };
   const line = (label, data, colour, axisId) => ({label:label, data:data, borderColor:colour,
       backgroundColor:colour, pointRadius:3, borderWidth:2, yAxisID:axisId||'y'});
-  make('psnr_iter', [line('held-out PSNR (dB)', evalAt, '#d62728'),
-                     line('training loss', d.trace.map(p => ({x:p.iteration, y:p.loss})), '#1f77b4', 'y2')],
+  // One training's curve, or one per block of a training in blocks (each block's own clock).
+  const palette = ['#1f77b4', '#2ca02c', '#9467bd', '#e377c2', '#7f7f7f', '#bcbd22', '#17becf', '#8c564b'];
+  const curves = d.blocks.length ? d.blocks.map((b, k) => ({label: ' (' + b.name + ')', curve: b.curve,
+      colour: palette[k % palette.length]})) : [{label: '', curve: d.trace, colour: '#1f77b4'}];
+  const losses = x => curves.map(c => line('training loss' + c.label, c.curve.map(p => ({x:p[x], y:p.loss})),
+      c.colour, 'y2'));
+  make('psnr_iter', [line('held-out PSNR (dB)', evalAt, '#d62728')].concat(losses('iteration')),
        'iteration', 'PSNR (dB)', 'loss');
-  make('psnr_time', [line('held-out PSNR (dB)', d.evaluations.map(e => ({x:timeAt(e.iteration), y:e.psnr_db})), '#d62728'),
-                     line('training loss', d.trace.map(p => ({x:p.seconds, y:p.loss})), '#1f77b4', 'y2')],
+  make('psnr_time', [line('held-out PSNR (dB)', d.evaluations.map(e => ({x:timeAt(e.iteration), y:e.psnr_db})), '#d62728')]
+                      .concat(losses('seconds')),
        'training time (s)', 'PSNR (dB)', 'loss');
-  make('gaussians', [line('Gaussians', d.trace.map(p => ({x:p.iteration, y:p.gaussians})), '#2ca02c')],
-       'iteration', 'Gaussians');
+  make('gaussians', curves.map(c => line('Gaussians' + c.label, c.curve.map(p => ({x:p.iteration, y:p.gaussians})),
+       d.blocks.length ? c.colour : '#2ca02c')), 'iteration', 'Gaussians');
   let drawn = 3;
   // A budget grown inside the training: validation PSNR against its size and against time, the phase that
   // stopped the growth drawn larger.
@@ -335,6 +340,18 @@ std::string trace_curve_json(const std::string& text) {
   return curve.dump();
 }
 
+json block_curves_json(const fs::path& train_dir, const json& metrics) {
+  json out = json::array();
+  for (const json& b : metrics.value("blocks", json::array())) {
+    const json trace = json_field(b, "trace");
+    if (!trace.is_string() || !fs::exists(train_dir / trace.get<std::string>())) continue;
+    out.push_back(
+        {{"name", b.value("name", "")},
+         {"curve", json::parse(trace_curve_json(read_text(train_dir / trace.get<std::string>())))}});
+  }
+  return out;
+}
+
 std::string report_html(const fs::path& run_dir, unsigned max_views) {
   const json metrics = read_json(run_dir / "train" / "metrics.json");
   const json eval = read_json(run_dir / "eval" / "eval.json");
@@ -346,6 +363,7 @@ std::string report_html(const fs::path& run_dir, unsigned max_views) {
   const json trajectory = eval.value("trajectory", json());
   const json growth = metrics.value("budget_growth", json());
   const json data = {{"trace", trace},
+                     {"blocks", block_curves_json(run_dir / "train", metrics)},
                      {"evaluations", evaluations},
                      {"growth", growth.is_null() ? json() : growth_chart_json(growth)},
                      {"trajectory", trajectory.is_object() ? trajectory : json(nullptr)}};

@@ -14,8 +14,8 @@
 namespace litgs::host::run {
 
 // Reads DIR/run.json (optional), DIR/train/budget.json (optional), DIR/train/metrics.json,
-// DIR/train/trace.jsonl, DIR/eval/eval.json and the pictures it lists. io::IoError naming a missing or
-// malformed file.
+// DIR/train/trace.jsonl (a training in blocks: each block's), DIR/eval/eval.json and the pictures it lists.
+// io::IoError naming a missing or malformed file.
 std::string report_html(const std::filesystem::path& run_dir, unsigned max_views);
 
 // The training's progress records as one curve: a resumed run appends records from its checkpoint's iteration
@@ -23,6 +23,11 @@ std::string report_html(const std::filesystem::path& run_dir, unsigned max_views
 // session's seconds continue from the last kept record. Returns [{iteration, seconds, loss, gaussians,
 // psnr_db}] in iteration order.
 std::string trace_curve_json(const std::string& trace_jsonl_text);
+
+// A training in blocks (metrics.json's `blocks`, each with its `trace` relative to `train_dir`): each block's
+// curve as trace_curve_json gives it, [{name, curve}], blocks without a trace file left out; [] for one
+// training.
+nlohmann::json block_curves_json(const std::filesystem::path& train_dir, const nlohmann::json& metrics);
 
 // A JSON number with `digits` decimals and `unit` appended; an en dash (&ndash;) where it is not a number.
 std::string number(const nlohmann::json& v, int digits, const std::string& unit = "");

@@ -155,6 +155,29 @@ TEST(Report, TraceCurveOfAResumedRun) {
   EXPECT_DOUBLE_EQ(c[3]["seconds"].get<double>(), 42.0);
 }
 
+TEST(Report, EachBlockOfATrainingInBlocksHasItsOwnCurve) {
+  const std::filesystem::path train =
+      std::filesystem::temp_directory_path() / ("litgs-report-blocks-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(train);
+  std::filesystem::create_directories(train / "partition/blocks/block-0-0/train");
+  std::ofstream(train / "partition/blocks/block-0-0/train/trace.jsonl")
+      << "{\"iteration\":1,\"session_s\":1.0,\"loss\":0.5,\"gaussians\":10}\n"
+         "{\"iteration\":50,\"session_s\":9.0,\"loss\":0.2,\"gaussians\":40}\n";
+  const nlohmann::json metrics = {
+      {"blocks",
+       {{{"name", "block-0-0"}, {"trace", "partition/blocks/block-0-0/train/trace.jsonl"}},
+        {{"name", "block-1-0"}, {"trace", "partition/blocks/block-1-0/train/trace.jsonl"}},  // trained before
+        {{"name", "block-2-0"}}}}};  // an older record
+  const nlohmann::json curves = block_curves_json(train, metrics);
+  ASSERT_EQ(curves.size(), 1u) << curves.dump();
+  EXPECT_EQ(curves[0]["name"], "block-0-0");
+  ASSERT_EQ(curves[0]["curve"].size(), 2u);
+  EXPECT_EQ(curves[0]["curve"][1]["gaussians"], 40);
+  EXPECT_DOUBLE_EQ(curves[0]["curve"][1]["seconds"].get<double>(), 9.0);
+  EXPECT_TRUE(block_curves_json(train, {{"gaussians", 5}}).empty());  // one training: no blocks
+  std::filesystem::remove_all(train);
+}
+
 // One table row per budget tried, from its <tr to its </tr>.
 std::string table_row(const std::string& html, const std::string& first_cell) {
   const size_t cell = html.find("><td>" + first_cell + "</td>");

@@ -49,7 +49,7 @@ class BlockTrainingTest : public ::testing::Test {
         << "[ \"$1\" = train ] || exit 2\n"
         << "case \"$2\" in *\"${FAIL_BLOCK:-none}\") echo \"cannot train $2\"; exit 1;; esac\n"
         << "mkdir -p \"$4\" && cp " << (dir_ / "model.ply").string()
-        << " \"$4/point_cloud.ply\" && echo \"trained $2 with $5 $6\"\n";
+        << " \"$4/point_cloud.ply\" && echo \"trained $2 with $5 $6 (all: $*)\"\n";
     ::chmod(engine_.c_str(), 0755);
   }
   void TearDown() override {
@@ -71,6 +71,10 @@ TEST_F(BlockTrainingTest, LocalTrainsEveryBlockAndARerunSkipsThem) {
     std::ifstream log(b.log);
     const std::string text(std::istreambuf_iterator<char>(log), {});
     EXPECT_NE(text.find("with --iterations 7"), std::string::npos) << text;
+    // Each block's progress reports go to its own trace, which the run report draws.
+    EXPECT_NE(text.find("--trace " + (dir_ / "part/blocks" / b.name / "train/trace.jsonl").string()),
+              std::string::npos)
+        << text;
   }
   for (const auto& b : train_blocks(dir_ / "part", engine_, o).blocks) EXPECT_EQ(b.state, "done before");
 }
@@ -123,6 +127,7 @@ TEST_F(BlockTrainingTest, TheArrayScriptTrainsTheBlockOfItsTaskId) {
   EXPECT_NE(script.find("#SBATCH --array=0-1\n"), std::string::npos) << script;
   EXPECT_NE(script.find("#SBATCH --gres=gpu:1\n"), std::string::npos) << script;
   EXPECT_NE(script.find("#SBATCH --mem=" + o.slurm.mem + "\n"), std::string::npos) << script;
+  EXPECT_NE(script.find("--trace \"$scene/train/trace.jsonl\""), std::string::npos) << script;
   std::ofstream(dir_ / "task.sh") << script;
   const std::string command = "SLURM_ARRAY_TASK_ID=1 bash " + (dir_ / "task.sh").string();
   ASSERT_EQ(std::system(command.c_str()), 0) << script;

@@ -155,6 +155,35 @@ TEST_F(RunReport, AGrownBudgetDrawsItsTwoGrowthCharts) {
   EXPECT_NE(b.out.find("Grown inside the training"), std::string::npos);
 }
 
+// The same run as if trained in two blocks (metrics.json's blocks, each with its own trace; the top-level
+// trace empty, as train_in_blocks writes them): the charts draw each block's curves.
+TEST_F(RunReport, ATrainingInBlocksDrawsEachBlocksCurves) {
+  const fs::path blocks = kRoot / "e2e-blocks";
+  fs::remove_all(blocks);
+  fs::create_directories(blocks / "train");
+  for (const char* part : {"run.json", "train/metrics.json"})
+    fs::copy_file(report_.parent_path() / part, blocks / part);
+  write_text(blocks / "train/trace.jsonl", "");
+  fs::copy(report_.parent_path() / "eval", blocks / "eval", fs::copy_options::recursive);
+  nlohmann::json metrics = nlohmann::json::parse(slurp(blocks / "train/metrics.json"));
+  metrics["blocks"] = nlohmann::json::array();
+  for (const char* name : {"block-0-0", "block-1-0"}) {
+    const std::string trace = std::string("partition/blocks/") + name + "/train/trace.jsonl";
+    fs::create_directories((blocks / "train" / trace).parent_path());
+    fs::copy_file(report_.parent_path() / "train/trace.jsonl", blocks / "train" / trace);
+    metrics["blocks"].push_back({{"name", name}, {"trace", trace}});
+  }
+  write_text(blocks / "train/metrics.json", metrics.dump());
+  const std::string cmd = std::string(LITGS_ENGINE_BINARY) + " report --run " + blocks.string() + " > " +
+                          (blocks / "report.log").string() + " 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(blocks / "report.log");
+  const Browser b = chromium(blocks / "report.html", "--dump-dom");
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_EQ(console_lines(b.err), std::vector<std::string>{}) << "console messages while loading the report";
+  EXPECT_NE(b.out.find("data-charts=\"5\""), std::string::npos) << "the chart script did not finish";
+  EXPECT_NE(slurp(blocks / "report.html").find("\"name\":\"block-1-0\""), std::string::npos);
+}
+
 TEST_F(RunReport, ScreenshotShowsChartsAndPictures) {
   // Layout (report_html.cc's style, CSS pixels = screenshot pixels): the charts in rows 40..340, the
   // held-out views from about 380 on, 196 rows each.

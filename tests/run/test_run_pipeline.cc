@@ -253,7 +253,18 @@ TEST(RunStages, TrainInBlocksMergesAndEvaluatesTheWholeScene) {
     EXPECT_GT(b["kept"].get<size_t>(), 0u);
     EXPECT_GT(b["peak_device_bytes"].get<double>(), 0) << "gathered from the block's own metrics.json";
     kept += b["kept"].get<size_t>();
+    std::ifstream trace(dir / "train" / b["trace"].get<std::string>());
+    EXPECT_TRUE(trace.good()) << "each block reports its progress to its own trace: " << b["trace"];
   }
+  // The report draws each block's curve: its data block holds both, each with its progress records.
+  std::ifstream report_file(dir / "report.html");
+  const std::string report(std::istreambuf_iterator<char>(report_file), {});
+  const size_t data = report.find("id=data>");
+  ASSERT_NE(data, std::string::npos);
+  const nlohmann::json charts =
+      nlohmann::json::parse(report.substr(data + 8, report.find("</script>", data) - data - 8));
+  ASSERT_EQ(charts["blocks"].size(), 2u);
+  for (const auto& b : charts["blocks"]) EXPECT_FALSE(b["curve"].empty()) << b["name"];
   EXPECT_EQ(metrics["gaussians"].get<size_t>(), kept);
   const nlohmann::json eval = read_json_file(dir / "eval" / "eval.json");
   ASSERT_TRUE(eval.is_object()) << r.output;
