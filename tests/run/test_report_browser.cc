@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -99,6 +100,32 @@ class RunReport : public ::testing::Test {
                                      << "runs it first as this test's fixture)";
     ASSERT_TRUE(fs::exists("/usr/bin/chromium")) << "install chromium (ci/setup)";
   }
+  // A copy of the end-to-end run's folder as `name` (the run's metrics, evaluation and, unless
+  // `with_trace`, an empty trace), whose metrics.json `edit` changes.
+  fs::path copy_run(const char* name, bool with_trace, const std::function<void(nlohmann::json&)>& edit) {
+    const fs::path dir = kRoot / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir / "train");
+    for (const char* part : {"run.json", "train/metrics.json", "train/trace.jsonl"})
+      fs::copy_file(report_.parent_path() / part, dir / part);
+    if (!with_trace) write_text(dir / "train/trace.jsonl", "");
+    fs::copy(report_.parent_path() / "eval", dir / "eval", fs::copy_options::recursive);
+    nlohmann::json metrics = nlohmann::json::parse(slurp(dir / "train/metrics.json"));
+    edit(metrics);
+    write_text(dir / "train/metrics.json", metrics.dump());
+    return dir;
+  }
+  // `litgs-engine report` on `dir`, then its page in Chromium: the DOM, and no console message.
+  static Browser report_in_chromium(const fs::path& dir) {
+    const std::string cmd = std::string(LITGS_ENGINE_BINARY) + " report --run " + dir.string() + " > " +
+                            (dir / "report.log").string() + " 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(dir / "report.log");
+    const Browser b = chromium(dir / "report.html", "--dump-dom");
+    EXPECT_EQ(b.status, 0) << b.err;
+    EXPECT_EQ(console_lines(b.err), std::vector<std::string>{})
+        << "console messages while loading the report";
+    return b;
+  }
   fs::path report_;
 };
 
@@ -124,32 +151,21 @@ TEST_F(RunReport, LoadsWithoutConsoleMessagesAndDrawsItsCharts) {
 // The same run as if its budget had grown inside the training (metrics.json's budget_growth, as
 // BudgetGrowth::to_json writes it): the Budget section's two growth charts are drawn too.
 TEST_F(RunReport, AGrownBudgetDrawsItsTwoGrowthCharts) {
-  const fs::path grown = kRoot / "e2e-grown";
-  fs::remove_all(grown);
-  fs::create_directories(grown / "train");
-  for (const char* part : {"run.json", "train/metrics.json", "train/trace.jsonl"})
-    fs::copy_file(report_.parent_path() / part, grown / part);
-  fs::copy(report_.parent_path() / "eval", grown / "eval", fs::copy_options::recursive);
-  nlohmann::json metrics = nlohmann::json::parse(slurp(grown / "train/metrics.json"));
-  metrics["budget_growth"] = nlohmann::json::parse(R"json({"budget": 20000, "ceiling": 8000000,
-    "stop_reason": "stop: validation gained 0.010 dB", "last_scored_view_psnr_db": [],
-    "last_scored_training_psnr_db": [], "phases": [
-    {"iteration": 600, "budget": 5000, "gaussians": 5000, "validation_psnr_db": 30.1, "gain_db": null,
-     "gain_se_db": null, "training_psnr_db": 31.0, "training_gain_db": null, "wall_s": 10.0,
-     "decision": "grow: first score; budget 10000"},
-    {"iteration": 900, "budget": 10000, "gaussians": 10000, "validation_psnr_db": 30.9, "gain_db": 0.8,
-     "gain_se_db": 0.1, "training_psnr_db": 32.0, "training_gain_db": 1.0, "wall_s": 16.0,
-     "decision": "grow: validation gained 0.800 dB; budget 20000"},
-    {"iteration": 1200, "budget": 20000, "gaussians": 20000, "validation_psnr_db": 30.91, "gain_db": 0.01,
-     "gain_se_db": 0.1, "training_psnr_db": 32.5, "training_gain_db": 0.5, "wall_s": 25.0,
-     "decision": "stop: validation gained 0.010 dB"}]})json");
-  write_text(grown / "train/metrics.json", metrics.dump());
-  const std::string cmd = std::string(LITGS_ENGINE_BINARY) + " report --run " + grown.string() + " > " +
-                          (grown / "report.log").string() + " 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(grown / "report.log");
-  const Browser b = chromium(grown / "report.html", "--dump-dom");
-  ASSERT_EQ(b.status, 0) << b.err;
-  EXPECT_EQ(console_lines(b.err), std::vector<std::string>{}) << "console messages while loading the report";
+  const fs::path grown = copy_run("e2e-grown", true, [](nlohmann::json& metrics) {
+    metrics["budget_growth"] = nlohmann::json::parse(R"json({"budget": 20000, "ceiling": 8000000,
+      "stop_reason": "stop: validation gained 0.010 dB", "last_scored_view_psnr_db": [],
+      "last_scored_training_psnr_db": [], "phases": [
+      {"iteration": 600, "budget": 5000, "gaussians": 5000, "validation_psnr_db": 30.1, "gain_db": null,
+       "gain_se_db": null, "training_psnr_db": 31.0, "training_gain_db": null, "wall_s": 10.0,
+       "decision": "grow: first score; budget 10000"},
+      {"iteration": 900, "budget": 10000, "gaussians": 10000, "validation_psnr_db": 30.9, "gain_db": 0.8,
+       "gain_se_db": 0.1, "training_psnr_db": 32.0, "training_gain_db": 1.0, "wall_s": 16.0,
+       "decision": "grow: validation gained 0.800 dB; budget 20000"},
+      {"iteration": 1200, "budget": 20000, "gaussians": 20000, "validation_psnr_db": 30.91, "gain_db": 0.01,
+       "gain_se_db": 0.1, "training_psnr_db": 32.5, "training_gain_db": 0.5, "wall_s": 25.0,
+       "decision": "stop: validation gained 0.010 dB"}]})json");
+  });
+  const Browser b = report_in_chromium(grown);
   EXPECT_NE(b.out.find("data-charts=\"7\""), std::string::npos)
       << "the growth charts were not drawn beside the five of the run";
   EXPECT_NE(b.out.find("Grown inside the training"), std::string::npos);
@@ -158,28 +174,19 @@ TEST_F(RunReport, AGrownBudgetDrawsItsTwoGrowthCharts) {
 // The same run as if trained in two blocks (metrics.json's blocks, each with its own trace; the top-level
 // trace empty, as train_in_blocks writes them): the charts draw each block's curves.
 TEST_F(RunReport, ATrainingInBlocksDrawsEachBlocksCurves) {
-  const fs::path blocks = kRoot / "e2e-blocks";
-  fs::remove_all(blocks);
-  fs::create_directories(blocks / "train");
-  for (const char* part : {"run.json", "train/metrics.json"})
-    fs::copy_file(report_.parent_path() / part, blocks / part);
-  write_text(blocks / "train/trace.jsonl", "");
-  fs::copy(report_.parent_path() / "eval", blocks / "eval", fs::copy_options::recursive);
-  nlohmann::json metrics = nlohmann::json::parse(slurp(blocks / "train/metrics.json"));
-  metrics["blocks"] = nlohmann::json::array();
-  for (const char* name : {"block-0-0", "block-1-0"}) {
-    const std::string trace = std::string("partition/blocks/") + name + "/train/trace.jsonl";
-    fs::create_directories((blocks / "train" / trace).parent_path());
-    fs::copy_file(report_.parent_path() / "train/trace.jsonl", blocks / "train" / trace);
-    metrics["blocks"].push_back({{"name", name}, {"trace", trace}});
+  const fs::path blocks = copy_run("e2e-blocks", false, [](nlohmann::json& metrics) {
+    metrics["blocks"] = nlohmann::json::array();
+    for (const char* name : {"block-0-0", "block-1-0"})
+      metrics["blocks"].push_back(
+          {{"name", name}, {"trace", std::string("partition/blocks/") + name + "/train/trace.jsonl"}});
+  });
+  const nlohmann::json metrics = nlohmann::json::parse(slurp(blocks / "train/metrics.json"));
+  for (const auto& block : metrics["blocks"]) {
+    const fs::path trace = blocks / "train" / block["trace"].get<std::string>();
+    fs::create_directories(trace.parent_path());
+    fs::copy_file(report_.parent_path() / "train/trace.jsonl", trace);
   }
-  write_text(blocks / "train/metrics.json", metrics.dump());
-  const std::string cmd = std::string(LITGS_ENGINE_BINARY) + " report --run " + blocks.string() + " > " +
-                          (blocks / "report.log").string() + " 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(blocks / "report.log");
-  const Browser b = chromium(blocks / "report.html", "--dump-dom");
-  ASSERT_EQ(b.status, 0) << b.err;
-  EXPECT_EQ(console_lines(b.err), std::vector<std::string>{}) << "console messages while loading the report";
+  const Browser b = report_in_chromium(blocks);
   EXPECT_NE(b.out.find("data-charts=\"5\""), std::string::npos) << "the chart script did not finish";
   EXPECT_NE(slurp(blocks / "report.html").find("\"name\":\"block-1-0\""), std::string::npos);
 }
