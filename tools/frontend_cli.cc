@@ -39,6 +39,9 @@ void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli
   cmd.add_option("--grid", o.features.grid_cols, "Grid bucketing: N x N cells (0: off)")
       ->capture_default_str()
       ->each([&o](const std::string&) { o.features.grid_rows = o.features.grid_cols; });
+  cmd.add_option("--keypoint-spacing", o.features.min_spacing_px,
+                 "orb, sift, akaze: drop a keypoint nearer than this to a stronger one (pixels; 0: none)")
+      ->capture_default_str();
   cmd.add_option("--clahe-clip", o.preprocess.clahe_clip_limit, "CLAHE clip limit")->capture_default_str();
   cmd.add_option("--clahe-tiles", o.preprocess.clahe_tiles, "CLAHE tile grid N x N")->capture_default_str();
   cmd.add_option("--stretch-window", o.preprocess.stretch_window,

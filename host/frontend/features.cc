@@ -1,9 +1,12 @@
 #include "host/frontend/features.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <opencv2/features2d.hpp>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace litgs::host::frontend {
 
@@ -35,6 +38,43 @@ void FeatureOptions::check() const {
   if (grid_cols < 0 || grid_rows < 0 || grid_cols > 256 || grid_rows > 256 ||
       (grid_cols == 0) != (grid_rows == 0))
     throw std::invalid_argument("grid cells must be both 0 or both in 1..256");
+  if (!(min_spacing_px >= 0 && min_spacing_px <= 64))
+    throw std::invalid_argument("min_spacing_px must be in 0..64, got " + std::to_string(min_spacing_px));
+}
+
+std::vector<size_t> spaced_keypoints(const std::vector<float>& x, const std::vector<float>& y,
+                                     const std::vector<float>& response, double min_spacing) {
+  std::vector<size_t> order(x.size());
+  std::iota(order.begin(), order.end(), size_t{0});
+  if (!(min_spacing > 0)) return order;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return response[a] > response[b]; });
+  // Kept keypoints by grid cell of side min_spacing: a rival lies in the 3 x 3 cells around.
+  std::unordered_map<int64_t, std::vector<size_t>> cells;
+  const auto cell_of = [&](double v) { return static_cast<int64_t>(std::floor(v / min_spacing)); };
+  const auto key = [](int64_t cx, int64_t cy) { return cx * 1000003 + cy; };
+  constexpr double kSamePositionPx = 1e-3;
+  std::vector<size_t> kept;
+  for (size_t i : order) {
+    const int64_t cx = cell_of(x[i]), cy = cell_of(y[i]);
+    bool near = false;
+    for (int64_t dy = -1; dy <= 1 && !near; ++dy)
+      for (int64_t dx = -1; dx <= 1 && !near; ++dx) {
+        const auto c = cells.find(key(cx + dx, cy + dy));
+        if (c == cells.end()) continue;
+        for (size_t j : c->second) {
+          const double d = std::hypot(double(x[i]) - x[j], double(y[i]) - y[j]);
+          if (d > kSamePositionPx && d < min_spacing) {
+            near = true;
+            break;
+          }
+        }
+      }
+    if (near) continue;
+    cells[key(cx, cy)].push_back(i);
+    kept.push_back(i);
+  }
+  std::sort(kept.begin(), kept.end());
+  return kept;
 }
 
 std::vector<size_t> bucket_keypoints(const std::vector<float>& x, const std::vector<float>& y,
@@ -109,6 +149,20 @@ ImageFeatures detect_features(const Gray8& image, const FeatureOptions& o) {
     x.push_back(k.pt.x);
     y.push_back(k.pt.y);
     r.push_back(k.response);
+  }
+  if (o.min_spacing_px > 0) {
+    std::vector<cv::KeyPoint> spaced;
+    std::vector<float> sx, sy, sr;
+    for (size_t i : spaced_keypoints(x, y, r, o.min_spacing_px)) {
+      spaced.push_back(all[i]);
+      sx.push_back(x[i]);
+      sy.push_back(y[i]);
+      sr.push_back(r[i]);
+    }
+    all.swap(spaced);
+    x.swap(sx);
+    y.swap(sy);
+    r.swap(sr);
   }
   std::vector<cv::KeyPoint> kept;
   for (size_t i :

@@ -24,6 +24,10 @@ struct FeatureOptions {
   // Grid bucketing: each of grid_cols x grid_rows cells keeps its strongest max_keypoints / cells first, the
   // rest of the budget goes to the strongest left anywhere. 0 cells: strongest overall.
   int grid_cols = 8, grid_rows = 8;
+  // The classical detectors: a keypoint nearer than this to a stronger one is dropped before bucketing (0:
+  // none). A blurred feature found at two scales a pixel or two apart otherwise gives two keypoints whose
+  // matches put both in one track, a conflict that costs one of them.
+  double min_spacing_px = 0;
   void check() const;  // std::invalid_argument naming the field
 };
 
@@ -41,6 +45,12 @@ ImageFeatures detect_features(const Gray8& image, const FeatureOptions& options)
 // A detector that runs outside this library (a network on the Vulkan device), called once per kept frame,
 // possibly from several threads at once.
 using LearnedDetector = std::function<ImageFeatures(const Gray8&)>;
+
+// Indices of the keypoints at (x, y) that no stronger one lies within `min_spacing` pixels of (ties: the
+// lower index is the stronger); keypoints at one position (SIFT's orientations of one feature) are all
+// kept, as they are one feature. Sorted.
+std::vector<size_t> spaced_keypoints(const std::vector<float>& x, const std::vector<float>& y,
+                                     const std::vector<float>& response, double min_spacing);
 
 // Indices of at most `budget` of the keypoints at (x, y) with `response`: per cell of the grid the
 // strongest budget / cells first, then the strongest of the rest. Ties keep the lower index. Sorted.

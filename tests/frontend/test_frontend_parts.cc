@@ -4,6 +4,8 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
+#include <numeric>
 #include <random>
 
 #include "host/frontend/features.h"
@@ -222,6 +224,41 @@ TEST(FrontendFeatures, GridBucketingSpreadsTheBudget) {
   size_t outside_corner = 0;
   for (size_t i : spread) outside_corner += x[i] >= 20 || y[i] >= 20;
   EXPECT_GE(outside_corner, 24u * 2 - 8);  // the 24 other cells get their quota (minus the corner's share)
+}
+
+TEST(FrontendFeatures, SpacingDropsAKeypointNearAStrongerOneButNotTheOrientationsOfOne) {
+  //                          0      1      2      3      4      5      6
+  const std::vector<float> x = {10.0f, 11.0f, 10.0f, 13.0f, 19.9f, 20.1f, 30.0f};
+  const std::vector<float> y = {10.0f, 10.0f, 10.0f, 10.0f, 0.0f, 0.0f, 30.0f};
+  const std::vector<float> r = {5.0f, 3.0f, 1.0f, 4.0f, 2.0f, 2.0f, 0.5f};
+  // 1 lies 1 px from the stronger 0; 2 shares 0's position (another orientation); 3 is 3 px from 0 and
+  // 2 px from 1, which is dropped and so spares it; 5 ties with 4 (the lower index is the stronger) across
+  // a cell border of the search.
+  EXPECT_EQ(spaced_keypoints(x, y, r, 2.5), (std::vector<size_t>{0, 2, 3, 4, 6}));
+  EXPECT_EQ(spaced_keypoints(x, y, r, 0.5), (std::vector<size_t>{0, 1, 2, 3, 4, 6}));  // 5 is 0.2 px from 4
+  EXPECT_EQ(spaced_keypoints(x, y, r, 0).size(), x.size());
+  // Against every pair tested, on 600 random keypoints.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0, 60);
+  std::vector<float> rx, ry, rr;
+  for (int i = 0; i < 600; ++i) {
+    rx.push_back(u(rng));
+    ry.push_back(u(rng));
+    rr.push_back(u(rng));
+  }
+  std::vector<size_t> order(rx.size()), expected;
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return rr[a] > rr[b]; });
+  for (size_t i : order) {
+    bool near = false;
+    for (size_t j : expected) near = near || std::hypot(rx[i] - rx[j], ry[i] - ry[j]) < 3.0;
+    if (!near) expected.push_back(i);
+  }
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(spaced_keypoints(rx, ry, rr, 3.0), expected);
+  FeatureOptions bad;
+  bad.min_spacing_px = -1;
+  EXPECT_THROW(bad.check(), std::invalid_argument);
 }
 
 TEST(FrontendIntensity, PercentileStretchAndConstantImages) {
