@@ -116,8 +116,10 @@ ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::v
   return s;
 }
 
-RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const RefineOptions& o) {
-  o.check();
+namespace {
+
+// The rounds of the solve with o.holdout's tracks held back, judged on them at the end.
+RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, const RefineOptions& o) {
   const auto start = std::chrono::steady_clock::now();
   RefineReport report;
   const size_t n = in.priors.size();
@@ -301,6 +303,33 @@ RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const Refin
   report.after = residual_stats(in.points, poses, in.camera);
   report.seconds = seconds_since(start);
   return report;
+}
+
+}  // namespace
+
+RefineReport refine(RefineInput& in, std::vector<CameraPose>& poses, const RefineOptions& o) {
+  o.check();
+  if (o.holdout.every == 0) return solve_and_judge(in, poses, o);
+  RefineInput every_track = in;
+  std::vector<CameraPose> refit = poses;
+  RefineReport judged = solve_and_judge(in, poses, o);
+  if (judged.outcome != "refined") return judged;
+  // The held-back tracks judged the solve worth keeping: solve again with them in it, as a cross-validation
+  // refits on all the data (an eighth more tracks: docs/experiments.md, issue 44).
+  RefineOptions all = o;
+  all.holdout.every = 0;
+  RefineReport r = solve_and_judge(every_track, refit, all);
+  if (r.outcome != "refined") {
+    judged.notes.push_back("the solve with the held-back tracks in it " + r.outcome + " (" + r.status +
+                           "): the judged solve is kept");
+    return judged;
+  }
+  in = std::move(every_track);
+  poses = std::move(refit);
+  r.holdout = judged.holdout;
+  r.notes.insert(r.notes.begin(), judged.holdout.summary + "; then solved again with every track");
+  r.seconds += judged.seconds;
+  return r;
 }
 
 }  // namespace litgs::host::refine

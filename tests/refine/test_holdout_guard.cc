@@ -35,6 +35,26 @@ TEST(RefineHoldoutGuard, AGoodRefinementIsKeptAndExplainsTheHeldBackTracksBetter
   EXPECT_LT(ate(poses, s.truth), ate(s.input.priors, s.truth));
 }
 
+// Once the held-back tracks have judged the solve worth keeping, it is solved again with them in it: the
+// output is the solve over every track (the same as one that held none back), the verdict the guard's.
+TEST(RefineHoldoutGuard, AKeptRefinementIsSolvedAgainWithEveryTrack) {
+  TestScene s, all;
+  make_test_scene(s, {});
+  make_test_scene(all, {});
+  const size_t tracks = s.input.points.size();
+  std::vector<CameraPose> poses = s.input.priors, every = all.input.priors;
+  const RefineReport r = refine(s.input, poses, {});
+  ASSERT_EQ(r.outcome, "refined");
+  ASSERT_TRUE(r.holdout.measured);
+  EXPECT_EQ(s.input.points.size(), tracks) << "the held-back tracks are back in the output";
+  EXPECT_NE(r.notes.at(0).find("then solved again with every track"), std::string::npos) << r.notes.at(0);
+  RefineOptions unguarded;
+  unguarded.holdout.every = 0;
+  refine(all.input, every, unguarded);
+  for (size_t f = 0; f < poses.size(); ++f)
+    EXPECT_LT((poses[f].p_world_cam - every[f].p_world_cam).norm(), 1e-9) << "frame " << f;
+}
+
 // Built to fail: the tracks the solve sees are corrupted in the second half of the sequence (every
 // observation 12 px to the right, as a wrong time offset or a bad calibration would do), the held-back ones
 // are not. The solve turns those cameras to fit; the held-back tracks show it, and the priors are kept.
