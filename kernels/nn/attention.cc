@@ -14,8 +14,14 @@ using loss_detail::check_binding;
 
 AttentionKernels::AttentionKernels(engine::Context& context)
     : context_(&context),
-      linear_(make_kernel(context, "nn/nn_linear", NN_LINEAR_BINDING_COUNT, sizeof(NnLinearParams))),
-      matmul_(make_kernel(context, "nn/nn_matmul", NN_MATMUL_BINDING_COUNT, sizeof(NnMatmulParams))),
+      // The matrices read as texels (nn_shared.h): a vector gather on CPU drivers.
+      linear_(make_kernel(context, "nn/nn_linear", NN_LINEAR_BINDING_COUNT, sizeof(NnLinearParams), {},
+                          {{NN_LINEAR_BINDING_A, VK_FORMAT_R32_SFLOAT},
+                           {NN_LINEAR_BINDING_B, VK_FORMAT_R32_SFLOAT},
+                           {NN_LINEAR_BINDING_W, VK_FORMAT_R32_SFLOAT}})),
+      matmul_(make_kernel(
+          context, "nn/nn_matmul", NN_MATMUL_BINDING_COUNT, sizeof(NnMatmulParams), {},
+          {{NN_MATMUL_BINDING_A, VK_FORMAT_R32_SFLOAT}, {NN_MATMUL_BINDING_B, VK_FORMAT_R32_SFLOAT}})),
       rows_(make_kernel(context, "nn/nn_rows", NN_ROWS_BINDING_COUNT, sizeof(NnRowsParams))) {}
 
 AttentionKernels::~AttentionKernels() = default;

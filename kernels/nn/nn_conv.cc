@@ -23,7 +23,10 @@ void ConvShape::check() const {
 
 Conv2dKernel::Conv2dKernel(engine::Context& context)
     : context_(&context),
-      kernel_(make_kernel(context, "nn/nn_conv2d", NN_CONV_BINDING_COUNT, sizeof(NnConvParams))) {}
+      // The input and the weights as texels (nn_shared.h): a vector gather on CPU drivers.
+      kernel_(make_kernel(
+          context, "nn/nn_conv2d", NN_CONV_BINDING_COUNT, sizeof(NnConvParams), {},
+          {{NN_CONV_BINDING_IN, VK_FORMAT_R32_SFLOAT}, {NN_CONV_BINDING_WEIGHT, VK_FORMAT_R32_SFLOAT}})) {}
 
 Conv2dKernel::~Conv2dKernel() = default;
 

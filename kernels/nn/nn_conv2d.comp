@@ -11,8 +11,10 @@
 
 layout(local_size_x = NN_CONV_GROUP_SIZE) in;
 
-layout(std430, binding = NN_CONV_BINDING_IN) readonly buffer In { float x[]; };
-layout(std430, binding = NN_CONV_BINDING_WEIGHT) readonly buffer Weight { float w[]; };
+// The input and the weights are uniform texel buffers (R32_SFLOAT, nn_shared.h): on CPU drivers a texel
+// fetch is one vector gather, a storage-buffer load at a per-lane index a loop over the lanes.
+layout(binding = NN_CONV_BINDING_IN) uniform samplerBuffer x;
+layout(binding = NN_CONV_BINDING_WEIGHT) uniform samplerBuffer w;
 layout(std430, binding = NN_CONV_BINDING_BIAS) readonly buffer Bias { float b[]; };
 layout(std430, binding = NN_CONV_BINDING_OUT) writeonly buffer Out { float y[]; };
 layout(push_constant) uniform Push { NnConvParams p; };
@@ -49,12 +51,12 @@ void main() {
         float v[NN_CONV_PIXELS];
         [[unroll]] for (uint q = 0u; q < NN_CONV_PIXELS; ++q) {
           const int sx = x0 + int(q * NN_CONV_LANES * p.stride + kx);
-          v[q] = (sx >= 0 && sx < int(p.in_width)) ? x[row + uint(sx)] : 0.0;
+          v[q] = (sx >= 0 && sx < int(p.in_width)) ? texelFetch(x, int(row) + sx).x : 0.0;
         }
         const uint tap = (c * p.kernel + ky) * p.kernel + kx;
         // A block past the last channel reads the last channel's weights again and never writes them.
         [[unroll]] for (uint j = 0u; j < NN_CONV_OUTPUTS; ++j) {
-          const float wj = w[min(o0 + j, p.out_channels - 1u) * taps_per_output + tap];
+          const float wj = texelFetch(w, int(min(o0 + j, p.out_channels - 1u) * taps_per_output + tap)).x;
           [[unroll]] for (uint q = 0u; q < NN_CONV_PIXELS; ++q) sum[j][q] += wj * v[q];
         }
       }

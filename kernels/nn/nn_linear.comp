@@ -8,9 +8,10 @@
 #include "nn/nn_shared.h"
 #include "elementwise.glsl"
 
-layout(std430, binding = NN_LINEAR_BINDING_A) readonly buffer A { float a[]; };
-layout(std430, binding = NN_LINEAR_BINDING_B) readonly buffer B { float b[]; };
-layout(std430, binding = NN_LINEAR_BINDING_W) readonly buffer W { float w[]; };
+// a, b and w are uniform texel buffers (R32_SFLOAT, nn_shared.h): a vector gather on CPU drivers.
+layout(binding = NN_LINEAR_BINDING_A) uniform samplerBuffer a;
+layout(binding = NN_LINEAR_BINDING_B) uniform samplerBuffer b;
+layout(binding = NN_LINEAR_BINDING_W) uniform samplerBuffer w;
 layout(std430, binding = NN_LINEAR_BINDING_BIAS) readonly buffer Bias { float bias[]; };
 layout(std430, binding = NN_LINEAR_BINDING_R) readonly buffer R { float r[]; };
 layout(std430, binding = NN_LINEAR_BINDING_Y) writeonly buffer Y { float y[]; };
@@ -25,9 +26,10 @@ void main() {
   [[unroll]] for (uint j = 0u; j < NN_LINEAR_OUTPUTS; ++j)
     sum[j] = p.has_bias != 0u ? bias[min(o0 + j, p.outputs - 1u)] : 0.0;
   for (uint i = 0u; i < p.a_cols + p.b_cols; ++i) {
-    const float v = i < p.a_cols ? a[row * p.a_cols + i] : b[row * p.b_cols + i - p.a_cols];
+    const float v = i < p.a_cols ? texelFetch(a, int(row * p.a_cols + i)).x
+                                  : texelFetch(b, int(row * p.b_cols + i - p.a_cols)).x;
     // A block past the last output reads the last one's weights again and never writes them.
-    [[unroll]] for (uint j = 0u; j < NN_LINEAR_OUTPUTS; ++j) sum[j] += v * w[i * p.outputs + min(o0 + j, p.outputs - 1u)];
+    [[unroll]] for (uint j = 0u; j < NN_LINEAR_OUTPUTS; ++j) sum[j] += v * texelFetch(w, int(i * p.outputs + min(o0 + j, p.outputs - 1u))).x;
   }
   for (uint j = 0u; j < NN_LINEAR_OUTPUTS; ++j) {
     const uint o = o0 + j;

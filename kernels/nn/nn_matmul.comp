@@ -10,8 +10,9 @@
 #include "nn/nn_shared.h"
 #include "elementwise.glsl"
 
-layout(std430, binding = NN_MATMUL_BINDING_A) readonly buffer A { float a[]; };
-layout(std430, binding = NN_MATMUL_BINDING_B) readonly buffer B { float b[]; };
+// a and b are uniform texel buffers (R32_SFLOAT, nn_shared.h): a vector gather on CPU drivers.
+layout(binding = NN_MATMUL_BINDING_A) uniform samplerBuffer a;
+layout(binding = NN_MATMUL_BINDING_B) uniform samplerBuffer b;
 layout(std430, binding = NN_MATMUL_BINDING_Y) writeonly buffer Y { float y[]; };
 layout(push_constant) uniform Push { NnMatmulParams p; };
 
@@ -28,10 +29,10 @@ void main() {
   for (uint k = 0u; k < p.k; ++k) {
     // Rows and columns past the edges read the last one again and are never written.
     float va[NN_MATMUL_ROWS], vb[NN_MATMUL_OUTPUTS];
-    [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i) va[i] = a[p.a_offset + min(r0 + i, p.n - 1u) * p.k + k];
+    [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i) va[i] = texelFetch(a, int(p.a_offset + min(r0 + i, p.n - 1u) * p.k + k)).x;
     [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) {
       const uint c = min(c0 + j * NN_MATMUL_LANES, p.m - 1u);
-      vb[j] = b[p.b_offset + (p.transposed != 0u ? c * p.k + k : k * p.m + c)];
+      vb[j] = texelFetch(b, int(p.b_offset + (p.transposed != 0u ? c * p.k + k : k * p.m + c))).x;
     }
     [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i)
       [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) sum[i][j] += va[i] * vb[j];

@@ -17,8 +17,8 @@ using uint = uint32_t;
 #define NN_CONV_LANES 8  // invocations that interleave their pixels over one run of a row
 #define NN_CONV_RUN (NN_CONV_LANES * NN_CONV_PIXELS)
 #define NN_CONV_GROUP_SIZE 64     // tiles of one channel block per workgroup; the grid's y is the block
-#define NN_CONV_BINDING_IN 0      // [C_in][H_in][W_in]
-#define NN_CONV_BINDING_WEIGHT 1  // [C_out][C_in][k][k]
+#define NN_CONV_BINDING_IN 0      // [C_in][H_in][W_in] (R32_SFLOAT texels)
+#define NN_CONV_BINDING_WEIGHT 1  // [C_out][C_in][k][k] (R32_SFLOAT texels)
 #define NN_CONV_BINDING_BIAS 2    // [C_out]
 #define NN_CONV_BINDING_OUT 3     // [C_out][H_out][W_out] (out)
 #define NN_CONV_BINDING_COUNT 4
@@ -79,7 +79,7 @@ struct NnKeypointsParams {
 
 // nn_linear.comp: y = [a | b] w + bias (+ r): one invocation per row and NN_LINEAR_OUTPUTS outputs.
 #define NN_LINEAR_OUTPUTS 8
-#define NN_LINEAR_BINDING_A 0     // [rows][a_cols]
+#define NN_LINEAR_BINDING_A 0     // [rows][a_cols] (A, B and W: R32_SFLOAT texels)
 #define NN_LINEAR_BINDING_B 1     // [rows][b_cols], concatenated after a's columns (bound to a without)
 #define NN_LINEAR_BINDING_W 2     // [a_cols + b_cols][out]
 #define NN_LINEAR_BINDING_BIAS 3  // [out] (bound to w without)
@@ -100,7 +100,7 @@ struct NnLinearParams {
 #define NN_MATMUL_OUTPUTS 4
 #define NN_MATMUL_LANES 8
 #define NN_MATMUL_RUN (NN_MATMUL_LANES * NN_MATMUL_OUTPUTS)
-#define NN_MATMUL_BINDING_A 0
+#define NN_MATMUL_BINDING_A 0  // A and B: R32_SFLOAT texels
 #define NN_MATMUL_BINDING_B 1
 #define NN_MATMUL_BINDING_Y 2
 #define NN_MATMUL_BINDING_COUNT 3
