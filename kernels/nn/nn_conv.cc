@@ -21,12 +21,26 @@ void ConvShape::check() const {
     throw std::invalid_argument("ConvShape: the kernel is larger than the padded input");
 }
 
+std::vector<float> pack_conv_weights(const std::vector<float>& weight, uint32_t out_channels,
+                                     uint32_t in_channels, uint32_t kernel) {
+  const size_t taps = size_t{in_channels} * kernel * kernel;
+  if (weight.size() != size_t{out_channels} * taps)
+    throw std::invalid_argument("pack_conv_weights: " + std::to_string(weight.size()) + " weights for " +
+                                std::to_string(out_channels) + " x " + std::to_string(in_channels) + " x " +
+                                std::to_string(kernel) + " x " + std::to_string(kernel));
+  const size_t fours = (size_t{out_channels} + 3) / 4;
+  std::vector<float> packed(fours * taps * 4, 0.0f);
+  for (size_t o = 0; o < out_channels; ++o)
+    for (size_t t = 0; t < taps; ++t) packed[((o / 4) * taps + t) * 4 + o % 4] = weight[o * taps + t];
+  return packed;
+}
+
 Conv2dKernel::Conv2dKernel(engine::Context& context)
     : context_(&context),
       // The input and the weights as texels (nn_shared.h): a vector gather on CPU drivers.
-      kernel_(make_kernel(
-          context, "nn/nn_conv2d", NN_CONV_BINDING_COUNT, sizeof(NnConvParams), {},
-          {{NN_CONV_BINDING_IN, VK_FORMAT_R32_SFLOAT}, {NN_CONV_BINDING_WEIGHT, VK_FORMAT_R32_SFLOAT}})) {}
+      kernel_(make_kernel(context, "nn/nn_conv2d", NN_CONV_BINDING_COUNT, sizeof(NnConvParams), {},
+                          {{NN_CONV_BINDING_IN, VK_FORMAT_R32_SFLOAT},
+                           {NN_CONV_BINDING_WEIGHT, VK_FORMAT_R32G32B32A32_SFLOAT}})) {}
 
 Conv2dKernel::~Conv2dKernel() = default;
 
@@ -35,8 +49,8 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
   static const char* who = "Conv2dKernel::record";
   c.check();
   check_binding(who, "in", in, uint64_t{c.in_channels} * c.in_height * c.in_width * sizeof(float));
-  check_binding(who, "weight", weight,
-                uint64_t{c.out_channels} * c.in_channels * c.kernel * c.kernel * sizeof(float));
+  check_binding(who, "weight (packed)", weight,
+                (uint64_t{c.out_channels} + 3) / 4 * 4 * c.in_channels * c.kernel * c.kernel * sizeof(float));
   check_binding(who, "bias", bias, uint64_t{c.out_channels} * sizeof(float));
   check_binding(who, "out", out, c.out_elements() * sizeof(float));
   NnConvParams p{};

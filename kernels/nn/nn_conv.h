@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "engine/buffer.h"
 #include "engine/context.h"
@@ -23,6 +24,13 @@ struct ConvShape {
   uint64_t out_elements() const { return uint64_t{out_channels} * out_height() * out_width(); }
   void check() const;  // std::invalid_argument naming the bad field
 };
+
+// ONNX Conv weights [out_channels][in_channels][kernel][kernel] as nn_conv2d.comp reads them:
+// [ceil(out_channels / 4)][in_channels][kernel][kernel][4], four output channels per tap side by side (zeros
+// past the last channel), so that one four-float texel fetch serves four channels. std::invalid_argument
+// when `weight` does not hold out_channels * in_channels * kernel * kernel values.
+std::vector<float> pack_conv_weights(const std::vector<float>& weight, uint32_t out_channels,
+                                     uint32_t in_channels, uint32_t kernel);
 
 // A feature map's shape on the device: [channels][height][width] floats.
 struct MapShape {
@@ -58,7 +66,8 @@ class Conv2dKernel {
  public:
   explicit Conv2dKernel(engine::Context& context);
   ~Conv2dKernel();
-  // Records out = conv(in) (+ the activation). Buffers too small for the shape are std::invalid_argument.
+  // Records out = conv(in) (+ the activation); `weight` holds pack_conv_weights' layout. Buffers too small
+  // for the shape are std::invalid_argument.
   void record(engine::Sequence& sequence, const engine::Buffer& in, const engine::Buffer& weight,
               const engine::Buffer& bias, const engine::Buffer& out, const ConvShape& shape) const;
 

@@ -11,8 +11,9 @@
 
 layout(local_size_x = NN_CONV_GROUP_SIZE) in;
 
-// The input and the weights are uniform texel buffers (R32_SFLOAT, nn_shared.h): on CPU drivers a texel
-// fetch is one vector gather, a storage-buffer load at a per-lane index a loop over the lanes.
+// The input and the weights are uniform texel buffers (nn_shared.h): on CPU drivers a texel fetch is one
+// vector gather, a storage-buffer load at a per-lane index a loop over the lanes. The weights are packed
+// in fours of output channels (pack_conv_weights), so that one four-float fetch serves four channels.
 layout(binding = NN_CONV_BINDING_IN) uniform samplerBuffer x;
 layout(binding = NN_CONV_BINDING_WEIGHT) uniform samplerBuffer w;
 layout(std430, binding = NN_CONV_BINDING_BIAS) readonly buffer Bias { float b[]; };
@@ -35,6 +36,7 @@ void main() {
   const uint outputs = min(NN_CONV_OUTPUTS, p.out_channels - o0);
   const int y0 = int(oy * p.stride) - int(p.pad), x0 = int(ox0 * p.stride) - int(p.pad);
   const uint taps_per_output = p.in_channels * p.kernel * p.kernel;
+  const uint fours = (p.out_channels + 3u) / 4u;  // the packed weights' groups of four output channels
   // Constant bounds throughout, so that the compiler unrolls them and keeps the tile in registers.
   float sum[NN_CONV_OUTPUTS][NN_CONV_PIXELS];
   [[unroll]] for (uint j = 0u; j < NN_CONV_OUTPUTS; ++j) {
@@ -54,10 +56,16 @@ void main() {
           v[q] = (sx >= 0 && sx < int(p.in_width)) ? texelFetch(x, int(row) + sx).x : 0.0;
         }
         const uint tap = (c * p.kernel + ky) * p.kernel + kx;
-        // A block past the last channel reads the last channel's weights again and never writes them.
-        [[unroll]] for (uint j = 0u; j < NN_CONV_OUTPUTS; ++j) {
-          const float wj = texelFetch(w, int(min(o0 + j, p.out_channels - 1u) * taps_per_output + tap)).x;
-          [[unroll]] for (uint q = 0u; q < NN_CONV_PIXELS; ++q) sum[j][q] += wj * v[q];
+        // A block past the last four channels reads the last four's weights again and never writes them
+        // (the packing's zeros fill the last four).
+        [[unroll]] for (uint f = 0u; f < NN_CONV_OUTPUTS / 4u; ++f) {
+          const vec4 w4 = texelFetch(w, int(min(o0 / 4u + f, fours - 1u) * taps_per_output + tap));
+          [[unroll]] for (uint q = 0u; q < NN_CONV_PIXELS; ++q) {
+            sum[4u * f][q] += w4.x * v[q];
+            sum[4u * f + 1u][q] += w4.y * v[q];
+            sum[4u * f + 2u][q] += w4.z * v[q];
+            sum[4u * f + 3u][q] += w4.w * v[q];
+          }
         }
       }
     }

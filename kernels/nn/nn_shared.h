@@ -12,13 +12,13 @@ using uint = uint32_t;
 // ---- nn_conv2d.comp: one invocation per NN_CONV_OUTPUTS output channels at NN_CONV_PIXELS neighbouring
 // pixels of a row (a register tile: each weight loaded once for the pixels, each input value for the
 // channels) ----
-#define NN_CONV_OUTPUTS 8
+#define NN_CONV_OUTPUTS 8  // a multiple of 4: the packed weights serve four channels per fetch
 #define NN_CONV_PIXELS 4
 #define NN_CONV_LANES 8  // invocations that interleave their pixels over one run of a row
 #define NN_CONV_RUN (NN_CONV_LANES * NN_CONV_PIXELS)
 #define NN_CONV_GROUP_SIZE 64     // tiles of one channel block per workgroup; the grid's y is the block
 #define NN_CONV_BINDING_IN 0      // [C_in][H_in][W_in] (R32_SFLOAT texels)
-#define NN_CONV_BINDING_WEIGHT 1  // [C_out][C_in][k][k] (R32_SFLOAT texels)
+#define NN_CONV_BINDING_WEIGHT 1  // [ceil(C_out / 4)][C_in][k][k][4] (R32G32B32A32_SFLOAT texels; pack_conv_weights)
 #define NN_CONV_BINDING_BIAS 2    // [C_out]
 #define NN_CONV_BINDING_OUT 3     // [C_out][H_out][W_out] (out)
 #define NN_CONV_BINDING_COUNT 4

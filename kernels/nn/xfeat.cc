@@ -37,9 +37,10 @@ XfeatNetwork::XfeatNetwork(engine::Context& context, const nn::XfeatWeights& wei
                                 " convolutions, XFeat has 27");
   for (const nn::ConvWeights& c : weights.convs) {
     Layer l;
-    l.weight = std::make_unique<engine::DeviceArray<float>>(context, "xfeat: weight", c.weight.size());
+    const std::vector<float> packed = pack_conv_weights(c.weight, c.out_channels, c.in_channels, c.kernel);
+    l.weight = std::make_unique<engine::DeviceArray<float>>(context, "xfeat: weight", packed.size());
     l.bias = std::make_unique<engine::DeviceArray<float>>(context, "xfeat: bias", c.bias.size());
-    l.weight->upload(c.weight);
+    l.weight->upload(packed);
     l.bias->upload(c.bias);
     l.out_channels = c.out_channels;
     l.in_channels = c.in_channels;

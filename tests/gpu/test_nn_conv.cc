@@ -54,11 +54,13 @@ class NnConvTest : public testing::GpuTest {
                              w.pad,
                              relu ? uint32_t{NN_ACTIVATION_RELU} : uint32_t{NN_ACTIVATION_NONE}};
     const std::vector<float> input(in.values.begin(), in.values.end());
+    const std::vector<float> packed =
+        kernels::pack_conv_weights(w.weight, w.out_channels, w.in_channels, w.kernel);
     DeviceArray<float> x(context(), "test: in", input.size()),
-        weight(context(), "test: weight", w.weight.size()), bias(context(), "test: bias", w.bias.size()),
+        weight(context(), "test: weight", packed.size()), bias(context(), "test: bias", w.bias.size()),
         y(context(), "test: out", shape.out_elements());
     x.upload(input);
-    weight.upload(w.weight);
+    weight.upload(packed);
     bias.upload(w.bias);
     kernels::Conv2dKernel conv(context());
     engine::Sequence s(context());
@@ -99,6 +101,12 @@ TEST_F(NnConvTest, BadShapesAndShortBuffersAreRefused) {
   EXPECT_THROW(zero_stride.check(), std::invalid_argument);
   kernels::ConvShape too_large{1, 2, 2, 1, 5, 1, 0, NN_ACTIVATION_NONE};
   EXPECT_THROW(too_large.check(), std::invalid_argument);
+  // Weights of another shape than the one named, and unpacked weights where the packed ones are longer.
+  EXPECT_THROW(kernels::pack_conv_weights(std::vector<float>(17), 2, 1, 3), std::invalid_argument);
+  DeviceArray<float> unpacked(context(), "test: unpacked", 2 * 9), input(context(), "test: in", 64),
+      out(context(), "test: out", 2 * 64), bias(context(), "test: bias", 2);
+  EXPECT_THROW(conv.record(s, input.buffer(), unpacked.buffer(), bias.buffer(), out.buffer(), shape),
+               std::invalid_argument);
   kernels::MapKernel map(context());
   EXPECT_THROW(map.unfold(s, small.buffer(), small.buffer(), {2, 8, 8}, 8), std::invalid_argument);
 }
