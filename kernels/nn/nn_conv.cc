@@ -21,6 +21,10 @@ void ConvShape::check() const {
     throw std::invalid_argument("ConvShape: the kernel is larger than the padded input");
 }
 
+uint64_t packed_conv_weight_floats(uint32_t out_channels, uint32_t in_channels, uint32_t kernel) {
+  return (uint64_t{out_channels} + 3) / 4 * 4 * in_channels * kernel * kernel;
+}
+
 std::vector<float> pack_conv_weights(const std::vector<float>& weight, uint32_t out_channels,
                                      uint32_t in_channels, uint32_t kernel) {
   const size_t taps = size_t{in_channels} * kernel * kernel;
@@ -28,8 +32,7 @@ std::vector<float> pack_conv_weights(const std::vector<float>& weight, uint32_t 
     throw std::invalid_argument("pack_conv_weights: " + std::to_string(weight.size()) + " weights for " +
                                 std::to_string(out_channels) + " x " + std::to_string(in_channels) + " x " +
                                 std::to_string(kernel) + " x " + std::to_string(kernel));
-  const size_t fours = (size_t{out_channels} + 3) / 4;
-  std::vector<float> packed(fours * taps * 4, 0.0f);
+  std::vector<float> packed(packed_conv_weight_floats(out_channels, in_channels, kernel), 0.0f);
   for (size_t o = 0; o < out_channels; ++o)
     for (size_t t = 0; t < taps; ++t) packed[((o / 4) * taps + t) * 4 + o % 4] = weight[o * taps + t];
   return packed;
@@ -50,7 +53,7 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
   c.check();
   check_binding(who, "in", in, uint64_t{c.in_channels} * c.in_height * c.in_width * sizeof(float));
   check_binding(who, "weight (packed)", weight,
-                (uint64_t{c.out_channels} + 3) / 4 * 4 * c.in_channels * c.kernel * c.kernel * sizeof(float));
+                packed_conv_weight_floats(c.out_channels, c.in_channels, c.kernel) * sizeof(float));
   check_binding(who, "bias", bias, uint64_t{c.out_channels} * sizeof(float));
   check_binding(who, "out", out, c.out_elements() * sizeof(float));
   NnConvParams p{};

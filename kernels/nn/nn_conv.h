@@ -31,6 +31,8 @@ struct ConvShape {
 // when `weight` does not hold out_channels * in_channels * kernel * kernel values.
 std::vector<float> pack_conv_weights(const std::vector<float>& weight, uint32_t out_channels,
                                      uint32_t in_channels, uint32_t kernel);
+// The floats pack_conv_weights returns: 4 ceil(out_channels / 4) in_channels kernel^2.
+uint64_t packed_conv_weight_floats(uint32_t out_channels, uint32_t in_channels, uint32_t kernel);
 
 // A feature map's shape on the device: [channels][height][width] floats.
 struct MapShape {
