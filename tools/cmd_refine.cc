@@ -31,6 +31,10 @@ void add_refine_command(CLI::App& app) {
   c->add_option(R::kThreads.flag, o->refine.threads, R::kThreads.help)->capture_default_str();
   c->add_option("--window", o->refine.window, "Frames per local window in round 1 (0: none)")
       ->capture_default_str();
+  c->add_option("--pixel-loss-px", o->refine.ba.pixel_loss_px,
+                "Cauchy scale of the reprojection residual, pixels")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   c->add_option(R::kTracks.flag, o->tracks, R::kTracks.help)->capture_default_str();
   c->add_option("--outliers", o->synthetic.outlier_fraction, "Oracle tracks: fraction of wrong matches")
       ->capture_default_str();
