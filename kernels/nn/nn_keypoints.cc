@@ -38,9 +38,9 @@ KeypointKernel::~KeypointKernel() = default;
 void KeypointKernel::heatmap(engine::Sequence& s, const engine::Buffer& logits, const engine::Buffer& heat,
                              uint32_t h, uint32_t w) const {
   static const char* who = "KeypointKernel::heatmap";
-  const NnKeypointsParams p = params(NN_KEYPOINTS_HEATMAP, 65, h, w, 64 * h * w);
+  const NnKeypointsParams p = params(NN_KEYPOINTS_HEATMAP, 65, h, w, h * w);
   check_binding(who, "logits", logits, uint64_t{65} * h * w * sizeof(float));
-  check_binding(who, "heat", heat, uint64_t{p.count} * sizeof(float));
+  check_binding(who, "heat", heat, uint64_t{64} * h * w * sizeof(float));
   s.dispatch(*kernel_, elementwise_groups(*context_, p.count, who),
              {{NN_KEYPOINTS_BINDING_A, &logits, engine::Access::kRead},
               {NN_KEYPOINTS_BINDING_B, &logits, engine::Access::kRead},
@@ -70,7 +70,7 @@ void KeypointKernel::normalize(engine::Sequence& s, const engine::Buffer& featur
                                const MapShape& shape) const {
   static const char* who = "KeypointKernel::normalize";
   const NnKeypointsParams p =
-      params(NN_KEYPOINTS_NORMALIZE, shape.channels, shape.height, shape.width, uint32_t(shape.elements()));
+      params(NN_KEYPOINTS_NORMALIZE, shape.channels, shape.height, shape.width, shape.height * shape.width);
   check_binding(who, "features", features, shape.elements() * sizeof(float));
   check_binding(who, "out", out, shape.elements() * sizeof(float));
   s.dispatch(*kernel_, elementwise_groups(*context_, p.count, who),

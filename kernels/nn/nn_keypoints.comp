@@ -22,14 +22,14 @@ float map_coordinate(float full, uint map_size, uint full_size) {
   return full * float(map_size) / float(max(full_size, 2u) - 1u) - 0.5;
 }
 
-void heatmap(uint e) {
-  const uint X = e % p.width, Y = e / p.width;
-  const uint cell = (Y / 8u) * p.map_width + X / 8u, plane = p.map_height * p.map_width;
+// One cell: its softmax's maximum and sum once, then its 64 pixels.
+void heatmap(uint cell) {
+  const uint plane = p.map_height * p.map_width, X0 = (cell % p.map_width) * 8u, Y0 = (cell / p.map_width) * 8u;
   float top = a[cell];
   for (uint k = 1u; k < 65u; ++k) top = max(top, a[k * plane + cell]);
   float sum = 0.0;
   for (uint k = 0u; k < 65u; ++k) sum += exp(a[k * plane + cell] - top);
-  y[e] = exp(a[((Y % 8u) * 8u + X % 8u) * plane + cell] - top) / sum;
+  for (uint k = 0u; k < 64u; ++k) y[(Y0 + k / 8u) * p.width + X0 + k % 8u] = exp(a[k * plane + cell] - top) / sum;
 }
 
 // b as the [map_height][map_width] reliability, bilinear at a full-resolution pixel, zero outside.
@@ -59,11 +59,13 @@ void scores(uint e) {
   y[e] = h * rel;
 }
 
-void normalize_channels(uint e) {
-  const uint plane = p.map_height * p.map_width, pixel = e % plane;
+// One pixel: its norm over the channels once, then each channel.
+void normalize_channels(uint pixel) {
+  const uint plane = p.map_height * p.map_width;
   float sq = 0.0;
   for (uint c = 0u; c < p.channels; ++c) sq += a[c * plane + pixel] * a[c * plane + pixel];
-  y[e] = a[e] / max(sqrt(sq), 1e-12);
+  const float n = max(sqrt(sq), 1e-12);
+  for (uint c = 0u; c < p.channels; ++c) y[c * plane + pixel] = a[c * plane + pixel] / n;
 }
 
 // Keys' cubic convolution, a = -0.75, taps at -1, 0, 1, 2 from floor.

@@ -53,8 +53,9 @@ struct NnMapParams {
   uint count;  // out_channels * out_height * out_width
 };
 
-// ---- nn_keypoints.comp: XFeat's post-processing (kernels/nn/xfeat_keypoints_reference.h), one output
-// element per invocation but for NN_KEYPOINTS_DESCRIPTORS (one keypoint per invocation) ----
+// ---- nn_keypoints.comp: XFeat's post-processing (kernels/nn/xfeat_keypoints_reference.h); one invocation
+// per 1/8-resolution cell (HEATMAP), per 1/8-resolution pixel (NORMALIZE: its channels), per output pixel
+// (SCORES) or per keypoint (DESCRIPTORS) ----
 #define NN_KEYPOINTS_HEATMAP 0  // out [H][W] = softmax over a's 65 bins, bin ky*8+kx at (8cy+ky, 8cx+kx)
 #define NN_KEYPOINTS_SCORES 1   // out [H][W] = heat a * reliability b (bilinear) at window maxima > threshold
 #define NN_KEYPOINTS_NORMALIZE 2    // out [C][h][w] = a divided by its L2 norm over the channels
@@ -70,7 +71,7 @@ struct NnKeypointsParams {
   uint channels, map_height, map_width;  // the 1/8-resolution maps
   uint height, width;                    // the image (8 map_height x 8 map_width)
   uint window;                           // NMS window (odd)
-  uint count;                            // outputs (keypoints for NN_KEYPOINTS_DESCRIPTORS)
+  uint count;                            // invocations (the op's cells, pixels or keypoints)
   float threshold;
 };
 
