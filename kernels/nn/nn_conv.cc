@@ -43,7 +43,8 @@ Conv2dKernel::Conv2dKernel(engine::Context& context)
       // The input and the weights as texels (nn_shared.h): a vector gather on CPU drivers.
       kernel_(make_kernel(context, "nn/nn_conv2d", NN_CONV_BINDING_COUNT, sizeof(NnConvParams), {},
                           {{NN_CONV_BINDING_IN, VK_FORMAT_R32_SFLOAT},
-                           {NN_CONV_BINDING_WEIGHT, VK_FORMAT_R32G32B32A32_SFLOAT}})) {}
+                           {NN_CONV_BINDING_WEIGHT, VK_FORMAT_R32G32B32A32_SFLOAT},
+                           {NN_CONV_BINDING_IN4, VK_FORMAT_R32G32B32A32_SFLOAT}})) {}
 
 Conv2dKernel::~Conv2dKernel() = default;
 
@@ -80,7 +81,8 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
              {{NN_CONV_BINDING_IN, &in, engine::Access::kRead},
               {NN_CONV_BINDING_WEIGHT, &weight, engine::Access::kRead},
               {NN_CONV_BINDING_BIAS, &bias, engine::Access::kRead},
-              {NN_CONV_BINDING_OUT, &out, engine::Access::kWrite}},
+              {NN_CONV_BINDING_OUT, &out, engine::Access::kWrite},
+              {NN_CONV_BINDING_IN4, &in, engine::Access::kRead}},
              p);
 }
 

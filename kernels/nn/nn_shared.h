@@ -21,7 +21,8 @@ using uint = uint32_t;
 #define NN_CONV_BINDING_WEIGHT 1  // [ceil(C_out / 4)][C_in][k][k][4] vec4 texels (pack_conv_weights)
 #define NN_CONV_BINDING_BIAS 2    // [C_out]
 #define NN_CONV_BINDING_OUT 3     // [C_out][H_out][W_out] (out)
-#define NN_CONV_BINDING_COUNT 4
+#define NN_CONV_BINDING_IN4 4     // the input again, as R32G32B32A32_SFLOAT texels (the row paths)
+#define NN_CONV_BINDING_COUNT 5
 
 #define NN_ACTIVATION_NONE 0
 #define NN_ACTIVATION_RELU 1

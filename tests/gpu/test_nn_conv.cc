@@ -1,6 +1,6 @@
 // The network kernels (kernels/nn/) against their double-precision CPU references (kernels/nn/nn_reference.h,
 // xfeat_reference.h), validation layer on: each of XFeat's convolutions with its own weights (3x3 and 1x1,
-// strides 1 and 2, with and without ReLU) on an input that is not a multiple of the stride, the whole
+// strides 1 and 2, with and without ReLU) on inputs whose width is or is not a multiple of four, the whole
 // network, and bad shapes. Tolerances (float against double): a convolution within 1e-5 of its largest
 // output; the network's outputs within 1e-4 of each output's RMS, element by element.
 #include <gtest/gtest.h>
@@ -83,9 +83,15 @@ TEST_F(NnConvTest, XfeatLayersMatchTheReference) {
   ASSERT_EQ(weights.convs.size(), 27u);
   uint32_t seed = 0;
   for (const kernels::nn::ConvWeights& w : weights.convs) {
-    // 29 wide: neither the stride nor the kernel's tile of NN_CONV_PIXELS divides it (a partial tile).
-    const FeatureMap in = random_map(int(w.in_channels), 36, 29, seed++);
-    for (bool relu : {false, true}) EXPECT_LT(relative_error(in, w, relu), 1e-5) << "layer " << seed - 1;
+    // 29 wide: neither the stride nor the kernel's tile of NN_CONV_PIXELS divides it (a partial tile, the
+    // generic path). 40 and 8 wide: rows of four-float texels (the 1x1 and 3x3 paths), with a partial run
+    // of NN_CONV_RUN pixels and, at 8, a row of two texels whose both ends are padding.
+    for (int width : {29, 40, 8}) {
+      const FeatureMap in = random_map(int(w.in_channels), 36, width, seed++);
+      for (bool relu : {false, true})
+        EXPECT_LT(relative_error(in, w, relu), 1e-5)
+            << "layer " << &w - weights.convs.data() << ", " << width << " wide";
+    }
   }
 }
 
