@@ -42,27 +42,30 @@ struct XfeatDetector {
     kernels::nn::XfeatKeypointOptions k;
     // Candidates beyond the budget, so that the grid bucketing has some to spread.
     k.top_k = static_cast<uint32_t>(4 * options.max_keypoints);
+    // Back to the frame's pixels, centres at integers on both sides of the half-pixel resize.
+    const float sx = float(frame.width) / float(width), sy = float(frame.height) / float(height);
+    // The grid bucketing chooses among the candidates before the descriptors are sampled.
+    const auto bucket = [&](const std::vector<kernels::nn::ScoredKeypoint>& candidates) {
+      std::vector<float> x, y, score;
+      for (const auto& p : candidates) {
+        x.push_back(p.x);
+        y.push_back(p.y);
+        score.push_back(p.score);
+      }
+      return frontend::bucket_keypoints(x, y, score, width, height, options.max_keypoints, options.grid_cols,
+                                        options.grid_rows);
+    };
     kernels::XfeatDetections d;
     {
       const std::lock_guard<std::mutex> lock(device);
-      d = network->detect(input, uint32_t(height), uint32_t(width), k);
+      d = network->detect(input, uint32_t(height), uint32_t(width), k, bucket);
     }
-    std::vector<float> x, y, score;
-    for (const auto& p : d.keypoints) {
-      x.push_back(p.x);
-      y.push_back(p.y);
-      score.push_back(p.score);
-    }
-    // Back to the frame's pixels, centres at integers on both sides of the half-pixel resize.
-    const float sx = float(frame.width) / float(width), sy = float(frame.height) / float(height);
-    const std::vector<size_t> kept = frontend::bucket_keypoints(
-        x, y, score, width, height, options.max_keypoints, options.grid_cols, options.grid_rows);
-    f.descriptors.resize(kept.size() * size_t(f.descriptor_bytes));
-    for (size_t n = 0; n < kept.size(); ++n) {
-      const size_t i = kept[n];
-      f.keypoints.push_back({(x[i] + 0.5f) * sx - 0.5f, (y[i] + 0.5f) * sy - 0.5f, kCellPx * sx, -1});
+    f.descriptors.resize(d.keypoints.size() * size_t(f.descriptor_bytes));
+    for (size_t n = 0; n < d.keypoints.size(); ++n) {
+      const kernels::nn::ScoredKeypoint& p = d.keypoints[n];
+      f.keypoints.push_back({(p.x + 0.5f) * sx - 0.5f, (p.y + 0.5f) * sy - 0.5f, kCellPx * sx, -1});
       std::memcpy(f.descriptors.data() + n * size_t(f.descriptor_bytes),
-                  d.descriptors.data() + i * kDescriptorFloats, size_t(f.descriptor_bytes));
+                  d.descriptors.data() + n * kDescriptorFloats, size_t(f.descriptor_bytes));
     }
     return f;
   }

@@ -122,7 +122,8 @@ XfeatDeviceOutputs XfeatNetwork::run(const std::vector<float>& image, uint32_t h
 }
 
 XfeatDetections XfeatNetwork::detect(const std::vector<float>& image, uint32_t height, uint32_t width,
-                                     const nn::XfeatKeypointOptions& o) const {
+                                     const nn::XfeatKeypointOptions& o,
+                                     const KeypointSelection& select) const {
   Pass pass(*context_);
   forward(pass, image, height, width);
   const uint32_t h = height / 8, w = width / 8;
@@ -137,6 +138,16 @@ XfeatDetections XfeatNetwork::detect(const std::vector<float>& image, uint32_t h
   out.height = height;
   out.width = width;
   out.keypoints = nn::top_keypoints(scores.data->download(), int(width), int(height), o.top_k);
+  if (select) {
+    std::vector<nn::ScoredKeypoint> chosen;
+    for (size_t i : select(out.keypoints)) {
+      if (i >= out.keypoints.size())
+        throw std::out_of_range("XfeatNetwork::detect: the selection names keypoint " + std::to_string(i) +
+                                " of " + std::to_string(out.keypoints.size()));
+      chosen.push_back(out.keypoints[i]);
+    }
+    out.keypoints = std::move(chosen);
+  }
   if (out.keypoints.empty()) return out;
   // The top-k choice is on the host: a second sequence samples the descriptors at the chosen pixels.
   std::vector<float> xy;

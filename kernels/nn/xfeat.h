@@ -4,6 +4,7 @@
 // maps are allocated for the size of each call.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -37,10 +38,17 @@ class XfeatNetwork {
   // `image`: height x width values, normalized to zero mean and unit variance; the sides positive multiples
   // of 32 (std::invalid_argument otherwise). Records, submits and waits.
   XfeatDeviceOutputs run(const std::vector<float>& image, uint32_t height, uint32_t width) const;
+  // Which of the top-k keypoints (highest score first) to describe, as indices into them; describes all
+  // when empty. The front end's grid bucketing keeps a share of the candidates, and only those need the
+  // descriptors' bicubic sampling.
+  using KeypointSelection = std::function<std::vector<size_t>(const std::vector<nn::ScoredKeypoint>&)>;
+
   // The network and the post-processing: on the device but for the top-k choice, which reads back the
-  // score map. Deterministic: one image gives the same keypoints and descriptors on one device.
+  // score map. The detections hold the selected keypoints in the selection's order, with their descriptors.
+  // Deterministic: one image gives the same keypoints and descriptors on one device.
   XfeatDetections detect(const std::vector<float>& image, uint32_t height, uint32_t width,
-                         const nn::XfeatKeypointOptions& options = {}) const;
+                         const nn::XfeatKeypointOptions& options = {},
+                         const KeypointSelection& select = {}) const;
 
  private:
   struct Pass;

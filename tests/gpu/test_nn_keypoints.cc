@@ -3,7 +3,8 @@
 // fed the device's own input to the op, so that it is compared alone: the heat map within 1e-6, scores within
 // 1e-5 of the largest and the same pixels kept, normalized channels within 1e-6, descriptors within 1e-5. The
 // whole detection on a DUNR crop against the CPU network and post-processing: the same keypoints but for
-// near-ties, descriptors within 1e-3. Hard cases: determinism, a uniform image, the smallest size.
+// near-ties, descriptors within 1e-3, and a selection of them described alone. Hard cases: determinism, a
+// uniform image, the smallest size.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -175,6 +176,23 @@ TEST_F(NnKeypointsTest, DetectionMatchesTheCpuNetworkAndPostProcessing) {
     EXPECT_EQ(again.keypoints[i].score, device.keypoints[i].score);
   }
   EXPECT_EQ(again.descriptors, device.descriptors);
+
+  // A selection (the front end's grid bucketing) describes only the keypoints it names, in its order, with
+  // the descriptors the whole detection gives them; an index beyond the candidates is refused.
+  const std::vector<size_t> picked = {7, 0, 42};
+  const kernels::XfeatDetections some =
+      network.detect(image, 128, 128, o, [&](const auto&) { return picked; });
+  ASSERT_EQ(some.keypoints.size(), picked.size());
+  ASSERT_EQ(some.descriptors.size(), picked.size() * 64);
+  for (size_t n = 0; n < picked.size(); ++n) {
+    EXPECT_EQ(some.keypoints[n].x, device.keypoints[picked[n]].x);
+    EXPECT_EQ(some.keypoints[n].y, device.keypoints[picked[n]].y);
+    for (int c = 0; c < 64; ++c)
+      EXPECT_EQ(some.descriptors[n * 64 + c], device.descriptors[picked[n] * 64 + c]);
+  }
+  EXPECT_THROW(
+      network.detect(image, 128, 128, o, [](const auto& all) { return std::vector<size_t>{all.size()}; }),
+      std::out_of_range);
 }
 
 TEST_F(NnKeypointsTest, AUniformImageGivesNoKeypointsAndTheSmallestSizeWorks) {
