@@ -19,13 +19,23 @@ layout(local_size_x = NN_CONV_GROUP_SIZE) in;
 layout(binding = NN_CONV_BINDING_IN) uniform samplerBuffer x;
 layout(binding = NN_CONV_BINDING_WEIGHT) uniform samplerBuffer w;
 layout(binding = NN_CONV_BINDING_IN4) uniform samplerBuffer x4;
+layout(std430, binding = NN_CONV_BINDING_BIAS) readonly buffer Bias { float b[]; };
+layout(std430, binding = NN_CONV_BINDING_OUT) writeonly buffer Out { float y[]; };
+layout(push_constant) uniform Push { NnConvParams p; };
 
 #if NN_CONV_PIXELS != 4
 #error "the row paths read four pixels of a row as one four-float texel"
 #endif
-layout(std430, binding = NN_CONV_BINDING_BIAS) readonly buffer Bias { float b[]; };
-layout(std430, binding = NN_CONV_BINDING_OUT) writeonly buffer Out { float y[]; };
-layout(push_constant) uniform Push { NnConvParams p; };
+
+// One tap into the register tile: the block's group F of four output channels at the tile's pixels, with
+// V[q] the input under pixel q and W4 the tap's weights of those four channels.
+#define NN_CONV_ACCUMULATE(F, W4, V)                                \
+  [[unroll]] for (uint q = 0u; q < NN_CONV_PIXELS; ++q) {           \
+    sum[4u * (F)][q] += (W4).x * (V)[q];                            \
+    sum[4u * (F) + 1u][q] += (W4).y * (V)[q];                       \
+    sum[4u * (F) + 2u][q] += (W4).z * (V)[q];                       \
+    sum[4u * (F) + 3u][q] += (W4).w * (V)[q];                       \
+  }
 
 void main() {
   // The channel block comes from the workgroup alone: the weights' addresses are then the same in every
@@ -68,12 +78,7 @@ void main() {
       const vec4 v = inside ? texelFetch(x4, int((c * p.in_height + oy) * row_texels + centre)) : vec4(0.0);
       [[unroll]] for (uint f = 0u; f < NN_CONV_OUTPUTS / 4u; ++f) {
         const vec4 w4 = texelFetch(w, int(min(o0 / 4u + f, fours - 1u) * taps_per_output + c));
-        [[unroll]] for (uint q = 0u; q < NN_CONV_PIXELS; ++q) {
-          sum[4u * f][q] += w4.x * v[q];
-          sum[4u * f + 1u][q] += w4.y * v[q];
-          sum[4u * f + 2u][q] += w4.z * v[q];
-          sum[4u * f + 3u][q] += w4.w * v[q];
-        }
+        NN_CONV_ACCUMULATE(f, w4, v);
       }
     }
   } else if (rows4) {
@@ -101,12 +106,7 @@ void main() {
           const uint tap = (c * 3u + ky) * 3u + kx;
           [[unroll]] for (uint f = 0u; f < NN_CONV_OUTPUTS / 4u; ++f) {
             const vec4 w4 = texelFetch(w, int(min(o0 / 4u + f, fours - 1u) * taps_per_output + tap));
-            [[unroll]] for (uint q = 0u; q < NN_CONV_PIXELS; ++q) {
-              sum[4u * f][q] += w4.x * v[kx][q];
-              sum[4u * f + 1u][q] += w4.y * v[kx][q];
-              sum[4u * f + 2u][q] += w4.z * v[kx][q];
-              sum[4u * f + 3u][q] += w4.w * v[kx][q];
-            }
+            NN_CONV_ACCUMULATE(f, w4, v[kx]);
           }
         }
       }
@@ -129,12 +129,7 @@ void main() {
           // (the packing's zeros fill the last four).
           [[unroll]] for (uint f = 0u; f < NN_CONV_OUTPUTS / 4u; ++f) {
             const vec4 w4 = texelFetch(w, int(min(o0 / 4u + f, fours - 1u) * taps_per_output + tap));
-            [[unroll]] for (uint q = 0u; q < NN_CONV_PIXELS; ++q) {
-              sum[4u * f][q] += w4.x * v[q];
-              sum[4u * f + 1u][q] += w4.y * v[q];
-              sum[4u * f + 2u][q] += w4.z * v[q];
-              sum[4u * f + 3u][q] += w4.w * v[q];
-            }
+            NN_CONV_ACCUMULATE(f, w4, v);
           }
         }
       }

@@ -24,12 +24,14 @@ float map_coordinate(float full, uint map_size, uint full_size) {
 
 // One cell: its softmax's maximum and sum once, then its 64 pixels.
 void heatmap(uint cell) {
-  const uint plane = p.map_height * p.map_width, X0 = (cell % p.map_width) * 8u, Y0 = (cell / p.map_width) * 8u;
+  const uint plane = p.map_height * p.map_width;
+  const uint X0 = (cell % p.map_width) * 8u, Y0 = (cell / p.map_width) * 8u;
   float top = a[cell];
   for (uint k = 1u; k < 65u; ++k) top = max(top, a[k * plane + cell]);
   float sum = 0.0;
   for (uint k = 0u; k < 65u; ++k) sum += exp(a[k * plane + cell] - top);
-  for (uint k = 0u; k < 64u; ++k) y[(Y0 + k / 8u) * p.width + X0 + k % 8u] = exp(a[k * plane + cell] - top) / sum;
+  for (uint k = 0u; k < 64u; ++k)
+    y[(Y0 + k / 8u) * p.width + X0 + k % 8u] = exp(a[k * plane + cell] - top) / sum;
 }
 
 // b as the [map_height][map_width] reliability, bilinear at a full-resolution pixel, zero outside.

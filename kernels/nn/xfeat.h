@@ -26,7 +26,7 @@ struct XfeatDeviceOutputs {
 
 struct XfeatDetections {
   uint32_t height = 0, width = 0;             // of the image
-  std::vector<nn::ScoredKeypoint> keypoints;  // highest score first
+  std::vector<nn::ScoredKeypoint> keypoints;  // highest score first (or in the selection's order)
   std::vector<float> descriptors;             // keypoints.size() x 64, L2-normalized
 };
 
