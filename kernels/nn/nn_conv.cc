@@ -40,7 +40,8 @@ std::vector<float> pack_conv_weights(const std::vector<float>& weight, uint32_t 
 
 Conv2dKernel::Conv2dKernel(engine::Context& context)
     : context_(&context),
-      // The input and the weights as texels (nn_shared.h): a vector gather on CPU drivers.
+      // The input and the weights as texels (nn_shared.h), and the input again as four-float texels of its
+      // rows (the 1x1 and 3x3 row paths of nn_conv2d.comp).
       kernel_(make_kernel(context, "nn/nn_conv2d", NN_CONV_BINDING_COUNT, sizeof(NnConvParams), {},
                           {{NN_CONV_BINDING_IN, VK_FORMAT_R32_SFLOAT},
                            {NN_CONV_BINDING_WEIGHT, VK_FORMAT_R32G32B32A32_SFLOAT},

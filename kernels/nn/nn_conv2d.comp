@@ -63,7 +63,9 @@ void main() {
   const uint outputs = min(NN_CONV_OUTPUTS, p.out_channels - o0);
   const int y0 = int(oy * p.stride) - int(p.pad), x0 = int(ox0 * p.stride) - int(p.pad);
   const uint taps_per_output = p.in_channels * p.kernel * p.kernel;
-  const uint fours = (p.out_channels + 3u) / 4u;  // the packed weights' groups of four output channels
+  // The packed weights' groups of four output channels. On every path a block past the last four reads the
+  // last four's weights again and never writes them (the packing's zeros fill the last four).
+  const uint fours = (p.out_channels + 3u) / 4u;
   // Constant bounds throughout, so that the compiler unrolls them and keeps the tile in registers.
   float sum[NN_CONV_OUTPUTS][NN_CONV_PIXELS];
   [[unroll]] for (uint j = 0u; j < NN_CONV_OUTPUTS; ++j) {
@@ -125,8 +127,6 @@ void main() {
             v[q] = (sx >= 0 && sx < int(p.in_width)) ? texelFetch(x, int(row) + sx).x : 0.0;
           }
           const uint tap = (c * p.kernel + ky) * p.kernel + kx;
-          // A block past the last four channels reads the last four's weights again and never writes them
-          // (the packing's zeros fill the last four).
           [[unroll]] for (uint f = 0u; f < NN_CONV_OUTPUTS / 4u; ++f) {
             const vec4 w4 = texelFetch(w, int(min(o0 / 4u + f, fours - 1u) * taps_per_output + tap));
             NN_CONV_ACCUMULATE(f, w4, v);
