@@ -1,6 +1,7 @@
 // `litgs-engine bench features [--image FILE] [--runs N] [--json]`: milliseconds per image for each detector
 // on one frame, in one run: ORB, SIFT and AKAZE (OpenCV, on the CPU, at the front end's defaults), XFeat's
-// network on the Vulkan device (upload, forward pass and download), XFeat as the front end runs it (network,
+// network on the Vulkan device (upload, forward pass and download; and the device's time in each of its
+// kernels), XFeat as the front end runs it (network,
 // keypoints and descriptors on the device, at match's defaults) and XFeat's double-precision CPU reference
 // of the network (one run). The frame is cropped to multiples of 32.
 #include <CLI/CLI.hpp>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -90,12 +92,28 @@ void run_bench_features(const BenchFeaturesOptions& o) {
   engine::Context& context = *shared_context;
   const kernels::XfeatNetwork network(context, weights);
   std::vector<double> ms;
+  std::map<std::string, std::vector<double>> kernel_ms;  // the device's time per kernel, each run
+  std::map<std::string, uint32_t> kernel_dispatches;
   for (uint32_t r = 0; r <= o.runs; ++r) {
-    const double t = time_ms([&] { network.run(input, uint32_t(frame.height), uint32_t(frame.width)); });
-    if (r) ms.push_back(t);
+    kernels::XfeatDeviceOutputs out;
+    const double t =
+        time_ms([&] { out = network.run(input, uint32_t(frame.height), uint32_t(frame.width)); });
+    if (!r) continue;
+    ms.push_back(t);
+    for (const engine::KernelTime& k : out.kernel_times) {
+      kernel_ms[k.name].push_back(k.ms);
+      kernel_dispatches[k.name] = k.dispatches;
+    }
   }
-  rows.push_back(
-      {{"detector", "xfeat network"}, {"where", "device: " + context.info().name}, {"ms", median(ms)}});
+  // Where the network's time goes: each kernel's device time (timestamps around each dispatch).
+  nlohmann::json network_kernels = nlohmann::json::array();
+  for (const auto& [name, times] : kernel_ms)
+    network_kernels.push_back(
+        {{"kernel", name}, {"dispatches", kernel_dispatches[name]}, {"ms", median(times)}});
+  rows.push_back({{"detector", "xfeat network"},
+                  {"where", "device: " + context.info().name},
+                  {"ms", median(ms)},
+                  {"kernels", network_kernels}});
   // What the front end pays per frame: normalization, network, keypoints, descriptors, grid bucketing.
   const host::frontend::LearnedDetector xfeat =
       host::nn::make_xfeat_detector(shared_context, weights, host::frontend::FeatureOptions{});
@@ -148,13 +166,20 @@ void run_bench_features(const BenchFeaturesOptions& o) {
   }
   std::cout << "bench features: " << frame.width << "x" << frame.height << ", median of " << o.runs
             << " runs after one warm-up (the CPU reference: one run)\n";
-  for (const auto& r : rows)
+  for (const auto& r : rows) {
     std::cout << "  " << std::left << std::setw(14) << r["detector"].get<std::string>() << std::setw(48)
               << r["where"].get<std::string>() << std::right << std::fixed << std::setprecision(1)
               << std::setw(9) << r["ms"].get<double>() << " ms"
               << (r.contains("keypoints") ? "  " + std::to_string(r["keypoints"].get<size_t>()) + " keypoints"
                                           : "")
               << "\n";
+    if (!r.contains("kernels")) continue;
+    for (const auto& k : r["kernels"])
+      std::cout << "    " << std::left << std::setw(60)
+                << (k["kernel"].get<std::string>() + ", " + std::to_string(k["dispatches"].get<uint32_t>()) +
+                    " dispatches")
+                << std::right << std::setw(9) << k["ms"].get<double>() << " ms on the device\n";
+  }
 }
 
 }  // namespace

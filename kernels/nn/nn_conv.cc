@@ -50,7 +50,8 @@ Conv2dKernel::Conv2dKernel(engine::Context& context)
 Conv2dKernel::~Conv2dKernel() = default;
 
 void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const engine::Buffer& weight,
-                          const engine::Buffer& bias, const engine::Buffer& out, const ConvShape& c) const {
+                          const engine::Buffer& bias, const engine::Buffer& out, const ConvShape& c,
+                          const engine::Buffer* residual) const {
   static const char* who = "Conv2dKernel::record";
   c.check();
   check_binding(who, "in", in, uint64_t{c.in_channels} * c.in_height * c.in_width * sizeof(float));
@@ -58,6 +59,7 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
                 packed_conv_weight_floats(c.out_channels, c.in_channels, c.kernel) * sizeof(float));
   check_binding(who, "bias", bias, uint64_t{c.out_channels} * sizeof(float));
   check_binding(who, "out", out, c.out_elements() * sizeof(float));
+  if (residual) check_binding(who, "residual", *residual, c.out_elements() * sizeof(float));
   NnConvParams p{};
   p.in_channels = c.in_channels;
   p.in_height = c.in_height;
@@ -69,6 +71,7 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
   p.stride = c.stride;
   p.pad = c.pad;
   p.activation = c.activation;
+  p.has_residual = residual != nullptr;
   const uint64_t tiles =
       uint64_t{c.out_height()} * ((c.out_width() + NN_CONV_RUN - 1) / NN_CONV_RUN) * NN_CONV_LANES;
   const uint64_t groups_x = (tiles + NN_CONV_GROUP_SIZE - 1) / NN_CONV_GROUP_SIZE;
@@ -83,7 +86,8 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
               {NN_CONV_BINDING_WEIGHT, &weight, engine::Access::kRead},
               {NN_CONV_BINDING_BIAS, &bias, engine::Access::kRead},
               {NN_CONV_BINDING_OUT, &out, engine::Access::kWrite},
-              {NN_CONV_BINDING_IN4, &in, engine::Access::kRead}},
+              {NN_CONV_BINDING_IN4, &in, engine::Access::kRead},
+              {NN_CONV_BINDING_RESIDUAL, residual ? residual : &bias, engine::Access::kRead}},
              p);
 }
 
@@ -99,7 +103,8 @@ void MapKernel::dispatch(engine::Sequence& s, uint32_t op, const engine::Buffer&
   if (!in.elements() || !o.elements())
     throw std::invalid_argument(std::string(who) + ": an empty feature map");
   check_binding(who, "a", a, in.elements() * sizeof(float));
-  check_binding(who, "b", b, op == NN_MAP_ADD ? in.elements() * sizeof(float) : 0);
+  const uint64_t b_elements = op == NN_MAP_ADD ? in.elements() : op == NN_MAP_ADD_RESIZED ? o.elements() : 0;
+  check_binding(who, "b", b, b_elements * sizeof(float));
   check_binding(who, "out", out, o.elements() * sizeof(float));
   NnMapParams p{};
   p.op = op;
@@ -137,6 +142,14 @@ MapShape MapKernel::resize(engine::Sequence& s, const engine::Buffer& a, const e
   const MapShape o{in.channels, height, width};
   dispatch(s, NN_MAP_RESIZE, a, a, out, in, o, 1);
   return o;
+}
+
+void MapKernel::add_resized(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& b,
+                            const engine::Buffer& out, const MapShape& in, const MapShape& shape) const {
+  if (in.channels != shape.channels)
+    throw std::invalid_argument("MapKernel::add_resized: " + std::to_string(in.channels) +
+                                " channels resized onto " + std::to_string(shape.channels));
+  dispatch(s, NN_MAP_ADD_RESIZED, a, b, out, in, shape, 1);
 }
 
 MapShape MapKernel::unfold(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out,

@@ -1,7 +1,7 @@
 // Network convolutions on the device (nn_conv2d.comp): ONNX Conv with group 1, dilation 1 and zero padding,
-// optionally followed by ReLU or a sigmoid; and the other operations of a network's feature maps
-// (nn_map.comp: add, average pool, bilinear resize, unfold). Its CPU double reference is
-// kernels/nn/nn_reference.h's conv2d.
+// optionally followed by ReLU or a sigmoid and a residual add; and the other operations of a network's
+// feature maps (nn_map.comp: add, average pool, bilinear resize, unfold, the add of a resized map). Its CPU
+// double reference is kernels/nn/nn_reference.h's conv2d.
 #pragma once
 
 #include <cstdint>
@@ -53,6 +53,9 @@ class MapKernel {
   // out = a resized to height x width (ONNX Resize, linear, half_pixel).
   MapShape resize(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, const MapShape& in,
                   uint32_t height, uint32_t width) const;
+  // out = b + a resized to b's height and width (b and out of `shape`, a of `in`: as many channels).
+  void add_resized(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& b,
+                   const engine::Buffer& out, const MapShape& in, const MapShape& shape) const;
   // A one-channel image's k x k blocks as k * k channels (XFeat's _unfold2d).
   MapShape unfold(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, const MapShape& in,
                   uint32_t k) const;
@@ -68,10 +71,11 @@ class Conv2dKernel {
  public:
   explicit Conv2dKernel(engine::Context& context);
   ~Conv2dKernel();
-  // Records out = conv(in) (+ the activation); `weight` holds pack_conv_weights' layout. Buffers too small
-  // for the shape are std::invalid_argument.
+  // Records out = conv(in) (+ the activation) (+ residual, a map of out's shape, when given); `weight` holds
+  // pack_conv_weights' layout. Buffers too small for the shape are std::invalid_argument.
   void record(engine::Sequence& sequence, const engine::Buffer& in, const engine::Buffer& weight,
-              const engine::Buffer& bias, const engine::Buffer& out, const ConvShape& shape) const;
+              const engine::Buffer& bias, const engine::Buffer& out, const ConvShape& shape,
+              const engine::Buffer* residual = nullptr) const;
 
  private:
   engine::Context* context_;

@@ -1,7 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
-// ONNX Conv (group 1, dilation 1, zero padding) with an optional ReLU or sigmoid: an invocation computes
+// ONNX Conv (group 1, dilation 1, zero padding) with an optional ReLU or sigmoid, then optionally a residual
+// map added (a following ONNX Add of two maps, without a pass of its own): an invocation computes
 // NN_CONV_OUTPUTS output channels at NN_CONV_PIXELS pixels of one row, so that each weight loaded serves all
 // the pixels and each input value all the channels (a register tile, as a GEMM's; larger tiles spilled on
 // lavapipe, docs/experiments.md). Each output is summed in the order of kernels/nn/nn_reference.cc's conv2d:
@@ -21,6 +22,7 @@ layout(binding = NN_CONV_BINDING_WEIGHT) uniform samplerBuffer w;
 layout(binding = NN_CONV_BINDING_IN4) uniform samplerBuffer x4;
 layout(std430, binding = NN_CONV_BINDING_BIAS) readonly buffer Bias { float b[]; };
 layout(std430, binding = NN_CONV_BINDING_OUT) writeonly buffer Out { float y[]; };
+layout(std430, binding = NN_CONV_BINDING_RESIDUAL) readonly buffer Residual { float r[]; };
 layout(push_constant) uniform Push { NnConvParams p; };
 
 #if NN_CONV_PIXELS != 4
@@ -143,7 +145,10 @@ void main() {
       float s = sum[j][q];
       if (p.activation == NN_ACTIVATION_RELU) s = max(s, 0.0);
       if (p.activation == NN_ACTIVATION_SIGMOID) s = 1.0 / (1.0 + exp(-s));
-      y[(o0 + j) * plane_out + oy * p.out_width + ox] = s;
+      const uint e = (o0 + j) * plane_out + oy * p.out_width + ox;
+      // A residual connection's add, here rather than in a pass of its own over both maps.
+      if (p.has_residual != 0u) s += r[e];
+      y[e] = s;
     }
   }
 }

@@ -1,7 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // The feature-map operations of a network besides convolution, one output element per invocation, each as
-// kernels/nn/nn_reference.cc computes it: add, average pool, bilinear resize (half-pixel), unfold.
+// kernels/nn/nn_reference.cc computes it: add, average pool, bilinear resize (half-pixel), unfold, and the
+// add of a resized map.
 #include "limits.h"
 #include "nn/nn_shared.h"
 #include "elementwise.glsl"
@@ -22,6 +23,16 @@ void source(uint d, uint in_size, uint out_size, out uint i0, out uint i1, out f
   t = s - float(i0);
 }
 
+// Channel c of a resized bilinearly to the output's size, at the output's (row, x).
+float resized(uint c, uint row, uint x) {
+  uint y0, y1, x0, x1;
+  float ty, tx;
+  source(row, p.in_height, p.out_height, y0, y1, ty);
+  source(x, p.in_width, p.out_width, x0, x1, tx);
+  return (1.0 - ty) * ((1.0 - tx) * at(c, y0, x0) + tx * at(c, y0, x1)) +
+         ty * ((1.0 - tx) * at(c, y1, x0) + tx * at(c, y1, x1));
+}
+
 void main() {
   const uint e = elementwise_index();
   if (e >= p.count) return;
@@ -38,12 +49,10 @@ void main() {
       for (uint kx = 0u; kx < p.k; ++kx) sum += at(c, row * p.k + ky, x * p.k + kx);
     y[e] = sum / float(p.k * p.k);
   } else if (p.op == NN_MAP_RESIZE) {
-    uint y0, y1, x0, x1;
-    float ty, tx;
-    source(row, p.in_height, p.out_height, y0, y1, ty);
-    source(x, p.in_width, p.out_width, x0, x1, tx);
-    y[e] = (1.0 - ty) * ((1.0 - tx) * at(c, y0, x0) + tx * at(c, y0, x1)) +
-           ty * ((1.0 - tx) * at(c, y1, x0) + tx * at(c, y1, x1));
+    y[e] = resized(c, row, x);
+  } else if (p.op == NN_MAP_ADD_RESIZED) {
+    // A feature pyramid's upsample-and-add in one pass: the resized map is never written.
+    y[e] = b[e] + resized(c, row, x);
   } else {  // NN_MAP_UNFOLD
     const uint ky = c / p.k, kx = c % p.k;
     y[e] = at(0u, row * p.k + ky, x * p.k + kx);

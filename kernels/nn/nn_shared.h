@@ -22,7 +22,9 @@ using uint = uint32_t;
 #define NN_CONV_BINDING_BIAS 2    // [C_out]
 #define NN_CONV_BINDING_OUT 3     // [C_out][H_out][W_out] (out)
 #define NN_CONV_BINDING_IN4 4     // the input again, as R32G32B32A32_SFLOAT texels (the row paths)
-#define NN_CONV_BINDING_COUNT 5
+#define NN_CONV_BINDING_RESIDUAL \
+  5  // [C_out][H_out][W_out], added after the activation (bound to bias without)
+#define NN_CONV_BINDING_COUNT 6
 
 #define NN_ACTIVATION_NONE 0
 #define NN_ACTIVATION_RELU 1
@@ -32,8 +34,9 @@ struct NnConvParams {
   uint in_channels, in_height, in_width;
   uint out_channels, out_height, out_width;
   uint kernel, stride, pad;
-  uint activation;  // NN_ACTIVATION_* on the output
-  uint count;       // invocations per channel block: out_height * runs per row * NN_CONV_LANES
+  uint activation;    // NN_ACTIVATION_* on the output
+  uint has_residual;  // 1: the residual map is added to the activated output
+  uint count;         // invocations per channel block: out_height * runs per row * NN_CONV_LANES
 };
 
 // ---- nn_map.comp: one invocation per output element; p.op chooses what it computes ----
@@ -41,8 +44,9 @@ struct NnConvParams {
 #define NN_MAP_AVERAGE_POOL 1  // out = mean of a's k x k window every k pixels (no padding)
 #define NN_MAP_RESIZE 2        // out = a resized bilinearly, half-pixel centres, clamped (ONNX Resize linear)
 #define NN_MAP_UNFOLD 3  // out channel ky k + kx = a one-channel image's pixel (ky, kx) of each k x k block
+#define NN_MAP_ADD_RESIZED 4  // out = b + a resized as NN_MAP_RESIZE does (b and out of the output's shape)
 #define NN_MAP_BINDING_A 0
-#define NN_MAP_BINDING_B 1  // NN_MAP_ADD's second operand (bound to a otherwise)
+#define NN_MAP_BINDING_B 1  // the second operand of NN_MAP_ADD and NN_MAP_ADD_RESIZED (bound to a otherwise)
 #define NN_MAP_BINDING_OUT 2
 #define NN_MAP_BINDING_COUNT 3
 

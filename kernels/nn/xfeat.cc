@@ -87,20 +87,30 @@ void XfeatNetwork::forward(Pass& pass, const std::vector<float>& image, uint32_t
   const Map x1 = layers(input, 0, 4, NN_ACTIVATION_RELU);
   const Map pooled = make({1, height / 4, width / 4});
   map_.average_pool(s, input.buffer(), pooled.buffer(), input.shape, 4);
-  const Map skip = layers(pooled, 4, 1, NN_ACTIVATION_NONE);
-  const Map sum1 = make(x1.shape);
-  map_.add(s, x1.buffer(), skip.buffer(), sum1.buffer(), x1.shape);
+  // The skip branch's 1x1 convolution adds x1 as it writes (x1 + skip: the reference's add, commuted).
+  const Layer& skip_layer = layers_[4];
+  const ConvShape skip{1,
+                       pooled.shape.height,
+                       pooled.shape.width,
+                       skip_layer.out_channels,
+                       skip_layer.kernel,
+                       skip_layer.stride,
+                       skip_layer.pad,
+                       NN_ACTIVATION_NONE};
+  const Map sum1 = make({skip.out_channels, skip.out_height(), skip.out_width()});
+  if (sum1.shape.channels != x1.shape.channels || sum1.shape.height != x1.shape.height ||
+      sum1.shape.width != x1.shape.width)
+    throw std::logic_error("XfeatNetwork: the skip branch's shape differs from the first block's");
+  conv_.record(s, pooled.buffer(), skip_layer.weight->buffer(), skip_layer.bias->buffer(), sum1.buffer(),
+               skip, &x1.buffer());
   const Map x2 = layers(sum1, 5, 2, NN_ACTIVATION_RELU);
   const Map x3 = layers(x2, 7, 3, NN_ACTIVATION_RELU);
   const Map x4 = layers(x3, 10, 3, NN_ACTIVATION_RELU);
   const Map x5 = layers(x4, 13, 4, NN_ACTIVATION_RELU);
-  const Map up4 = make({x4.shape.channels, x3.shape.height, x3.shape.width});
-  map_.resize(s, x4.buffer(), up4.buffer(), x4.shape, x3.shape.height, x3.shape.width);
-  const Map up5 = make({x5.shape.channels, x3.shape.height, x3.shape.width});
-  map_.resize(s, x5.buffer(), up5.buffer(), x5.shape, x3.shape.height, x3.shape.width);
+  // (x3 + resize(x4)) + resize(x5), the upsampled maps never written.
   const Map fused34 = make(x3.shape), fused = make(x3.shape);
-  map_.add(s, x3.buffer(), up4.buffer(), fused34.buffer(), x3.shape);
-  map_.add(s, fused34.buffer(), up5.buffer(), fused.buffer(), x3.shape);
+  map_.add_resized(s, x4.buffer(), x3.buffer(), fused34.buffer(), x4.shape, x3.shape);
+  map_.add_resized(s, x5.buffer(), fused34.buffer(), fused.buffer(), x5.shape, x3.shape);
   pass.features = layers(fused, 17, 3, NN_ACTIVATION_NONE);
   pass.heatmap = layers(pass.features, 20, 3, NN_ACTIVATION_SIGMOID);
   const Map cells = make({64, height / 8, width / 8});
@@ -118,6 +128,7 @@ XfeatDeviceOutputs XfeatNetwork::run(const std::vector<float>& image, uint32_t h
   out.features = pass.features.data->download();
   out.keypoints = pass.keypoints.data->download();
   out.heatmap = pass.heatmap.data->download();
+  out.kernel_times = pass.sequence.profile();
   return out;
 }
 

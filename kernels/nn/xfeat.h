@@ -10,6 +10,7 @@
 
 #include "engine/buffer.h"
 #include "engine/context.h"
+#include "engine/sequence.h"
 #include "kernels/nn/nn_conv.h"
 #include "kernels/nn/nn_keypoints.h"
 #include "kernels/nn/nn_weights.h"
@@ -22,6 +23,8 @@ struct XfeatDeviceOutputs {
   std::vector<float> features;     // [64][height][width], not L2-normalized
   std::vector<float> keypoints;    // [65][height][width] logits
   std::vector<float> heatmap;      // [height][width] reliability
+  std::vector<engine::KernelTime>
+      kernel_times;  // the device's time in each kernel (empty without timestamps)
 };
 
 struct XfeatDetections {

@@ -1,11 +1,13 @@
 // The network kernels (kernels/nn/) against their double-precision CPU references (kernels/nn/nn_reference.h,
 // xfeat_reference.h), validation layer on: each of XFeat's convolutions with its own weights (3x3 and 1x1,
-// strides 1 and 2, with and without ReLU) on inputs whose width is or is not a multiple of four, the whole
-// network, and bad shapes. Tolerances (float against double): a convolution within 1e-5 of its largest
-// output; the network's outputs within 1e-4 of each output's RMS, element by element.
+// strides 1 and 2, with and without ReLU, with a residual add) on inputs whose width is or is not a multiple
+// of four, the feature-map operations, the whole network, and bad shapes. Tolerances (float against double):
+// a convolution within 1e-5 of its largest output, a map operation within 1e-6; the network's outputs within
+// 1e-4 of each output's RMS, element by element.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -41,10 +43,13 @@ FeatureMap random_map(int c, int h, int w, uint32_t seed) {
 
 class NnConvTest : public testing::GpuTest {
  protected:
-  // conv(in) on the device and on the CPU; the largest difference over the largest reference magnitude.
-  double relative_error(const FeatureMap& in, const kernels::nn::ConvWeights& w, bool relu) {
+  // conv(in) (+ residual) on the device and on the CPU; the largest difference over the largest reference
+  // magnitude.
+  double relative_error(const FeatureMap& in, const kernels::nn::ConvWeights& w, bool relu,
+                        const FeatureMap* residual = nullptr) {
     FeatureMap ref = kernels::nn::conv2d(in, w);
     if (relu) kernels::nn::relu(ref);
+    if (residual) ref = kernels::nn::add(ref, *residual);
     kernels::ConvShape shape{uint32_t(in.channels),
                              uint32_t(in.height),
                              uint32_t(in.width),
@@ -62,9 +67,12 @@ class NnConvTest : public testing::GpuTest {
     x.upload(input);
     weight.upload(packed);
     bias.upload(w.bias);
+    DeviceArray<float> r(context(), "test: residual", residual ? residual->values.size() : 1);
+    if (residual) r.upload(std::vector<float>(residual->values.begin(), residual->values.end()));
     kernels::Conv2dKernel conv(context());
     engine::Sequence s(context());
-    conv.record(s, x.buffer(), weight.buffer(), bias.buffer(), y.buffer(), shape);
+    conv.record(s, x.buffer(), weight.buffer(), bias.buffer(), y.buffer(), shape,
+                residual ? &r.buffer() : nullptr);
     s.submit_and_wait();
     const std::vector<float> out = y.download();
     EXPECT_EQ(out.size(), ref.values.size());
@@ -93,6 +101,69 @@ TEST_F(NnConvTest, XfeatLayersMatchTheReference) {
             << "layer " << &w - weights.convs.data() << ", " << width << " wide";
     }
   }
+}
+
+// A residual map added as the convolution writes (XFeat's skip branch; a ReLU layer too, where the add
+// must follow the activation), on the generic path (29 wide) and the row paths (40 wide).
+TEST_F(NnConvTest, ResidualIsAddedAfterTheActivation) {
+  const kernels::nn::XfeatWeights weights = xfeat_weights();
+  uint32_t seed = 100;
+  for (size_t layer : {size_t{4}, size_t{1}})
+    for (int width : {29, 40}) {
+      const kernels::nn::ConvWeights& w = weights.convs[layer];
+      const FeatureMap in = random_map(int(w.in_channels), 20, width, seed++);
+      const FeatureMap shape_of_out = kernels::nn::conv2d(in, w);
+      const FeatureMap residual =
+          random_map(shape_of_out.channels, shape_of_out.height, shape_of_out.width, seed++);
+      EXPECT_LT(relative_error(in, w, layer == 1, &residual), 1e-5) << "layer " << layer << ", " << width;
+    }
+}
+
+// The feature-map operations (nn_map.comp) against their references: add, average pool, bilinear resize up
+// and down (shapes that no factor divides), the add of a resized map, unfold.
+TEST_F(NnConvTest, MapOperationsMatchTheReference) {
+  kernels::MapKernel map(context());
+  const auto upload = [&](const FeatureMap& m) {
+    auto a = std::make_unique<DeviceArray<float>>(context(), "test: map", m.values.size());
+    a->upload(std::vector<float>(m.values.begin(), m.values.end()));
+    return a;
+  };
+  const auto shape_of = [](const FeatureMap& m) {
+    return kernels::MapShape{uint32_t(m.channels), uint32_t(m.height), uint32_t(m.width)};
+  };
+  const auto worst_relative = [](const std::vector<float>& out, const FeatureMap& ref) {
+    EXPECT_EQ(out.size(), ref.values.size());
+    double worst = 0, largest = 1e-12;
+    for (size_t i = 0; i < out.size() && i < ref.values.size(); ++i) {
+      worst = std::max(worst, std::abs(double(out[i]) - ref.values[i]));
+      largest = std::max(largest, std::abs(ref.values[i]));
+    }
+    return worst / largest;
+  };
+  const FeatureMap a = random_map(3, 12, 20, 1), b = random_map(3, 12, 20, 2);
+  const FeatureMap small = random_map(3, 5, 7, 3), image = random_map(1, 16, 24, 4);
+  const auto da = upload(a), db = upload(b), dsmall = upload(small), dimage = upload(image);
+  DeviceArray<float> sum(context(), "test: sum", a.values.size()), up(context(), "test: up", a.values.size()),
+      up_added(context(), "test: added", a.values.size()), down(context(), "test: down", 3 * 5 * 7),
+      pooled(context(), "test: pooled", 3 * 3 * 5), cells(context(), "test: cells", 16 * 4 * 6);
+  engine::Sequence s(context());
+  map.add(s, da->buffer(), db->buffer(), sum.buffer(), shape_of(a));
+  map.resize(s, dsmall->buffer(), up.buffer(), shape_of(small), 12, 20);
+  map.add_resized(s, dsmall->buffer(), db->buffer(), up_added.buffer(), shape_of(small), shape_of(b));
+  map.resize(s, da->buffer(), down.buffer(), shape_of(a), 5, 7);
+  map.average_pool(s, da->buffer(), pooled.buffer(), shape_of(a), 4);
+  map.unfold(s, dimage->buffer(), cells.buffer(), shape_of(image), 4);
+  s.submit_and_wait();
+  const FeatureMap upsampled = kernels::nn::resize_bilinear(small, 12, 20);
+  EXPECT_LT(worst_relative(sum.download(), kernels::nn::add(a, b)), 1e-6);
+  EXPECT_LT(worst_relative(up.download(), upsampled), 1e-6);
+  EXPECT_LT(worst_relative(up_added.download(), kernels::nn::add(b, upsampled)), 1e-6);
+  EXPECT_LT(worst_relative(down.download(), kernels::nn::resize_bilinear(a, 5, 7)), 1e-6);
+  EXPECT_LT(worst_relative(pooled.download(), kernels::nn::average_pool(a, 4, 4)), 1e-6);
+  EXPECT_LT(worst_relative(cells.download(), kernels::nn::unfold(image, 4)), 1e-6);
+  // A resized map whose channels differ from the map it is added to.
+  EXPECT_THROW(map.add_resized(s, dsmall->buffer(), db->buffer(), up_added.buffer(), {2, 5, 7}, shape_of(b)),
+               std::invalid_argument);
 }
 
 TEST_F(NnConvTest, BadShapesAndShortBuffersAreRefused) {
