@@ -16,14 +16,13 @@ using uint = uint32_t;
 #define NN_CONV_PIXELS 4
 #define NN_CONV_LANES 8  // invocations that interleave their pixels over one run of a row
 #define NN_CONV_RUN (NN_CONV_LANES * NN_CONV_PIXELS)
-#define NN_CONV_GROUP_SIZE 64     // tiles of one channel block per workgroup; the grid's y is the block
-#define NN_CONV_BINDING_IN 0      // [C_in][H_in][W_in] (R32_SFLOAT texels)
-#define NN_CONV_BINDING_WEIGHT 1  // [ceil(C_out / 4)][C_in][k][k][4] vec4 texels (pack_conv_weights)
-#define NN_CONV_BINDING_BIAS 2    // [C_out]
-#define NN_CONV_BINDING_OUT 3     // [C_out][H_out][W_out] (out)
-#define NN_CONV_BINDING_IN4 4     // the input again, as R32G32B32A32_SFLOAT texels (the row paths)
-#define NN_CONV_BINDING_RESIDUAL \
-  5  // [C_out][H_out][W_out], added after the activation (bound to bias without)
+#define NN_CONV_GROUP_SIZE 64       // tiles of one channel block per workgroup; the grid's y is the block
+#define NN_CONV_BINDING_IN 0        // [C_in][H_in][W_in] (R32_SFLOAT texels)
+#define NN_CONV_BINDING_WEIGHT 1    // [ceil(C_out / 4)][C_in][k][k][4] vec4 texels (pack_conv_weights)
+#define NN_CONV_BINDING_BIAS 2      // [C_out]
+#define NN_CONV_BINDING_OUT 3       // [C_out][H_out][W_out] (out)
+#define NN_CONV_BINDING_IN4 4       // the input again, as R32G32B32A32_SFLOAT texels (the row paths)
+#define NN_CONV_BINDING_RESIDUAL 5  // [C_out][H_out][W_out] added after the activation (else: bias)
 #define NN_CONV_BINDING_COUNT 6
 
 #define NN_ACTIVATION_NONE 0
