@@ -19,12 +19,11 @@
 namespace litgs::kernels {
 
 struct XfeatDeviceOutputs {
-  uint32_t height = 0, width = 0;  // of the maps: the image's / 8
-  std::vector<float> features;     // [64][height][width], not L2-normalized
-  std::vector<float> keypoints;    // [65][height][width] logits
-  std::vector<float> heatmap;      // [height][width] reliability
-  std::vector<engine::KernelTime>
-      kernel_times;  // the device's time in each kernel (empty without timestamps)
+  uint32_t height = 0, width = 0;                // of the maps: the image's / 8
+  std::vector<float> features;                   // [64][height][width], not L2-normalized
+  std::vector<float> keypoints;                  // [65][height][width] logits
+  std::vector<float> heatmap;                    // [height][width] reliability
+  std::vector<engine::KernelTime> kernel_times;  // device time per kernel (none without timestamps)
 };
 
 struct XfeatDetections {
