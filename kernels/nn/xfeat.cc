@@ -62,8 +62,10 @@ void XfeatNetwork::forward(Pass& pass, const std::vector<float>& image, uint32_t
         " values");
   engine::Sequence& s = pass.sequence;
   const auto make = [&pass](const MapShape& shape) { return pass.make(shape); };
-  // Layers first .. first + count - 1 in turn: ReLU after each but the last, `last` after the last.
-  const auto layers = [&](const Map& in, size_t first, size_t count, uint32_t last) {
+  // Layers first .. first + count - 1 in turn: ReLU after each but the last, `last` after the last, and
+  // `residual` (a map of the last one's shape) added as the last one writes.
+  const auto layers = [&](const Map& in, size_t first, size_t count, uint32_t last,
+                          const Map* residual = nullptr) {
     Map x = in;
     for (size_t i = first; i < first + count; ++i) {
       const Layer& l = layers_[i];
@@ -76,7 +78,12 @@ void XfeatNetwork::forward(Pass& pass, const std::vector<float>& image, uint32_t
                         l.pad,
                         i + 1 < first + count ? uint32_t{NN_ACTIVATION_RELU} : last};
       const Map y = make({c.out_channels, c.out_height(), c.out_width()});
-      conv_.record(s, x.buffer(), l.weight->buffer(), l.bias->buffer(), y.buffer(), c);
+      const bool add = residual && i + 1 == first + count;
+      if (add && (residual->shape.channels != y.shape.channels || residual->shape.height != y.shape.height ||
+                  residual->shape.width != y.shape.width))
+        throw std::logic_error("XfeatNetwork: a residual map whose shape differs from its layer's output");
+      conv_.record(s, x.buffer(), l.weight->buffer(), l.bias->buffer(), y.buffer(), c,
+                   add ? &residual->buffer() : nullptr);
       x = y;
     }
     return x;
@@ -88,21 +95,7 @@ void XfeatNetwork::forward(Pass& pass, const std::vector<float>& image, uint32_t
   const Map pooled = make({1, height / 4, width / 4});
   map_.average_pool(s, input.buffer(), pooled.buffer(), input.shape, 4);
   // The skip branch's 1x1 convolution adds x1 as it writes (x1 + skip: the reference's add, commuted).
-  const Layer& skip_layer = layers_[4];
-  const ConvShape skip{1,
-                       pooled.shape.height,
-                       pooled.shape.width,
-                       skip_layer.out_channels,
-                       skip_layer.kernel,
-                       skip_layer.stride,
-                       skip_layer.pad,
-                       NN_ACTIVATION_NONE};
-  const Map sum1 = make({skip.out_channels, skip.out_height(), skip.out_width()});
-  if (sum1.shape.channels != x1.shape.channels || sum1.shape.height != x1.shape.height ||
-      sum1.shape.width != x1.shape.width)
-    throw std::logic_error("XfeatNetwork: the skip branch's shape differs from the first block's");
-  conv_.record(s, pooled.buffer(), skip_layer.weight->buffer(), skip_layer.bias->buffer(), sum1.buffer(),
-               skip, &x1.buffer());
+  const Map sum1 = layers(pooled, 4, 1, NN_ACTIVATION_NONE, &x1);
   const Map x2 = layers(sum1, 5, 2, NN_ACTIVATION_RELU);
   const Map x3 = layers(x2, 7, 3, NN_ACTIVATION_RELU);
   const Map x4 = layers(x3, 10, 3, NN_ACTIVATION_RELU);
