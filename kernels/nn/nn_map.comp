@@ -7,12 +7,14 @@
 #include "nn/nn_shared.h"
 #include "elementwise.glsl"
 
-layout(std430, binding = NN_MAP_BINDING_A) readonly buffer A { float a[]; };
-layout(std430, binding = NN_MAP_BINDING_B) readonly buffer B { float b[]; };
+// The operands are uniform texel buffers, as the convolution's input (nn_conv2d.comp): on CPU drivers a texel
+// fetch at a per-lane index is one vector gather, a storage-buffer load a loop over the lanes.
+layout(binding = NN_MAP_BINDING_A) uniform samplerBuffer a;
+layout(binding = NN_MAP_BINDING_B) uniform samplerBuffer b;
 layout(std430, binding = NN_MAP_BINDING_OUT) writeonly buffer Out { float y[]; };
 layout(push_constant) uniform Push { NnMapParams p; };
 
-float at(uint c, uint row, uint column) { return a[(c * p.in_height + row) * p.in_width + column]; }
+float at(uint c, uint row, uint column) { return texelFetch(a, int((c * p.in_height + row) * p.in_width + column)).x; }
 
 // Source coordinate of output index d along a side of in_size -> out_size samples.
 void source(uint d, uint in_size, uint out_size, out uint i0, out uint i1, out float t) {
@@ -37,7 +39,7 @@ void main() {
   const uint e = elementwise_index();
   if (e >= p.count) return;
   if (p.op == NN_MAP_ADD) {
-    y[e] = a[e] + b[e];
+    y[e] = texelFetch(a, int(e)).x + texelFetch(b, int(e)).x;
     return;
   }
   const uint x = e % p.out_width;
@@ -52,7 +54,7 @@ void main() {
     y[e] = resized(c, row, x);
   } else if (p.op == NN_MAP_ADD_RESIZED) {
     // A feature pyramid's upsample-and-add in one pass: the resized map is never written.
-    y[e] = b[e] + resized(c, row, x);
+    y[e] = texelFetch(b, int(e)).x + resized(c, row, x);
   } else {  // NN_MAP_UNFOLD
     const uint ky = c / p.k, kx = c % p.k;
     y[e] = at(0u, row * p.k + ky, x * p.k + kx);
