@@ -94,8 +94,9 @@ void Conv2dKernel::record(engine::Sequence& s, const engine::Buffer& in, const e
 MapKernel::MapKernel(engine::Context& context)
     : context_(&context),
       // Both operands as texels (nn_map.comp).
-      kernel_(make_kernel(context, "nn/nn_map", NN_MAP_BINDING_COUNT, sizeof(NnMapParams), {},
-                          {{NN_MAP_BINDING_A, VK_FORMAT_R32_SFLOAT}, {NN_MAP_BINDING_B, VK_FORMAT_R32_SFLOAT}})) {}
+      kernel_(make_kernel(
+          context, "nn/nn_map", NN_MAP_BINDING_COUNT, sizeof(NnMapParams), {},
+          {{NN_MAP_BINDING_A, VK_FORMAT_R32_SFLOAT}, {NN_MAP_BINDING_B, VK_FORMAT_R32_SFLOAT}})) {}
 
 MapKernel::~MapKernel() = default;
 

@@ -44,7 +44,7 @@ struct NnConvParams {
 #define NN_MAP_RESIZE 2        // out = a resized bilinearly, half-pixel centres, clamped (ONNX Resize linear)
 #define NN_MAP_UNFOLD 3  // out channel ky k + kx = a one-channel image's pixel (ky, kx) of each k x k block
 #define NN_MAP_ADD_RESIZED 4  // out = b + a resized as NN_MAP_RESIZE does (b and out of the output's shape)
-#define NN_MAP_BINDING_A 0  // the maps (A and B): R32_SFLOAT texels
+#define NN_MAP_BINDING_A 0    // the maps (A and B): R32_SFLOAT texels
 #define NN_MAP_BINDING_B 1  // the second operand of NN_MAP_ADD and NN_MAP_ADD_RESIZED (bound to a otherwise)
 #define NN_MAP_BINDING_OUT 2
 #define NN_MAP_BINDING_COUNT 3
