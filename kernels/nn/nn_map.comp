@@ -14,7 +14,9 @@ layout(binding = NN_MAP_BINDING_B) uniform samplerBuffer b;
 layout(std430, binding = NN_MAP_BINDING_OUT) writeonly buffer Out { float y[]; };
 layout(push_constant) uniform Push { NnMapParams p; };
 
-float at(uint c, uint row, uint column) { return texelFetch(a, int((c * p.in_height + row) * p.in_width + column)).x; }
+float at(uint c, uint row, uint column) {
+  return texelFetch(a, int((c * p.in_height + row) * p.in_width + column)).x;
+}
 
 // Source coordinate of output index d along a side of in_size -> out_size samples.
 void source(uint d, uint in_size, uint out_size, out uint i0, out uint i1, out float t) {
