@@ -23,6 +23,25 @@ void add_refine_command(CLI::App& app) {
   auto no_anchors = std::make_shared<bool>(false);
   c->add_flag("--no-anchors", *no_anchors, "The same as --anchors off");
   c->add_flag(R::kPlanes.flag, *planes, R::kPlanes.help);
+  auto scans = std::make_shared<bool>(false);
+  c->add_flag(R::kScans.flag, *scans, R::kScans.help);
+  c->add_option("--scan-sigma", o->refine.ba.scan_sigma_m, "Scan point-to-plane sigma, metres")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  c->add_option("--scan-weight", o->refine.ba.scan_weight, "Weight of each scan point-to-plane residual")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  c->add_flag(
+      "--points-on-scan-map", o->refine.scan_alignment.points_on_scan_map,
+      "Hold the track points to the planes of the map the scans build each round (not lidar/map.pcd)");
+  c->add_option("--scan-gate", o->refine.scan_alignment.gate_start_m,
+                "Scan point-to-plane gate of the first round, metres (halved each round, floor 3 cm)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  c->add_option("--scan-points", o->refine.scan_alignment.residual_points_per_scan,
+                "Scan points per scan held to the map's planes")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   c->add_option("--alpha-min", o->refine.weights.alpha_min,
                 "Anchors' share of a frame's weight, slowest frames")
       ->capture_default_str();
@@ -80,10 +99,11 @@ void add_refine_command(CLI::App& app) {
   c->add_option("--markers", o->markers_xml,
                 "Metashape camera XML with the control points' image observations")
       ->check(CLI::ExistingFile);
-  c->callback([scene, o, no_anchors, planes, absolute] {
+  c->callback([scene, o, no_anchors, planes, absolute, scans] {
     if (*absolute) o->priors = "absolute";
     if (*no_anchors) o->anchors = "off";
     o->refine.use_planes = *planes;
+    o->refine.use_scans = *scans;
     const host::refine::SceneRefineReport r = host::refine::refine_scene(*scene, *o);
     const auto& rr = r.refine;
     std::cout << std::fixed << std::setprecision(3) << "refine: " << rr.outcome << " (" << rr.status << "); "

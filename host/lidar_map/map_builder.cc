@@ -87,6 +87,38 @@ LidarPoseAt scene_lidar_pose(const io::SceneConfig& config, const std::vector<io
   };
 }
 
+PlacedScan place_scan(const io::PointCloud& cloud, double t_stamp_s, const LidarPoseAt& pose_at,
+                      const LidarMapOptions& o) {
+  PlacedScan out;
+  const auto T0 = pose_at(t_stamp_s);
+  if (!T0) return out;
+  const io::ScalarField* time = o.deskew ? cloud.field("time") : nullptr;
+  ScanMotion motion;
+  if (time && !time->values.empty()) {
+    const auto [lo, hi] = std::minmax_element(time->values.begin(), time->values.end());
+    motion.t0 = *lo;
+    motion.dt = (*hi - *lo) / (o.deskew_samples - 1);
+    for (int k = 0; k < o.deskew_samples; ++k) {
+      // Beyond the trajectory's ends the scan's own stamp pose stands in.
+      const auto T = pose_at(t_stamp_s + motion.t0 + k * motion.dt);
+      add_pose(motion, T ? *T : *T0);
+    }
+    out.deskewed = true;
+  } else {
+    add_pose(motion, *T0);
+    time = nullptr;
+  }
+  const double min2 = o.min_range_m * o.min_range_m, max2 = o.max_range_m * o.max_range_m;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3d& x = cloud.positions[i];
+    const double r2 = x.squaredNorm();
+    if (r2 < min2 || r2 > max2) continue;
+    out.world.push_back(motion.place(x, time ? time->values[i] : 0.0));
+    out.index.push_back(i);
+  }
+  return out;
+}
+
 io::PointCloud build_lidar_map(const std::vector<double>& times,
                                const std::function<io::PointCloud(size_t)>& scan, const LidarPoseAt& pose_at,
                                const LidarMapOptions& o, LidarMapReport& report) {
@@ -94,39 +126,21 @@ io::PointCloud build_lidar_map(const std::vector<double>& times,
   const auto start = std::chrono::steady_clock::now();
   std::unordered_map<uint64_t, VoxelSum> voxels;
   bool all_intensity = true;
-  const double min2 = o.min_range_m * o.min_range_m, max2 = o.max_range_m * o.max_range_m;
   for (size_t s = 0; s < times.size(); ++s) {
-    const auto T0 = pose_at(times[s]);
-    if (!T0) {
+    if (!pose_at(times[s])) {
       ++report.scans_without_pose;
       continue;
     }
     const io::PointCloud cloud = scan(s);
-    const io::ScalarField* time = o.deskew ? cloud.field("time") : nullptr;
-    ScanMotion motion;
-    if (time && !time->values.empty()) {
-      const auto [lo, hi] = std::minmax_element(time->values.begin(), time->values.end());
-      motion.t0 = *lo;
-      motion.dt = (*hi - *lo) / (o.deskew_samples - 1);
-      for (int k = 0; k < o.deskew_samples; ++k) {
-        // Beyond the trajectory's ends the scan's own stamp pose stands in.
-        const auto T = pose_at(times[s] + motion.t0 + k * motion.dt);
-        add_pose(motion, T ? *T : *T0);
-      }
-      ++report.scans_deskewed;
-    } else {
-      add_pose(motion, *T0);
-      time = nullptr;
-    }
+    const PlacedScan placed = place_scan(cloud, times[s], pose_at, o);
+    report.scans_deskewed += placed.deskewed;
     ++report.scans;
     all_intensity = all_intensity && cloud.intensity.size() == cloud.size();
-    for (size_t i = 0; i < cloud.size(); ++i) {
-      const Eigen::Vector3d& x = cloud.positions[i];
-      const double r2 = x.squaredNorm();
-      if (r2 < min2 || r2 > max2) continue;
-      const Eigen::Vector3d w = motion.place(x, time ? time->values[i] : 0.0);
+    for (size_t k = 0; k < placed.world.size(); ++k) {
+      const Eigen::Vector3d& w = placed.world[k];
       VoxelSum& v = voxels[voxel_key(w, o.voxel_m)];
       v.xyz += w;
+      const size_t i = placed.index[k];
       if (i < cloud.intensity.size()) v.intensity += cloud.intensity[i];
       ++v.count;
       ++report.input_points;

@@ -53,6 +53,17 @@ LidarPoseAt scene_lidar_pose(const io::Scene& scene);
 // prior and refined poses); `poses` must outlive the returned function.
 LidarPoseAt scene_lidar_pose(const io::SceneConfig& config, const std::vector<io::TumPose>& poses);
 
+// One scan's points in range, each placed in the world with the pose at its own time (deskewed where the
+// scan has a "time" field and options.deskew), and the index of each in the scan. Empty when the stamp
+// lies outside the trajectory.
+struct PlacedScan {
+  std::vector<Eigen::Vector3d> world;
+  std::vector<size_t> index;
+  bool deskewed = false;
+};
+PlacedScan place_scan(const io::PointCloud& scan, double t_stamp_s, const LidarPoseAt& T_world_lidar,
+                      const LidarMapOptions& options);
+
 // The map from scans given one at a time (sensor frame; an extra field "time" holds each point's seconds
 // after the scan's stamp). Output: world positions, mean intensity where every scan has one, unit normals
 // where planar (zero elsewhere), and the extra field "planarity" = 1 - smallest/middle eigenvalue of the

@@ -81,6 +81,17 @@ BaSolveSummary solve_bundle_adjustment(BaProblem& b) {
       ++s.anchor_residuals;
     }
   }
+  if (b.scan_links)
+    for (const ScanPlaneLink& l : *b.scan_links) {
+      if (!variable(l.frame)) continue;
+      add_pose(l.frame);
+      auto* cost = new ceres::AutoDiffCostFunction<ScanPointToPlane, 1, 4, 3>(
+          new ScanPointToPlane{l.x_cam, l.plane, 1 / w.scan_sigma_m});
+      problem.AddResidualBlock(
+          cost, new ceres::ScaledLoss(new ceres::CauchyLoss(1.0), w.scan_weight, ceres::TAKE_OWNERSHIP),
+          poses[l.frame].q_world_cam.coeffs().data(), poses[l.frame].p_world_cam.data());
+      ++s.scan_residuals;
+    }
   // Odometry priors between consecutive frames with at least one variable.
   for (size_t f = 0; f + 1 < n; ++f) {
     if (!variable(f) && !variable(f + 1)) continue;

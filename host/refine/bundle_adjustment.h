@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "host/refine/ba_types.h"
+#include "host/refine/scan_alignment.h"
 
 namespace litgs::host::refine {
 
@@ -60,6 +61,10 @@ struct BaWeights {
   // out of code comments"). 0: off.
   double odometry_sigma_t_m = 0.02;
   double odometry_sigma_t_per_m = 0.02;
+  // LiDAR scan points held to the planes of the map the current poses build (scan_alignment.h): residual
+  // distance / sigma, Cauchy at 1, times scan_weight.
+  double scan_sigma_m = 0.02;
+  double scan_weight = 1;
   double gauge_sigma_t_m = 0.01;     // the first frame's pose prior: the odometry's per-frame accuracy
   double gauge_sigma_r_rad = 0.003;  // (translation as rel_sigma_t_m)
   // Priors that are absolute (a georeferenced photogrammetric solution such as Metashape's, not an
@@ -69,12 +74,13 @@ struct BaWeights {
 
 struct BaProblem {
   PinholeCamera camera;
-  std::vector<CameraPose>* poses = nullptr;              // refined in place
-  const std::vector<CameraPose>* priors = nullptr;       // the odometry's poses, same frames
-  std::vector<TrackPoint>* points = nullptr;             // refined in place
-  const std::vector<AnchorPoint>* anchors = nullptr;     // null: no anchor priors
-  std::vector<Eigen::Matrix3d> anchor_sqrt_information;  // L^-1 per anchor (when anchors)
-  std::vector<bool> variable;                            // per frame; empty: all
+  std::vector<CameraPose>* poses = nullptr;                // refined in place
+  const std::vector<CameraPose>* priors = nullptr;         // the odometry's poses, same frames
+  std::vector<TrackPoint>* points = nullptr;               // refined in place
+  const std::vector<AnchorPoint>* anchors = nullptr;       // null: no anchor priors
+  std::vector<Eigen::Matrix3d> anchor_sqrt_information;    // L^-1 per anchor (when anchors)
+  const std::vector<ScanPlaneLink>* scan_links = nullptr;  // null: no scan term
+  std::vector<bool> variable;                              // per frame; empty: all
   bool use_planes = true, use_anchor_priors = true;
   BaWeights weights;
   int threads = 1;
@@ -84,7 +90,8 @@ struct BaProblem {
 struct BaSolveSummary {
   double initial_cost = 0, final_cost = 0;
   int iterations = 0;
-  size_t reprojection_residuals = 0, plane_residuals = 0, prior_residuals = 0, anchor_residuals = 0;
+  size_t reprojection_residuals = 0, plane_residuals = 0, prior_residuals = 0, anchor_residuals = 0,
+         scan_residuals = 0;
   size_t points = 0, variable_frames = 0;
   bool usable = false;      // Ceres' verdict on the solution
   std::string termination;  // CONVERGENCE, NO_CONVERGENCE, ...

@@ -43,6 +43,22 @@ struct PointToPlane {
   }
 };
 
+// Signed distance of a LiDAR point, fixed in its frame's camera (x_cam), placed through that frame's pose
+// T_world_cam = (q, p), to its map plane, over sigma.
+struct ScanPointToPlane {
+  Eigen::Vector3d x_cam;
+  PlaneRef plane;
+  double inv_sigma;
+  template <class T>
+  bool operator()(const T* q_, const T* p_, T* r) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(q_);
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> p(p_);
+    const Eigen::Matrix<T, 3, 1> x = q * x_cam.cast<T>() + p;
+    r[0] = T(inv_sigma) * plane.n.cast<T>().dot(x - plane.l.cast<T>());
+    return true;
+  }
+};
+
 // A small rotation error e as the whitened angle-axis 2 vec(e) / sigma (radians), the same for e and -e.
 template <class T>
 void rotation_residual(const Eigen::Quaternion<T>& e, double inv_sigma_r, T* r) {

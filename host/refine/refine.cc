@@ -76,6 +76,10 @@ void RefineOptions::check() const {
   if (max_iterations < 1) throw std::invalid_argument("refine: max_iterations must be >= 1");
   weights.check();
   holdout.check();
+  scan_alignment.check();
+  if (!(ba.scan_sigma_m > 0)) throw std::invalid_argument("refine: scan_sigma_m must be > 0");
+  if (!(ba.scan_weight >= 0) || !std::isfinite(ba.scan_weight))
+    throw std::invalid_argument("refine: scan_weight must be finite and >= 0");
 }
 
 ResidualStats residual_stats(const std::vector<TrackPoint>& points, const std::vector<CameraPose>& poses,
@@ -142,6 +146,7 @@ RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, co
 
   const bool planes = o.use_planes && in.map && in.map->planar_count() > 0;
   const bool anchors = o.use_anchors && !in.anchors.empty();
+  const bool scans = o.use_scans && !in.scans.empty();
   if (o.use_planes && !planes) report.notes.push_back("no LiDAR planes: the plane term is off");
   if (o.use_anchors && !anchors) report.notes.push_back("no anchors: the anchor weights and priors are off");
   if (anchors && o.rounds <= o.anchors_from_round)
@@ -166,7 +171,10 @@ RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, co
   }
   report.alphas = motion_alphas(motion_scores(in.priors), o.weights);
   std::unique_ptr<PlaneAssociator> associator;
-  if (planes) associator = std::make_unique<PlaneAssociator>(*in.map, in.camera);
+  // With points_on_scan_map the track points take their planes from the map the scans build each round.
+  const bool points_on_scans = scans && planes && o.scan_alignment.points_on_scan_map;
+  if (planes && !points_on_scans) associator = std::make_unique<PlaneAssociator>(*in.map, in.camera);
+  PlanarMap round_map;
 
   size_t active_points = 0;
   for (const auto& p : in.points) active_points += p.active;
@@ -218,7 +226,17 @@ RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, co
     if (anchors_now)
       report.anchor_association = associate_anchors(in.points, guarded_anchors, poses, in.camera,
                                                     planes ? in.map : nullptr, o.anchor_association, r);
+    if (scans) {
+      if (points_on_scans) associator.reset();  // it holds the previous round's map
+      round_map = scan_map(in.scans, poses, r, o.scan_alignment);
+      if (points_on_scans) associator = std::make_unique<PlaneAssociator>(round_map, in.camera);
+    }
     if (associator) rr.planes = associator->associate(in.points, poses, r, o.plane_association);
+    std::vector<ScanPlaneLink> scan_links;
+    if (scans) {
+      scan_links = associate_scan_planes(in.scans, poses, round_map, r, o.scan_alignment, rr.scans);
+      rr.scan_rms_before_m = scan_plane_rms_m(scan_links, poses);
+    }
     if (r == 0) report.before = residual_stats(in.points, poses, in.camera);
     rr.before = residual_stats(in.points, poses, in.camera);
     assign_observation_weights(in.points, report.alphas, anchor_w, o.weights);
@@ -232,6 +250,7 @@ RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, co
     problem.anchors = anchors_now ? &in.anchors : nullptr;
     problem.anchor_sqrt_information = sqrt_info;
     problem.use_planes = planes;
+    problem.scan_links = scans ? &scan_links : nullptr;
     problem.use_anchor_priors = anchors_now;
     problem.weights = o.ba;
     problem.threads = o.threads;
@@ -257,6 +276,7 @@ RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, co
       report.stopped_early = true;
     }
     rr.after = residual_stats(in.points, poses, in.camera);
+    rr.scan_rms_after_m = scan_plane_rms_m(scan_links, poses);
     if (r + 1 < o.rounds && !report.stopped_early) {
       // Rejection between rounds: observations and plane links beyond the robust bound.
       std::vector<double> e, d;

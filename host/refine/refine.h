@@ -10,6 +10,7 @@
 #include "host/refine/association.h"
 #include "host/refine/bundle_adjustment.h"
 #include "host/refine/holdout_guard.h"
+#include "host/refine/scan_alignment.h"
 #include "host/refine/weights.h"
 
 namespace litgs::host::refine {
@@ -38,6 +39,10 @@ struct RefineOptions {
   WeightOptions weights;
   AnchorAssociationOptions anchor_association;
   PlaneAssociationOptions plane_association;
+  // The LiDAR scans in the solve (scan_alignment.h), when the input has them. Off by default: on the
+  // synthetic street it made two of five seeds worse than their input (docs/experiments.md).
+  bool use_scans = false;
+  ScanAlignmentOptions scan_alignment;
   BaWeights ba;
   void check() const;  // std::invalid_argument naming the bad field
 };
@@ -48,6 +53,7 @@ struct RefineInput {
   std::vector<TrackPoint> points;  // observations undistorted; X the initial triangulation
   std::vector<AnchorPoint> anchors;
   const PlanarMap* map = nullptr;  // the LiDAR map's plane fits; null: none
+  std::vector<RefineScan> scans;   // the scans tied to their frames (not the guard's held-out ones)
 };
 
 struct ResidualStats {
@@ -69,6 +75,8 @@ struct RoundReport {
   size_t local_solves = 0;
   ResidualStats before, after;
   PlaneAssociationReport planes;
+  ScanAssociationReport scans;
+  double scan_rms_before_m = 0, scan_rms_after_m = 0;  // the scan links' point-to-plane RMS
   size_t rejected_observations = 0, rejected_planes = 0, dropped_points = 0;  // after this round
   double reject_bound_px = 0, reject_bound_m = 0;
   BaSolveSummary global;

@@ -122,6 +122,14 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                         {"by_nearest_point", rr.planes.by_nearest_point},
                         {"unassociated", rr.planes.unassociated},
                         {"radius_m", rr.planes.radius_m}}},
+                      {"scans",
+                       {{"scans", rr.scans.scans},
+                        {"map_points", rr.scans.map_points},
+                        {"planar_map_points", rr.scans.planar_map_points},
+                        {"links", rr.scans.links},
+                        {"gate_m", rr.scans.gate_m},
+                        {"rms_before_m", rr.scan_rms_before_m},
+                        {"rms_after_m", rr.scan_rms_after_m}}},
                       {"rejected_observations", rr.rejected_observations},
                       {"rejected_planes", rr.rejected_planes},
                       {"dropped_points", rr.dropped_points},
@@ -137,6 +145,7 @@ nlohmann::json report_json(const SceneRefineReport& sr, const SceneRefineOptions
                         {"plane_residuals", rr.global.plane_residuals},
                         {"prior_residuals", rr.global.prior_residuals},
                         {"anchor_residuals", rr.global.anchor_residuals},
+                        {"scan_residuals", rr.global.scan_residuals},
                         {"brief", rr.global.brief},
                         {"seconds", rr.global.seconds}}},
                       {"seconds", rr.seconds}});
@@ -229,6 +238,41 @@ PlanarMap map_through(const fs::path& dir, const io::Scene& scene, const LidarPo
       times, [&](size_t j) { return io::read_pcd(dir / scene.scans[kept[j]].file); }, trajectory, options,
       report);
   return fit_planes(map.positions, {});
+}
+
+// The scans that enter the solve: every scan the guard's scan check does not hold out, its points in range
+// deskewed to its stamp through the priors and evenly subsampled, tied to the frame nearest its stamp by
+// the priors' pose of the LiDAR in that frame's camera.
+std::vector<RefineScan> scans_tied_to_frames(const fs::path& dir, const io::Scene& scene,
+                                             const std::vector<CameraPose>& priors, int heldout_every,
+                                             size_t points_per_scan) {
+  std::vector<RefineScan> out;
+  if (priors.empty()) return out;
+  const std::vector<io::TumPose> trajectory = to_tum(priors, scene.config);
+  const LidarPoseAt lidar_at = scene_lidar_pose(scene.config, trajectory);
+  const LidarMapOptions placing;  // the map's range gate and deskew
+  for (size_t i = 0; i < scene.scans.size(); ++i) {
+    if (io::is_heldout_scan(i, heldout_every)) continue;
+    const double t_lidar = scene.scans[i].t_s;
+    const auto T_world_lidar = lidar_at(t_lidar);
+    if (!T_world_lidar) continue;  // outside the frames' time span
+    const double t_cam = t_lidar - scene.config.time_offset_cam_lidar_s;
+    size_t f = 0;
+    for (size_t k = 1; k < scene.frames.size(); ++k)
+      if (std::abs(scene.frames[k].t_s - t_cam) < std::abs(scene.frames[f].t_s - t_cam)) f = k;
+    const PlacedScan placed = place_scan(io::read_pcd(dir / scene.scans[i].file), t_lidar, lidar_at, placing);
+    if (placed.world.empty()) continue;
+    const Eigen::Isometry3d world_lidar(*T_world_lidar);
+    RefineScan scan;
+    scan.frame = static_cast<uint32_t>(f);
+    scan.T_cam_scan = Eigen::Isometry3d(to_matrix(priors[f]).inverse()) * world_lidar;
+    const Eigen::Isometry3d lidar_world = world_lidar.inverse();
+    const size_t step = std::max<size_t>(1, placed.world.size() / points_per_scan);
+    for (size_t k = 0; k < placed.world.size(); k += step)
+      scan.points_lidar.push_back(lidar_world * placed.world[k]);
+    out.push_back(std::move(scan));
+  }
+  return out;
 }
 
 // The scans the map left out (or, in a scene that holds none out, every Nth scan) through the prior and
@@ -353,6 +397,12 @@ SceneRefineReport refine_scene(const fs::path& dir, const SceneRefineOptions& o)
   if (scene.map && o.refine.use_planes) {
     planar = fit_planes(scene.map->positions, {});
     in.map = &planar;
+  }
+  if (o.refine.use_scans && !scene.scans.empty()) {
+    const int guard_every = scene.config.lidar_holdout_every > 0 ? scene.config.lidar_holdout_every
+                                                                 : static_cast<int>(o.scan_check.every);
+    in.scans =
+        scans_tied_to_frames(dir, scene, in.priors, guard_every, o.refine.scan_alignment.map_points_per_scan);
   }
   std::vector<CameraPose> poses = in.priors;
   // The points as they came (through the priors), written instead of the solve's when the priors are kept:

@@ -53,6 +53,7 @@ struct RunConfig {
     std::string tracks = "auto";
     std::string anchors = "auto";
     bool planes = true;
+    bool scans = false;
     uint32_t rounds = 8;  // refine's default (host/refine/refine.h)
     // auto: a pose prior on every frame (`refine --absolute-priors`) when INPUT is a Metashape or COLMAP
     // project, whose poses are a global photogrammetric solution, not a drifting odometry.
@@ -134,6 +135,7 @@ void for_each_field(Config& c, F&& f) {
   named("refine", refine_option::kTracks, c.refine.tracks);
   named("refine", refine_option::kAnchors, c.refine.anchors);
   named("refine", refine_option::kPlanes, c.refine.planes);
+  named("refine", refine_option::kScans, c.refine.scans);
   named("refine", refine_option::kRounds, c.refine.rounds);
   f("refine", "absolute_priors", c.refine.absolute_priors,
     "auto (a pose prior on every frame when INPUT is a Metashape or COLMAP project: a global solution, not "

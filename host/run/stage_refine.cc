@@ -43,7 +43,8 @@ StagePlan plan(const StageContext& c) {
   plan_on_scene_copy(
       c, "refine", SceneCopy{scene, {"poses.txt", "poses_prior.txt"}, {"refine", "refine.json"}},
       option_flags(flags_from, {refine_option::kTracks, refine_option::kAnchors, refine_option::kPlanes,
-                                refine_option::kRounds, refine_option::kThreads, refine_option::kPriors}),
+                                refine_option::kScans, refine_option::kRounds, refine_option::kThreads,
+                                refine_option::kPriors}),
       o.extra_args, p);
   return p;
 }
@@ -59,6 +60,10 @@ nlohmann::json result(const StageContext& c) {
   // Only where points were held to LiDAR planes (a scene without LiDAR has no plane residual, not a 0).
   if (r["before"].value("plane_points", 0) > 0 || r["after"].value("plane_points", 0) > 0)
     metrics["plane_rms_m"] = {r["before"]["plane_rms_m"], r["after"]["plane_rms_m"]};
+  // The scans' point-to-plane RMS at the first round's association and after the last solve.
+  const nlohmann::json& rounds = r.value("rounds", nlohmann::json::array());
+  if (!rounds.empty() && rounds.front().contains("scans") && rounds.front()["scans"].value("links", 0) > 0)
+    metrics["scan_rms_m"] = {rounds.front()["scans"]["rms_before_m"], rounds.back()["scans"]["rms_after_m"]};
   return {{"scene", scene.string()}, {"metrics", metrics}};
 }
 

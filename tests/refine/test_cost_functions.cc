@@ -89,6 +89,30 @@ TEST(RefineCostFunctions, PointToPlaneIsTheSignedDistanceOverSigma) {
   expect_jacobians_agree(automatic, numeric, {X.data()}, 1e-6);
 }
 
+TEST(RefineCostFunctions, ScanPointToPlaneIsThePlacedPointsSignedDistanceOverSigma) {
+  PlaneRef plane;
+  plane.n = Eigen::Vector3d(0, 0.6, 0.8);
+  plane.l = Eigen::Vector3d(1, 2, 3);
+  CameraPose pose{0, rotation(0.2, -0.1, 0.4), {0.3, 1.0, -0.5}};
+  const Eigen::Vector3d x_cam(0.7, -1.2, 4.0);
+  const ScanPointToPlane f{x_cam, plane, 1 / 0.02};
+  double r;
+  ASSERT_TRUE(f(pose.q_world_cam.coeffs().data(), pose.p_world_cam.data(), &r));
+  // Independently: through the rotation matrix.
+  const Eigen::Vector3d w = pose.q_world_cam.toRotationMatrix() * x_cam + pose.p_world_cam;
+  EXPECT_NEAR(r, plane.n.dot(w - plane.l) / 0.02, 1e-9);
+  // Moving the camera 3 cm along the normal moves the residual by 1.5 sigma.
+  CameraPose moved = pose;
+  moved.p_world_cam += 0.03 * plane.n;
+  double r_moved;
+  ASSERT_TRUE(f(moved.q_world_cam.coeffs().data(), moved.p_world_cam.data(), &r_moved));
+  EXPECT_NEAR(r_moved - r, 1.5, 1e-9);
+  ceres::AutoDiffCostFunction<ScanPointToPlane, 1, 4, 3> automatic(new ScanPointToPlane(f));
+  ceres::NumericDiffCostFunction<ScanPointToPlane, ceres::CENTRAL, 1, 4, 3> numeric(new ScanPointToPlane(f));
+  expect_jacobians_agree(automatic, numeric, {pose.q_world_cam.coeffs().data(), pose.p_world_cam.data()},
+                         1e-5);
+}
+
 TEST(RefineCostFunctions, RelativePoseIsZeroAtTheMeasuredMotionAndGrowsWithTheError) {
   const Eigen::Quaterniond qi = rotation(0.05, 0.1, -0.2), qj = rotation(0.06, 0.08, -0.15);
   const Eigen::Vector3d pi(1, 2, 0.5), pj(1.3, 2.1, 0.45);
