@@ -39,8 +39,8 @@ struct RefineOptions {
   WeightOptions weights;
   AnchorAssociationOptions anchor_association;
   PlaneAssociationOptions plane_association;
-  // The LiDAR scans in the solve (scan_alignment.h), when the input has them. Off by default: on the
-  // synthetic street it made two of five seeds worse than their input (docs/experiments.md).
+  // The LiDAR scans in the solve (scan_alignment.h), when the input has them. Off by default until it is
+  // measured where the defaults are (docs/refinement.md, "Scans in the solve").
   bool use_scans = false;
   ScanAlignmentOptions scan_alignment;
   BaWeights ba;
