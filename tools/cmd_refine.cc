@@ -38,6 +38,9 @@ void add_refine_command(CLI::App& app) {
                 "Scan point-to-plane gate of the first round, metres (halved each round, floor 3 cm)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  c->add_option("--scans-from-round", o->refine.scan_alignment.from_round,
+                "Round (0-based) in which the scans join the solve")
+      ->capture_default_str();
   c->add_option("--scan-points", o->refine.scan_alignment.residual_points_per_scan,
                 "Scan points per scan held to the map's planes")
       ->capture_default_str()

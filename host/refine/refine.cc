@@ -173,7 +173,7 @@ RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, co
   std::unique_ptr<PlaneAssociator> associator;
   // With points_on_scan_map the track points take their planes from the map the scans build each round.
   const bool points_on_scans = scans && planes && o.scan_alignment.points_on_scan_map;
-  if (planes && !points_on_scans) associator = std::make_unique<PlaneAssociator>(*in.map, in.camera);
+  if (planes) associator = std::make_unique<PlaneAssociator>(*in.map, in.camera);
   PlanarMap round_map;
 
   size_t active_points = 0;
@@ -226,15 +226,18 @@ RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, co
     if (anchors_now)
       report.anchor_association = associate_anchors(in.points, guarded_anchors, poses, in.camera,
                                                     planes ? in.map : nullptr, o.anchor_association, r);
-    if (scans) {
+    // The scans join from their round on, their map's voxel and gate schedule starting there.
+    const bool scans_now = scans && r >= o.scan_alignment.from_round;
+    const size_t scan_round = scans_now ? r - o.scan_alignment.from_round : 0;
+    if (scans_now) {
       if (points_on_scans) associator.reset();  // it holds the previous round's map
-      round_map = scan_map(in.scans, poses, r, o.scan_alignment);
+      round_map = scan_map(in.scans, poses, scan_round, o.scan_alignment);
       if (points_on_scans) associator = std::make_unique<PlaneAssociator>(round_map, in.camera);
     }
     if (associator) rr.planes = associator->associate(in.points, poses, r, o.plane_association);
     std::vector<ScanPlaneLink> scan_links;
-    if (scans) {
-      scan_links = associate_scan_planes(in.scans, poses, round_map, r, o.scan_alignment, rr.scans);
+    if (scans_now) {
+      scan_links = associate_scan_planes(in.scans, poses, round_map, scan_round, o.scan_alignment, rr.scans);
       rr.scan_rms_before_m = scan_plane_rms_m(scan_links, poses);
     }
     if (r == 0) report.before = residual_stats(in.points, poses, in.camera);
@@ -250,7 +253,7 @@ RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, co
     problem.anchors = anchors_now ? &in.anchors : nullptr;
     problem.anchor_sqrt_information = sqrt_info;
     problem.use_planes = planes;
-    problem.scan_links = scans ? &scan_links : nullptr;
+    problem.scan_links = scans_now ? &scan_links : nullptr;
     problem.use_anchor_priors = anchors_now;
     problem.weights = o.ba;
     problem.threads = o.threads;

@@ -30,6 +30,7 @@ struct ScanAlignmentOptions {
   // The track points' plane term on this map too, instead of the scene's LiDAR map (which the prior poses
   // placed): one map that moves with the poses.
   bool points_on_scan_map = false;
+  size_t from_round = 0;  // the refinement's round (0-based) the scans join in
   double voxel_at(size_t round) const;
   void check() const;  // std::invalid_argument naming the field
 };
