@@ -1,6 +1,7 @@
 // `litgs-engine refine SCENE [--no-anchors] [--no-planes] [--alpha-min A --alpha-max B] [--rounds N]
 // [--threads T]`: LiDAR-plane-constrained bundle adjustment of the scene's poses (docs/refinement.md).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -23,8 +24,7 @@ void add_refine_command(CLI::App& app) {
   auto no_anchors = std::make_shared<bool>(false);
   c->add_flag("--no-anchors", *no_anchors, "The same as --anchors off");
   c->add_flag(R::kPlanes.flag, *planes, R::kPlanes.help);
-  auto scans = std::make_shared<bool>(false);
-  c->add_flag(R::kScans.flag, *scans, R::kScans.help);
+  c->add_flag(R::kScans.flag, o->refine.use_scans, R::kScans.help);
   c->add_option("--scan-sigma", o->refine.ba.scan_sigma_m, "Scan point-to-plane sigma, metres")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -102,11 +102,10 @@ void add_refine_command(CLI::App& app) {
   c->add_option("--markers", o->markers_xml,
                 "Metashape camera XML with the control points' image observations")
       ->check(CLI::ExistingFile);
-  c->callback([scene, o, no_anchors, planes, absolute, scans] {
+  c->callback([scene, o, no_anchors, planes, absolute] {
     if (*absolute) o->priors = "absolute";
     if (*no_anchors) o->anchors = "off";
     o->refine.use_planes = *planes;
-    o->refine.use_scans = *scans;
     const host::refine::SceneRefineReport r = host::refine::refine_scene(*scene, *o);
     const auto& rr = r.refine;
     std::cout << std::fixed << std::setprecision(3) << "refine: " << rr.outcome << " (" << rr.status << "); "
@@ -117,6 +116,12 @@ void add_refine_command(CLI::App& app) {
     if (rr.after.behind_camera > 0)
       std::cout << " (" << rr.after.behind_camera << " observations behind their camera left out)";
     std::cout << ", plane RMS " << rr.before.plane_rms_m << " -> " << rr.after.plane_rms_m << " m";
+    const auto first_scans =
+        std::find_if(rr.rounds.begin(), rr.rounds.end(),
+                     [](const host::refine::RoundReport& x) { return x.scans.links > 0; });
+    if (first_scans != rr.rounds.end())
+      std::cout << ", scan RMS " << first_scans->scan_rms_before_m << " -> "
+                << rr.rounds.back().scan_rms_after_m << " m (" << first_scans->scans.scans << " scans)";
     if (r.has_truth) std::cout << "; ATE " << r.ate_before_m << " -> " << r.ate_after_m << " m";
     if (r.ate_rejected_m >= 0)
       std::cout << " (the solve the guards turned down: " << r.ate_rejected_m << " m)";
