@@ -22,22 +22,6 @@ struct VoxelSum {
   uint32_t count = 0;
 };
 
-// 21 bits per axis (offset binary): +-1,048,576 voxels, 100 km at 0.1 m.
-constexpr int64_t kVoxelHalfRange = int64_t{1} << 20;
-
-uint64_t voxel_key(const Eigen::Vector3d& p, double voxel_m) {
-  uint64_t key = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double c = std::floor(p[a] / voxel_m);
-    if (!(std::abs(c) < static_cast<double>(kVoxelHalfRange)))
-      throw std::invalid_argument("LiDAR map: a point at " + std::to_string(p[a]) + " m lies beyond the " +
-                                  std::to_string(kVoxelHalfRange) + " voxels of the map's grid (voxel " +
-                                  std::to_string(voxel_m) + " m)");
-    key = (key << 21) | static_cast<uint64_t>(static_cast<int64_t>(c) + kVoxelHalfRange);
-  }
-  return key;
-}
-
 // Poses sampled across one scan's time span; a point's pose interpolates the two around its time.
 struct ScanMotion {
   double t0 = 0, dt = 0;
@@ -58,7 +42,23 @@ void add_pose(ScanMotion& m, const Eigen::Matrix4d& T) {
   m.p.push_back(T.topRightCorner<3, 1>());
 }
 
+// 21 bits per axis (offset binary): +-1,048,576 voxels, 100 km at 0.1 m.
+constexpr int64_t kVoxelHalfRange = int64_t{1} << 20;
+
 }  // namespace
+
+uint64_t voxel_key(const Eigen::Vector3d& p, double voxel_m) {
+  uint64_t key = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double c = std::floor(p[a] / voxel_m);
+    if (!(std::abs(c) < static_cast<double>(kVoxelHalfRange)))
+      throw std::invalid_argument("LiDAR map: a point at " + std::to_string(p[a]) + " m lies beyond the " +
+                                  std::to_string(kVoxelHalfRange) + " voxels of the map's grid (voxel " +
+                                  std::to_string(voxel_m) + " m)");
+    key = (key << 21) | static_cast<uint64_t>(static_cast<int64_t>(c) + kVoxelHalfRange);
+  }
+  return key;
+}
 
 void LidarMapOptions::check() const {
   if (!(voxel_m > 0)) throw std::invalid_argument("LidarMapOptions.voxel_m must be > 0");

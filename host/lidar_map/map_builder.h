@@ -53,6 +53,10 @@ LidarPoseAt scene_lidar_pose(const io::Scene& scene);
 // prior and refined poses); `poses` must outlive the returned function.
 LidarPoseAt scene_lidar_pose(const io::SceneConfig& config, const std::vector<io::TumPose>& poses);
 
+// The key of the map voxel (edge voxel_m) that holds p: 21 bits per axis, so +-2^20 voxels; a point beyond
+// them is a std::invalid_argument that names it.
+uint64_t voxel_key(const Eigen::Vector3d& p, double voxel_m);
+
 // One scan's points in range, each placed in the world with the pose at its own time (deskewed where the
 // scan has a "time" field and options.deskew), and the index of each in the scan. Empty when the stamp
 // lies outside the trajectory.

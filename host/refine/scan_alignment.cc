@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "host/lidar_map/map_builder.h"
 #include "host/train/point_kdtree.h"
 
 namespace litgs::host::refine {
@@ -57,12 +58,7 @@ std::vector<Eigen::Vector3d> voxel_map(const std::vector<RefineScan>& scans,
     for (size_t i = 0; i < s.points_lidar.size(); i += step) {
       const Eigen::Vector3d w = T * s.points_lidar[i];
       if (!w.allFinite()) continue;
-      uint64_t key = 0;
-      for (int a = 0; a < 3; ++a)  // 21 bits per axis, offset binary: +-105 km at 0.1 m
-        key = (key << 21) |
-              (static_cast<uint64_t>(static_cast<int64_t>(std::floor(w[a] / voxel_m)) + (int64_t{1} << 20)) &
-               ((uint64_t{1} << 21) - 1));
-      Sum& v = voxels[key];
+      Sum& v = voxels[voxel_key(w, voxel_m)];
       v.xyz += w;
       ++v.n;
     }
