@@ -153,6 +153,9 @@ RefineReport solve_and_judge(RefineInput& in, std::vector<CameraPose>& poses, co
     report.notes.push_back("anchors join in round " + std::to_string(o.anchors_from_round + 1) +
                            " (after a solve without them); with " + std::to_string(o.rounds) +
                            " round(s) they are not used");
+  if (scans && o.rounds <= o.scan_alignment.from_round)
+    report.notes.push_back("the scans join in round " + std::to_string(o.scan_alignment.from_round + 1) +
+                           "; with " + std::to_string(o.rounds) + " round(s) they are not used");
   std::vector<double> anchor_w;
   std::vector<Eigen::Matrix3d> sqrt_info;
   std::vector<AnchorPoint> guarded_anchors;  // covariances guarded: the association's gate inverts them

@@ -39,9 +39,9 @@ struct RefineOptions {
   WeightOptions weights;
   AnchorAssociationOptions anchor_association;
   PlaneAssociationOptions plane_association;
-  // The LiDAR scans in the solve (scan_alignment.h), when the input has them. Off by default until it is
-  // measured where the defaults are (docs/refinement.md, "Scans in the solve").
-  bool use_scans = false;
+  // The LiDAR scans in the solve (scan_alignment.h), when the input has them, from
+  // scan_alignment.from_round on (docs/refinement.md, "Scans in the solve").
+  bool use_scans = true;
   ScanAlignmentOptions scan_alignment;
   BaWeights ba;
   void check() const;  // std::invalid_argument naming the bad field

@@ -18,9 +18,9 @@ inline constexpr OptionName kPlanes{
     "LiDAR point-to-plane term (--no-planes: none; off where the scene has no "
     "LiDAR map)"};
 inline constexpr OptionName kScans{
-    "scans", "--scans",
-    "LiDAR scans in the solve, an experiment (docs/refinement.md): each scan's points held to the planes of "
-    "the map the current poses build from all scans"};
+    "scans", "!--no-scans",
+    "LiDAR scans in the solve from --scans-from-round on, each scan's points held to the planes of the map "
+    "the current poses build from all scans (--no-scans: none; off where the scene has no scans)"};
 inline constexpr OptionName kRounds{"rounds", "--rounds", "Rounds (association, solve, rejection)"};
 inline constexpr OptionName kThreads{"threads", "--threads", "Ceres threads"};
 // run.yaml's refine.absolute_priors decides it (run passes "absolute" or "odometry").

@@ -30,7 +30,10 @@ struct ScanAlignmentOptions {
   // The track points' plane term on this map too, instead of the scene's LiDAR map (which the prior poses
   // placed): one map that moves with the poses.
   bool points_on_scan_map = false;
-  size_t from_round = 0;  // the refinement's round (0-based) the scans join in
+  // The refinement's round (0-based) the scans join in. Their map is built through the current poses, and
+  // through poses that still carry most of the priors' drift it is smeared: the links it gives hold the
+  // solve in that state (docs/refinement.md). From the fifth round the image term has done most of its work.
+  size_t from_round = 4;
   double voxel_at(size_t round) const;
   void check() const;  // std::invalid_argument naming the field
 };
