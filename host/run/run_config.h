@@ -53,7 +53,7 @@ struct RunConfig {
     std::string tracks = "auto";
     std::string anchors = "auto";
     bool planes = true;
-    bool scans = true;
+    bool scans = true;    // refine's default (host/refine/refine.h)
     uint32_t rounds = 8;  // refine's default (host/refine/refine.h)
     // auto: a pose prior on every frame (`refine --absolute-priors`) when INPUT is a Metashape or COLMAP
     // project, whose poses are a global photogrammetric solution, not a drifting odometry.
