@@ -11,7 +11,6 @@ void LidarCheckOptions::check() const {
   if (!(max_transfer_px > 0)) throw std::invalid_argument("lidar_check.max_transfer_px must be > 0");
   if (cell_px < 1) throw std::invalid_argument("lidar_check.cell_px must be >= 1");
   if (window > 8) throw std::invalid_argument("lidar_check.window must be <= 8");
-  if (!(edge_ratio >= 0)) throw std::invalid_argument("lidar_check.edge_ratio must be >= 0");
   if (!(min_depth_m > 0)) throw std::invalid_argument("lidar_check.min_depth_m must be > 0");
 }
 
@@ -23,7 +22,6 @@ LidarDepthImage::LidarDepthImage(const std::vector<Eigen::Vector3d>& map_world,
       cells_y_((height + o.cell_px - 1) / o.cell_px),
       cell_px_(o.cell_px),
       window_(o.window),
-      edge_ratio_(o.edge_ratio),
       first_depth_m_(static_cast<size_t>(cells_x_) * cells_y_, std::numeric_limits<float>::infinity()) {
   for (const Eigen::Vector3d& x : map_world) {
     const Eigen::Vector3d c = R_cam_world * x + t_cam_world;
@@ -41,21 +39,11 @@ std::vector<double> LidarDepthImage::candidates(const Eigen::Vector2d& px) const
   if (!px.allFinite()) return out;
   const long cx = static_cast<long>(std::floor((px.x() + 0.5) / cell_px_));
   const long cy = static_cast<long>(std::floor((px.y() + 0.5) / cell_px_));
-  const auto depth_at = [&](long x, long y) {
-    if (x < 0 || y < 0 || x >= static_cast<long>(cells_x_) || y >= static_cast<long>(cells_y_))
-      return std::numeric_limits<float>::infinity();
-    return first_depth_m_[static_cast<size_t>(y) * cells_x_ + static_cast<size_t>(x)];
-  };
-  const float own = depth_at(cx, cy);
-  if (std::isfinite(own)) out.push_back(own);
   const long w = window_;
-  for (long y = cy - w; y <= cy + w; ++y)
-    for (long x = cx - w; x <= cx + w; ++x) {
-      const float d = depth_at(x, y);
-      if (!std::isfinite(d) || (x == cx && y == cy)) continue;
-      // A neighbour on the same surface only blurs the own cell's depth (and lets a match one period off
-      // pass on an oblique wall); one on another surface is a candidate at a depth edge.
-      if (!std::isfinite(own) || std::abs(d - own) > edge_ratio_ * own) out.push_back(d);
+  for (long y = std::max(0L, cy - w); y <= std::min<long>(cells_y_ - 1, cy + w); ++y)
+    for (long x = std::max(0L, cx - w); x <= std::min<long>(cells_x_ - 1, cx + w); ++x) {
+      const float d = first_depth_m_[static_cast<size_t>(y) * cells_x_ + static_cast<size_t>(x)];
+      if (std::isfinite(d)) out.push_back(d);
     }
   return out;
 }

@@ -20,15 +20,11 @@ namespace litgs::host::frontend {
 struct LidarCheckOptions {
   bool enabled = true;  // used where the scene has lidar/map.pcd and both images a prior pose
   // A match is kept when the map's depth carries one keypoint to within this of the other (undistorted
-  // pixels). It must cover the priors' error between the two frames, which grows with the focal length in
-  // pixels; the bound of the tracks' split (conflicts.max_error_px). From 5 px to 3 px, what the check
-  // rejected more on synth's corridor was mostly false (docs/experiments.md).
-  double max_transfer_px = 3;
+  // pixels). Like prior_epipolar_px it must cover the priors' error between the two frames, which grows
+  // with the focal length in pixels: the default suits synth's odometry at 320x256 (docs/results.md).
+  double max_transfer_px = 5;
   uint32_t cell_px = 4;  // z-buffer cell edge (pixels)
-  uint32_t window = 1;   // cells on each side whose first surfaces are also candidates...
-  // ...where the keypoint's own cell has none, or theirs differs from its own by more than this share
-  // (another surface: a depth edge)
-  double edge_ratio = 0.2;
+  uint32_t window = 1;   // cells on each side whose first surfaces are also candidates
   double min_depth_m = 0.1;
   void check() const;  // std::invalid_argument naming the bad field
 };
@@ -45,7 +41,6 @@ class LidarDepthImage {
 
  private:
   uint32_t cells_x_ = 0, cells_y_ = 0, cell_px_ = 1, window_ = 0;
-  double edge_ratio_ = 0;
   std::vector<float> first_depth_m_;  // [cells_y][cells_x], +inf where no sample projects
 };
 

@@ -85,26 +85,6 @@ TEST(FrontendLidarCheck, AMatchBesideADepthEdgeIsKept) {
   EXPECT_FALSE(contradicted_by_lidar({kA.R, kA.t, xa, da}, {kB.R, kB.t, xb, db}, kK, 8));
 }
 
-TEST(FrontendLidarCheck, OnOneSlantedSurfaceOnlyTheKeypointsOwnCellIsACandidate) {
-  // A side wall (x = 1) seen at a grazing angle: the neighbouring cells' depths differ from the keypoint's
-  // by 5-8 %, the same surface. Taken as candidates they would let a match one period along the wall
-  // pass; only the keypoint's own cell is.
-  std::vector<Eigen::Vector3d> map;
-  for (double z = 2; z <= 12; z += 0.01)
-    for (double y = -1; y <= 1; y += 0.01) map.emplace_back(1.0, y, z);
-  const LidarDepthImage da(map, kA.R, kA.t, kK, kWidth, kHeight, {});
-  const Eigen::Vector2d xa = kA.project({1.0, 0.1, 5.0});  // 60 px right of the centre
-  const std::vector<double> own = da.candidates(xa);
-  ASSERT_EQ(own.size(), 1u);
-  // The nearest sample in the keypoint's 4-px cell, which spans the wall from 4.69 to 5 m.
-  EXPECT_NEAR(own[0], 300.0 / 64, 0.01);
-  // Counting every neighbour of another depth as another surface (edge_ratio 0), the six cells of the
-  // columns beside it join (those above and below lie at its own depth).
-  LidarCheckOptions every_neighbour;
-  every_neighbour.edge_ratio = 0.0;
-  EXPECT_EQ(LidarDepthImage(map, kA.R, kA.t, kK, kWidth, kHeight, every_neighbour).candidates(xa).size(), 7u);
-}
-
 TEST(FrontendLidarCheck, WithoutMapDepthTheMatchCannotBeJudgedAndIsKept) {
   const LidarDepthImage empty({}, kA.R, kA.t, kK, kWidth, kHeight, {});
   const Eigen::Vector2d xa(100, 100), xb(300, 20);  // far from consistent, but nothing to judge by
