@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "host/refine/scan_alignment.h"
 #include "host/train/train_defaults.h"
 #include "io/scene_yaml.h"
 
@@ -28,7 +29,11 @@ constexpr double kMatchSecondsPerMpx = 0.8;  // on 2 threads
 // rest).
 constexpr double kXfeatCpuDeviceSecondsPerMpx = 3.8;
 constexpr double kXfeatMatchSecondsPerMpx = 2.3;
-constexpr double kRefineSecondsPerMpxLidar = 4.5;  // with the LiDAR point-to-plane term
+// Refine with the LiDAR point-to-plane term: fitted to `ci/refine-bench`'s refinements (facade, street and
+// corridor at 320x256) with and without the scans, whose term is per scan for each round it is in the
+// solve (refine.scans: the map the poses build, and its residuals).
+constexpr double kRefineSecondsPerMpxLidar = 6.8;
+constexpr double kRefineSecondsPerScanRound = 0.015;
 constexpr double kRefineSecondsPerMpxNoLidar = 0.4;
 // Training on a CPU device (lavapipe, 2 cores): per iteration (a + b per thousand Gaussians) at 320x256,
 // scaled by (pixels / 320x256)^0.85 (4x the pixels: 3.2-3.4x the time up to 100k Gaussians).
@@ -127,6 +132,7 @@ std::optional<RunSize> size_before_import(InputKind kind, const fs::path& input,
   s.width = config.import.synth_width;
   s.height = config.import.synth_height;
   s.lidar_map = s.map_file = true;  // synth writes its map
+  s.scans = s.frames;               // and one scan per frame
   return s;
 }
 
@@ -203,8 +209,15 @@ std::optional<StageEstimate> estimate_stage(const std::string& stage, InputKind 
                 size_text(s) + " on " + std::to_string(static_cast<int>(threads)) + " threads");
   } else if (stage == "refine") {
     const bool planes = s.lidar_map && c.refine.planes;
-    e = fixed(1.0 + (planes ? kRefineSecondsPerMpxLidar : kRefineSecondsPerMpxNoLidar) * mpx,
-              size_text(s) + (planes ? ", with LiDAR planes" : ", without LiDAR planes"));
+    const size_t from_round = refine::ScanAlignmentOptions{}.from_round;
+    const size_t scan_rounds =
+        c.refine.scans && c.refine.rounds > from_round ? c.refine.rounds - from_round : 0;
+    const double scans = kRefineSecondsPerScanRound * s.scans * static_cast<double>(scan_rounds);
+    e = fixed(1.0 + (planes ? kRefineSecondsPerMpxLidar : kRefineSecondsPerMpxNoLidar) * mpx + scans,
+              size_text(s) + (planes ? ", with LiDAR planes" : ", without LiDAR planes") +
+                  (s.scans && scan_rounds ? ", " + std::to_string(s.scans) + " scans in the last " +
+                                                std::to_string(scan_rounds) + " rounds"
+                                          : ""));
   } else if (stage == "train") {
     e = estimate_train(s, c.train, d, reason);
   } else if (stage == "eval") {

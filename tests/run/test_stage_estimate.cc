@@ -62,6 +62,24 @@ TEST(StageEstimate, GrowsWithFramesPixelsIterationsAndBudget) {
             seconds("match", larger, xfeat, cpu_device()));
 }
 
+TEST(StageEstimate, TheScansInTheRefinementCostTimeOnlyInTheRoundsTheyJoin) {
+  const RunSize s = synth_size(60, 320, 256);
+  RunConfig c;  // refine.scans on, 8 rounds: the scans are in the last four
+  const auto with = estimate_stage("refine", InputKind::kSynthetic, s, c, cpu_device());
+  ASSERT_TRUE(with.has_value());
+  EXPECT_NE(with->basis.find("60 scans in the last 4 rounds"), std::string::npos) << with->basis;
+  RunConfig without = c;
+  without.refine.scans = false;
+  const double no_scans = seconds("refine", s, without, cpu_device());
+  EXPECT_GT(with->high_s, no_scans + 2);
+  RunConfig two_more = c;
+  two_more.refine.rounds = 10;
+  EXPECT_GT(seconds("refine", s, two_more, cpu_device()), with->high_s);
+  RunConfig before_they_join = c;
+  before_they_join.refine.rounds = 4;
+  EXPECT_DOUBLE_EQ(seconds("refine", s, before_they_join, cpu_device()), no_scans);
+}
+
 TEST(StageEstimate, AGrownBudgetIsARangeAndStagesWithoutAModelSayWhy) {
   const RunSize s = synth_size(40, 320, 256);
   RunConfig c;
