@@ -29,12 +29,13 @@ constexpr double kMatchSecondsPerMpx = 0.8;  // on 2 threads
 // rest).
 constexpr double kXfeatCpuDeviceSecondsPerMpx = 3.8;
 constexpr double kXfeatMatchSecondsPerMpx = 2.3;
-// Refine with the LiDAR point-to-plane term: fitted to `ci/refine-bench`'s refinements (facade, street and
-// corridor at 320x256) with and without the scans, whose term is per scan for each round it is in the
-// solve (refine.scans: the map the poses build, and its residuals).
+// Refine on 2 threads, with the LiDAR point-to-plane term: fitted to `ci/refine-bench`'s refinements
+// (facade, street and corridor at 320x256) with and without the scans, whose term is per scan for each
+// round it is in the solve (refine.scans: the map the poses build, and its residuals). Without the LiDAR:
+// DUNR's refinement in `run`.
 constexpr double kRefineSecondsPerMpxLidar = 6.8;
 constexpr double kRefineSecondsPerScanRound = 0.015;
-constexpr double kRefineSecondsPerMpxNoLidar = 0.4;
+constexpr double kRefineSecondsPerMpxNoLidar = 1.34;
 // Training on a CPU device (lavapipe, 2 cores): per iteration (a + b per thousand Gaussians) at 320x256,
 // scaled by (pixels / 320x256)^0.85 (4x the pixels: 3.2-3.4x the time up to 100k Gaussians).
 constexpr double kCpuMsPerIteration = 30.7, kCpuMsPerThousandGaussians = 1.13, kCpuPixelExponent = 0.85;
@@ -213,8 +214,11 @@ std::optional<StageEstimate> estimate_stage(const std::string& stage, InputKind 
     const size_t scan_rounds =
         c.refine.scans && c.refine.rounds > from_round ? c.refine.rounds - from_round : 0;
     const double scans = kRefineSecondsPerScanRound * s.scans * static_cast<double>(scan_rounds);
-    e = fixed(1.0 + (planes ? kRefineSecondsPerMpxLidar : kRefineSecondsPerMpxNoLidar) * mpx + scans,
-              size_text(s) + (planes ? ", with LiDAR planes" : ", without LiDAR planes") +
+    const double threads = c.refine.threads ? c.refine.threads : cores;
+    e = fixed(1.0 + ((planes ? kRefineSecondsPerMpxLidar : kRefineSecondsPerMpxNoLidar) * mpx + scans) *
+                        thread_factor(threads),
+              size_text(s) + " on " + std::to_string(static_cast<int>(threads)) + " threads" +
+                  (planes ? ", with LiDAR planes" : ", without LiDAR planes") +
                   (s.scans && scan_rounds ? ", " + std::to_string(s.scans) + " scans in the last " +
                                                 std::to_string(scan_rounds) + " rounds"
                                           : ""));

@@ -78,6 +78,9 @@ TEST(StageEstimate, TheScansInTheRefinementCostTimeOnlyInTheRoundsTheyJoin) {
   RunConfig before_they_join = c;
   before_they_join.refine.rounds = 4;
   EXPECT_DOUBLE_EQ(seconds("refine", s, before_they_join, cpu_device()), no_scans);
+  RunConfig two_threads = c;  // run's refine takes one thread by default
+  two_threads.refine.threads = 2;
+  EXPECT_LT(seconds("refine", s, two_threads, cpu_device()), 0.8 * with->high_s);
 }
 
 TEST(StageEstimate, AGrownBudgetIsARangeAndStagesWithoutAModelSayWhy) {
