@@ -60,8 +60,10 @@ void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli
   cmd.add_flag("--no-prior-epipolar", cli->no_prior_epipolar, "Do not use the prior poses' epipolar bound");
   cmd.add_flag("!--no-lidar-check", o.lidar_check.enabled,
                "Keep the matches the LiDAR map contradicts (default: reject them where the scene has a map)");
-  cmd.add_option("--lidar-transfer-px", o.lidar_check.max_transfer_px,
-                 "LiDAR check: a keypoint lifted to the map's depth must land this near its match (pixels)")
+  cmd.add_option(
+         "--lidar-transfer-px", o.lidar_check.max_transfer_px,
+         "LiDAR check: a keypoint lifted to the map's depth must land this near its match, less the pair's "
+         "common offset (pixels)")
       ->capture_default_str();
   cmd.add_option("--min-inliers", o.verify.min_inliers, "Verified matches a pair needs")
       ->capture_default_str();

@@ -57,13 +57,19 @@ size_t reject_by_lidar(const Context& c, uint32_t a, uint32_t b,
                        const std::vector<std::array<uint32_t, 2>>& mutual, Verification& v) {
   if (c.lidar_depth.empty() || !c.lidar_depth[a] || !c.lidar_depth[b] || !v.verified) return 0;
   size_t rejected = 0;
+  auto view = [&](uint32_t image, uint32_t keypoint) {
+    return DepthView{c.poses[image]->R_cam_world, c.poses[image]->t_cam_world, c.undistorted[image][keypoint],
+                     *c.lidar_depth[image]};
+  };
+  // The priors' relative error moves every match of the pair alike: the bound applies to what is left.
+  std::vector<std::array<DepthView, 2>> verified;
+  for (size_t k = 0; k < mutual.size(); ++k)
+    if (v.inlier[k]) verified.push_back({view(a, mutual[k][0]), view(b, mutual[k][1])});
+  const PairTransferOffset offset = pair_transfer_offset(verified, c.K, c.o.verify.min_inliers);
   for (size_t k = 0; k < mutual.size(); ++k) {
     if (!v.inlier[k]) continue;
-    const DepthView va{c.poses[a]->R_cam_world, c.poses[a]->t_cam_world, c.undistorted[a][mutual[k][0]],
-                       *c.lidar_depth[a]};
-    const DepthView vb{c.poses[b]->R_cam_world, c.poses[b]->t_cam_world, c.undistorted[b][mutual[k][1]],
-                       *c.lidar_depth[b]};
-    if (contradicted_by_lidar(va, vb, c.K, c.o.lidar_check.max_transfer_px)) {
+    const DepthView va = view(a, mutual[k][0]), vb = view(b, mutual[k][1]);
+    if (contradicted_by_lidar(va, vb, c.K, c.o.lidar_check.max_transfer_px, offset.ab, offset.ba)) {
       v.inlier[k] = 0;
       ++rejected;
     }

@@ -11,6 +11,7 @@ void LidarCheckOptions::check() const {
   if (!(max_transfer_px > 0)) throw std::invalid_argument("lidar_check.max_transfer_px must be > 0");
   if (cell_px < 1) throw std::invalid_argument("lidar_check.cell_px must be >= 1");
   if (window > 8) throw std::invalid_argument("lidar_check.window must be <= 8");
+  if (!(edge_ratio >= 0)) throw std::invalid_argument("lidar_check.edge_ratio must be >= 0");
   if (!(min_depth_m > 0)) throw std::invalid_argument("lidar_check.min_depth_m must be > 0");
 }
 
@@ -22,6 +23,7 @@ LidarDepthImage::LidarDepthImage(const std::vector<Eigen::Vector3d>& map_world,
       cells_y_((height + o.cell_px - 1) / o.cell_px),
       cell_px_(o.cell_px),
       window_(o.window),
+      edge_ratio_(o.edge_ratio),
       first_depth_m_(static_cast<size_t>(cells_x_) * cells_y_, std::numeric_limits<float>::infinity()) {
   for (const Eigen::Vector3d& x : map_world) {
     const Eigen::Vector3d c = R_cam_world * x + t_cam_world;
@@ -39,33 +41,90 @@ std::vector<double> LidarDepthImage::candidates(const Eigen::Vector2d& px) const
   if (!px.allFinite()) return out;
   const long cx = static_cast<long>(std::floor((px.x() + 0.5) / cell_px_));
   const long cy = static_cast<long>(std::floor((px.y() + 0.5) / cell_px_));
+  const auto depth_at = [&](long x, long y) {
+    if (x < 0 || y < 0 || x >= static_cast<long>(cells_x_) || y >= static_cast<long>(cells_y_))
+      return std::numeric_limits<float>::infinity();
+    return first_depth_m_[static_cast<size_t>(y) * cells_x_ + static_cast<size_t>(x)];
+  };
+  const float own = depth_at(cx, cy);
+  if (std::isfinite(own)) out.push_back(own);
   const long w = window_;
-  for (long y = std::max(0L, cy - w); y <= std::min<long>(cells_y_ - 1, cy + w); ++y)
-    for (long x = std::max(0L, cx - w); x <= std::min<long>(cells_x_ - 1, cx + w); ++x) {
-      const float d = first_depth_m_[static_cast<size_t>(y) * cells_x_ + static_cast<size_t>(x)];
-      if (std::isfinite(d)) out.push_back(d);
+  for (long y = cy - w; y <= cy + w; ++y)
+    for (long x = cx - w; x <= cx + w; ++x) {
+      const float d = depth_at(x, y);
+      if (!std::isfinite(d) || (x == cx && y == cy)) continue;
+      // A neighbour on the same surface only blurs the own cell's depth (and lets a match one period off
+      // pass on an oblique wall); one on another surface is a candidate at a depth edge.
+      if (!std::isfinite(own) || std::abs(d - own) > edge_ratio_ * own) out.push_back(d);
     }
   return out;
 }
 
-std::optional<double> lidar_transfer_px(const DepthView& from, const DepthView& to, const PinholeK& K) {
+namespace {
+std::vector<Eigen::Vector2d> transfers(const DepthView& from, const DepthView& to, const PinholeK& K) {
+  std::vector<Eigen::Vector2d> out;
   const std::vector<double> depths = from.depth.candidates(from.px);
-  if (depths.empty()) return std::nullopt;
   const Eigen::Vector3d ray((from.px.x() - K.cx) / K.fx, (from.px.y() - K.cy) / K.fy, 1.0);
   const Eigen::Matrix3d R_to_from = to.R_cam_world * from.R_cam_world.transpose();
   const Eigen::Vector3d t_to_from = to.t_cam_world - R_to_from * from.t_cam_world;
-  double best = std::numeric_limits<double>::infinity();
   for (double z : depths) {
     const Eigen::Vector3d c = R_to_from * (z * ray) + t_to_from;
-    if (!(c.z() > 0)) continue;
-    best = std::min(
-        best, std::hypot(K.fx * c.x() / c.z() + K.cx - to.px.x(), K.fy * c.y() / c.z() + K.cy - to.px.y()));
+    if (!(c.z() > 0)) {
+      out.emplace_back(Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()));
+      continue;
+    }
+    out.emplace_back(K.fx * c.x() / c.z() + K.cx - to.px.x(), K.fy * c.y() / c.z() + K.cy - to.px.y());
   }
+  return out;
+}
+}  // namespace
+
+std::optional<double> lidar_transfer_px(const DepthView& from, const DepthView& to, const PinholeK& K,
+                                        const Eigen::Vector2d& offset) {
+  const std::vector<Eigen::Vector2d> t = transfers(from, to, K);
+  if (t.empty()) return std::nullopt;
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& v : t)
+    if (v.allFinite()) best = std::min(best, (v - offset).norm());
   return best;
 }
 
-bool contradicted_by_lidar(const DepthView& a, const DepthView& b, const PinholeK& K, double bound_px) {
-  const std::optional<double> ab = lidar_transfer_px(a, b, K), ba = lidar_transfer_px(b, a, K);
+std::optional<Eigen::Vector2d> nearest_lidar_transfer(const DepthView& from, const DepthView& to,
+                                                      const PinholeK& K) {
+  const std::vector<Eigen::Vector2d> t = transfers(from, to, K);
+  std::optional<Eigen::Vector2d> best;
+  for (const auto& v : t)
+    if (v.allFinite() && (!best || v.norm() < best->norm())) best = v;
+  return best;
+}
+
+PairTransferOffset pair_transfer_offset(const std::vector<std::array<DepthView, 2>>& matches,
+                                        const PinholeK& K, size_t min_matches) {
+  std::array<std::vector<double>, 4> axes;  // ab x, ab y, ba x, ba y
+  for (const auto& [a, b] : matches) {
+    if (const auto t = nearest_lidar_transfer(a, b, K)) {
+      axes[0].push_back(t->x());
+      axes[1].push_back(t->y());
+    }
+    if (const auto t = nearest_lidar_transfer(b, a, K)) {
+      axes[2].push_back(t->x());
+      axes[3].push_back(t->y());
+    }
+  }
+  const auto median = [](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  PairTransferOffset o;
+  if (axes[0].size() >= std::max<size_t>(min_matches, 1)) o.ab = {median(axes[0]), median(axes[1])};
+  if (axes[2].size() >= std::max<size_t>(min_matches, 1)) o.ba = {median(axes[2]), median(axes[3])};
+  return o;
+}
+
+bool contradicted_by_lidar(const DepthView& a, const DepthView& b, const PinholeK& K, double bound_px,
+                           const Eigen::Vector2d& offset_ab, const Eigen::Vector2d& offset_ba) {
+  const std::optional<double> ab = lidar_transfer_px(a, b, K, offset_ab),
+                              ba = lidar_transfer_px(b, a, K, offset_ba);
   if (!ab && !ba) return false;
   return !(ab && *ab <= bound_px) && !(ba && *ba <= bound_px);
 }

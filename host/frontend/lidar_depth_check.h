@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -20,11 +21,14 @@ namespace litgs::host::frontend {
 struct LidarCheckOptions {
   bool enabled = true;  // used where the scene has lidar/map.pcd and both images a prior pose
   // A match is kept when the map's depth carries one keypoint to within this of the other (undistorted
-  // pixels). Like prior_epipolar_px it must cover the priors' error between the two frames, which grows
-  // with the focal length in pixels: the default suits synth's odometry at 320x256 (docs/results.md).
-  double max_transfer_px = 5;
+  // pixels), once the pair's common transfer is removed: the priors' relative error moves every match of a
+  // pair alike, and what is left is the match's own error (docs/frontend.md, docs/experiments.md).
+  double max_transfer_px = 3;
   uint32_t cell_px = 4;  // z-buffer cell edge (pixels)
-  uint32_t window = 1;   // cells on each side whose first surfaces are also candidates
+  uint32_t window = 1;   // cells on each side whose first surfaces are also candidates...
+  // ...where the keypoint's own cell has none, or theirs differs from its own by more than this share
+  // (another surface: a depth edge)
+  double edge_ratio = 0.2;
   double min_depth_m = 0.1;
   void check() const;  // std::invalid_argument naming the bad field
 };
@@ -41,6 +45,7 @@ class LidarDepthImage {
 
  private:
   uint32_t cells_x_ = 0, cells_y_ = 0, cell_px_ = 1, window_ = 0;
+  double edge_ratio_ = 0;
   std::vector<float> first_depth_m_;  // [cells_y][cells_x], +inf where no sample projects
 };
 
@@ -53,11 +58,27 @@ struct DepthView {
   const LidarDepthImage& depth;
 };
 
-// The smallest pixel distance from `to.px` of `from.px` lifted to one of its candidate depths and projected
-// into `to`; nullopt where `from` has no candidate depth (the map cannot judge).
-std::optional<double> lidar_transfer_px(const DepthView& from, const DepthView& to, const PinholeK& K);
+// The smallest pixel distance from `to.px` + `offset` of `from.px` lifted to one of its candidate depths
+// and projected into `to`; nullopt where `from` has no candidate depth (the map cannot judge).
+std::optional<double> lidar_transfer_px(const DepthView& from, const DepthView& to, const PinholeK& K,
+                                        const Eigen::Vector2d& offset = Eigen::Vector2d::Zero());
+// The transfer itself (lifted, projected, less to.px) at the candidate depth that lands nearest; nullopt
+// as above.
+std::optional<Eigen::Vector2d> nearest_lidar_transfer(const DepthView& from, const DepthView& to,
+                                                      const PinholeK& K);
 
-// Whether the map contradicts the match: some direction could be judged and none transfers within bound.
-bool contradicted_by_lidar(const DepthView& a, const DepthView& b, const PinholeK& K, double bound_px);
+// A pair's common transfer in each direction: the per-axis median of its matches' nearest transfers
+// (zero with fewer than `min_matches` that the map can judge).
+struct PairTransferOffset {
+  Eigen::Vector2d ab = Eigen::Vector2d::Zero(), ba = Eigen::Vector2d::Zero();
+};
+PairTransferOffset pair_transfer_offset(const std::vector<std::array<DepthView, 2>>& matches,
+                                        const PinholeK& K, size_t min_matches);
+
+// Whether the map contradicts the match: some direction could be judged and none transfers within bound
+// of its offset.
+bool contradicted_by_lidar(const DepthView& a, const DepthView& b, const PinholeK& K, double bound_px,
+                           const Eigen::Vector2d& offset_ab = Eigen::Vector2d::Zero(),
+                           const Eigen::Vector2d& offset_ba = Eigen::Vector2d::Zero());
 
 }  // namespace litgs::host::frontend

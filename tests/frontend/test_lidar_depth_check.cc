@@ -2,6 +2,7 @@
 // depth must land near its match. Exact inputs: a wall of map points in front of two cameras.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include "host/frontend/lidar_depth_check.h"
@@ -83,6 +84,60 @@ TEST(FrontendLidarCheck, AMatchBesideADepthEdgeIsKept) {
   ASSERT_GE(near_edge.size(), 2u);
   EXPECT_NEAR(*std::min_element(near_edge.begin(), near_edge.end()), 3.0, 1e-6);
   EXPECT_FALSE(contradicted_by_lidar({kA.R, kA.t, xa, da}, {kB.R, kB.t, xb, db}, kK, 8));
+}
+
+TEST(FrontendLidarCheck, OnOneSlantedSurfaceOnlyTheKeypointsOwnCellIsACandidate) {
+  // A side wall (x = 1) seen at a grazing angle: the neighbouring cells' depths differ from the keypoint's
+  // by 5-8 %, the same surface. Taken as candidates they would let a match one period along the wall
+  // pass; only the keypoint's own cell is.
+  std::vector<Eigen::Vector3d> map;
+  for (double z = 2; z <= 12; z += 0.01)
+    for (double y = -1; y <= 1; y += 0.01) map.emplace_back(1.0, y, z);
+  const LidarDepthImage da(map, kA.R, kA.t, kK, kWidth, kHeight, {});
+  const Eigen::Vector2d xa = kA.project({1.0, 0.1, 5.0});  // 60 px right of the centre
+  const std::vector<double> own = da.candidates(xa);
+  ASSERT_EQ(own.size(), 1u);
+  // The nearest sample in the keypoint's 4-px cell, which spans the wall from 4.69 to 5 m.
+  EXPECT_NEAR(own[0], 300.0 / 64, 0.01);
+  // Counting every neighbour of another depth as another surface (edge_ratio 0), the six cells of the
+  // columns beside it join (those above and below lie at its own depth).
+  LidarCheckOptions every_neighbour;
+  every_neighbour.edge_ratio = 0.0;
+  EXPECT_EQ(LidarDepthImage(map, kA.R, kA.t, kK, kWidth, kHeight, every_neighbour).candidates(xa).size(), 7u);
+}
+
+TEST(FrontendLidarCheck, APairsCommonPriorErrorIsRemovedBeforeTheBound) {
+  // Camera b's prior is turned 0.02 rad about y from where it was: every true match of the pair transfers
+  // about 6 px off, beyond a 3 px bound. Their common offset removed, the true matches pass and a brick
+  // matched one period (15 px) off is still contradicted.
+  const std::vector<Eigen::Vector3d> map = wall(5.0);
+  const Camera b_prior{Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitY()).toRotationMatrix() * kB.R,
+                       Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitY()).toRotationMatrix() * kB.t};
+  const LidarDepthImage da(map, kA.R, kA.t, kK, kWidth, kHeight, {}),
+      db(map, b_prior.R, b_prior.t, kK, kWidth, kHeight, {});
+  std::vector<Eigen::Vector2d> xa, xb;  // true matches: the truth's projections (the keypoints)
+  for (double x = -0.6; x <= 0.61; x += 0.2)
+    for (double y = -0.4; y <= 0.41; y += 0.2) {
+      xa.push_back(kA.project({x, y, 5}));
+      xb.push_back(kB.project({x, y, 5}));
+    }
+  std::vector<std::array<DepthView, 2>> matches;
+  for (size_t k = 0; k < xa.size(); ++k)
+    matches.push_back({DepthView{kA.R, kA.t, xa[k], da}, DepthView{b_prior.R, b_prior.t, xb[k], db}});
+  const Eigen::Vector2d wrong_b = kB.project({0.45, 0.1, 5});  // the brick at x = 0.2 matched one period off
+  const Eigen::Vector2d brick_a = kA.project({0.2, 0.1, 5});
+  const DepthView wa{kA.R, kA.t, brick_a, da}, wb{b_prior.R, b_prior.t, wrong_b, db};
+  matches.push_back({wa, wb});
+  size_t beyond_without_offset = 0;
+  for (const auto& [a, b] : matches) beyond_without_offset += contradicted_by_lidar(a, b, kK, 3);
+  EXPECT_GE(beyond_without_offset, matches.size() - 1);  // the prior's error alone exceeds the bound
+  const PairTransferOffset offset = pair_transfer_offset(matches, kK, 15);
+  EXPECT_GT(offset.ab.norm(), 5.0);
+  for (size_t k = 0; k + 1 < matches.size(); ++k)
+    EXPECT_FALSE(contradicted_by_lidar(matches[k][0], matches[k][1], kK, 3, offset.ab, offset.ba)) << k;
+  EXPECT_TRUE(contradicted_by_lidar(wa, wb, kK, 3, offset.ab, offset.ba));
+  // Too few matches to judge the pair by: no offset.
+  EXPECT_EQ(pair_transfer_offset(matches, kK, matches.size() + 1).ab, Eigen::Vector2d::Zero());
 }
 
 TEST(FrontendLidarCheck, WithoutMapDepthTheMatchCannotBeJudgedAndIsKept) {
