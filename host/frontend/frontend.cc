@@ -56,24 +56,25 @@ std::optional<RelativePose> relative_prior(const Context& c, uint32_t a, uint32_
 size_t reject_by_lidar(const Context& c, uint32_t a, uint32_t b,
                        const std::vector<std::array<uint32_t, 2>>& mutual, Verification& v) {
   if (c.lidar_depth.empty() || !c.lidar_depth[a] || !c.lidar_depth[b] || !v.verified) return 0;
-  size_t rejected = 0;
   auto view = [&](uint32_t image, uint32_t keypoint) {
     return DepthView{c.poses[image]->R_cam_world, c.poses[image]->t_cam_world, c.undistorted[image][keypoint],
                      *c.lidar_depth[image]};
   };
-  // The priors' relative error moves every match of the pair alike: the bound applies to what is left.
-  std::vector<std::array<DepthView, 2>> verified;
+  std::vector<size_t> verified;  // indices into `mutual`
+  std::vector<MatchTransfers> transfers;
   for (size_t k = 0; k < mutual.size(); ++k)
-    if (v.inlier[k]) verified.push_back({view(a, mutual[k][0]), view(b, mutual[k][1])});
-  const PairTransferOffset offset = pair_transfer_offset(verified, c.K, c.o.verify.min_inliers);
-  for (size_t k = 0; k < mutual.size(); ++k) {
-    if (!v.inlier[k]) continue;
-    const DepthView va = view(a, mutual[k][0]), vb = view(b, mutual[k][1]);
-    if (contradicted_by_lidar(va, vb, c.K, c.o.lidar_check.max_transfer_px, offset.ab, offset.ba)) {
-      v.inlier[k] = 0;
+    if (v.inlier[k]) {
+      verified.push_back(k);
+      transfers.push_back(match_transfers(view(a, mutual[k][0]), view(b, mutual[k][1]), c.K));
+    }
+  // The priors' relative error moves every match of the pair alike: the bound applies to what is left.
+  const PairTransferOffset offset = pair_transfer_offset(transfers, c.o.verify.min_inliers);
+  size_t rejected = 0;
+  for (size_t j = 0; j < verified.size(); ++j)
+    if (contradicted_by_lidar(transfers[j], c.o.lidar_check.max_transfer_px, offset.ab, offset.ba)) {
+      v.inlier[verified[j]] = 0;
       ++rejected;
     }
-  }
   v.inliers -= rejected;
   if (v.inliers < c.o.verify.min_inliers) {
     std::fill(v.inlier.begin(), v.inlier.end(), 0);

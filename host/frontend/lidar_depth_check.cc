@@ -1,6 +1,7 @@
 #include "host/frontend/lidar_depth_check.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -77,36 +78,37 @@ std::vector<Eigen::Vector2d> transfers(const DepthView& from, const DepthView& t
   }
   return out;
 }
+
+// The finite transfer of least norm; nullopt where none is finite.
+std::optional<Eigen::Vector2d> nearest(const std::vector<Eigen::Vector2d>& transfers) {
+  std::optional<Eigen::Vector2d> best;
+  for (const auto& v : transfers)
+    if (v.allFinite() && (!best || v.norm() < best->norm())) best = v;
+  return best;
+}
 }  // namespace
 
-std::optional<double> lidar_transfer_px(const DepthView& from, const DepthView& to, const PinholeK& K,
+MatchTransfers match_transfers(const DepthView& a, const DepthView& b, const PinholeK& K) {
+  return {transfers(a, b, K), transfers(b, a, K)};
+}
+
+std::optional<double> lidar_transfer_px(const std::vector<Eigen::Vector2d>& transfers,
                                         const Eigen::Vector2d& offset) {
-  const std::vector<Eigen::Vector2d> t = transfers(from, to, K);
-  if (t.empty()) return std::nullopt;
+  if (transfers.empty()) return std::nullopt;
   double best = std::numeric_limits<double>::infinity();
-  for (const auto& v : t)
+  for (const auto& v : transfers)
     if (v.allFinite()) best = std::min(best, (v - offset).norm());
   return best;
 }
 
-std::optional<Eigen::Vector2d> nearest_lidar_transfer(const DepthView& from, const DepthView& to,
-                                                      const PinholeK& K) {
-  const std::vector<Eigen::Vector2d> t = transfers(from, to, K);
-  std::optional<Eigen::Vector2d> best;
-  for (const auto& v : t)
-    if (v.allFinite() && (!best || v.norm() < best->norm())) best = v;
-  return best;
-}
-
-PairTransferOffset pair_transfer_offset(const std::vector<std::array<DepthView, 2>>& matches,
-                                        const PinholeK& K, size_t min_matches) {
+PairTransferOffset pair_transfer_offset(const std::vector<MatchTransfers>& matches, size_t min_matches) {
   std::array<std::vector<double>, 4> axes;  // ab x, ab y, ba x, ba y
-  for (const auto& [a, b] : matches) {
-    if (const auto t = nearest_lidar_transfer(a, b, K)) {
+  for (const MatchTransfers& m : matches) {
+    if (const auto t = nearest(m.ab)) {
       axes[0].push_back(t->x());
       axes[1].push_back(t->y());
     }
-    if (const auto t = nearest_lidar_transfer(b, a, K)) {
+    if (const auto t = nearest(m.ba)) {
       axes[2].push_back(t->x());
       axes[3].push_back(t->y());
     }
@@ -121,10 +123,10 @@ PairTransferOffset pair_transfer_offset(const std::vector<std::array<DepthView, 
   return o;
 }
 
-bool contradicted_by_lidar(const DepthView& a, const DepthView& b, const PinholeK& K, double bound_px,
-                           const Eigen::Vector2d& offset_ab, const Eigen::Vector2d& offset_ba) {
-  const std::optional<double> ab = lidar_transfer_px(a, b, K, offset_ab),
-                              ba = lidar_transfer_px(b, a, K, offset_ba);
+bool contradicted_by_lidar(const MatchTransfers& m, double bound_px, const Eigen::Vector2d& offset_ab,
+                           const Eigen::Vector2d& offset_ba) {
+  const std::optional<double> ab = lidar_transfer_px(m.ab, offset_ab),
+                              ba = lidar_transfer_px(m.ba, offset_ba);
   if (!ab && !ba) return false;
   return !(ab && *ab <= bound_px) && !(ba && *ba <= bound_px);
 }

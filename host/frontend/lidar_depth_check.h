@@ -9,7 +9,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -58,26 +57,29 @@ struct DepthView {
   const LidarDepthImage& depth;
 };
 
-// The smallest pixel distance from `to.px` + `offset` of `from.px` lifted to one of its candidate depths
-// and projected into `to`; nullopt where `from` has no candidate depth (the map cannot judge).
-std::optional<double> lidar_transfer_px(const DepthView& from, const DepthView& to, const PinholeK& K,
+// A match's transfers: a keypoint lifted to each of its candidate depths and projected into the other view,
+// less the partner's pixel (infinite where it lands behind that camera), in both directions. Computed once
+// per match: the pair's offset and the bound are both judged on them.
+struct MatchTransfers {
+  std::vector<Eigen::Vector2d> ab, ba;  // empty where that direction's keypoint has no candidate depth
+};
+MatchTransfers match_transfers(const DepthView& a, const DepthView& b, const PinholeK& K);
+
+// The smallest distance of one direction's transfers from `offset`; nullopt where there are none (the map
+// cannot judge).
+std::optional<double> lidar_transfer_px(const std::vector<Eigen::Vector2d>& transfers,
                                         const Eigen::Vector2d& offset = Eigen::Vector2d::Zero());
-// The transfer itself (lifted, projected, less to.px) at the candidate depth that lands nearest; nullopt
-// as above.
-std::optional<Eigen::Vector2d> nearest_lidar_transfer(const DepthView& from, const DepthView& to,
-                                                      const PinholeK& K);
 
 // A pair's common transfer in each direction: the per-axis median of its matches' nearest transfers
 // (zero with fewer than `min_matches` that the map can judge).
 struct PairTransferOffset {
   Eigen::Vector2d ab = Eigen::Vector2d::Zero(), ba = Eigen::Vector2d::Zero();
 };
-PairTransferOffset pair_transfer_offset(const std::vector<std::array<DepthView, 2>>& matches,
-                                        const PinholeK& K, size_t min_matches);
+PairTransferOffset pair_transfer_offset(const std::vector<MatchTransfers>& matches, size_t min_matches);
 
 // Whether the map contradicts the match: some direction could be judged and none transfers within bound
 // of its offset.
-bool contradicted_by_lidar(const DepthView& a, const DepthView& b, const PinholeK& K, double bound_px,
+bool contradicted_by_lidar(const MatchTransfers& m, double bound_px,
                            const Eigen::Vector2d& offset_ab = Eigen::Vector2d::Zero(),
                            const Eigen::Vector2d& offset_ba = Eigen::Vector2d::Zero());
 

@@ -60,14 +60,16 @@ TEST(FrontendLidarCheck, RepetitiveTextureMatchedOnePeriodOffIsContradicted) {
   ASSERT_NEAR(xb_true.y(), xb_wrong.y(), 1e-9);  // same epipolar line
   const DepthView a{kA.R, kA.t, xa, da};
   const DepthView b_true{kB.R, kB.t, xb_true, db}, b_wrong{kB.R, kB.t, xb_wrong, db};
-  const std::optional<double> t_true = lidar_transfer_px(a, b_true, kK);
+  const std::optional<double> t_true = lidar_transfer_px(match_transfers(a, b_true, kK).ab);
   ASSERT_TRUE(t_true.has_value());
   // Cells of 4 px on a wall 5 m deep: every candidate depth is the wall's, so the transfer is exact.
   EXPECT_NEAR(*t_true, 0.0, 1e-6);
-  EXPECT_NEAR(*lidar_transfer_px(a, b_wrong, kK), 300 * 0.25 / 5, 1e-6);  // one period: 15 px
-  EXPECT_FALSE(contradicted_by_lidar(a, b_true, kK, 8));
-  EXPECT_TRUE(contradicted_by_lidar(a, b_wrong, kK, 8));
-  EXPECT_FALSE(contradicted_by_lidar(a, b_wrong, kK, 16));  // a bound wider than the period keeps it
+  EXPECT_NEAR(*lidar_transfer_px(match_transfers(a, b_wrong, kK).ab), 300 * 0.25 / 5,
+              1e-6);  // one period: 15 px
+  EXPECT_FALSE(contradicted_by_lidar(match_transfers(a, b_true, kK), 8));
+  EXPECT_TRUE(contradicted_by_lidar(match_transfers(a, b_wrong, kK), 8));
+  EXPECT_FALSE(
+      contradicted_by_lidar(match_transfers(a, b_wrong, kK), 16));  // a bound wider than the period keeps it
 }
 
 TEST(FrontendLidarCheck, AMatchBesideADepthEdgeIsKept) {
@@ -83,7 +85,7 @@ TEST(FrontendLidarCheck, AMatchBesideADepthEdgeIsKept) {
   std::vector<double> near_edge = da.candidates(xa);
   ASSERT_GE(near_edge.size(), 2u);
   EXPECT_NEAR(*std::min_element(near_edge.begin(), near_edge.end()), 3.0, 1e-6);
-  EXPECT_FALSE(contradicted_by_lidar({kA.R, kA.t, xa, da}, {kB.R, kB.t, xb, db}, kK, 8));
+  EXPECT_FALSE(contradicted_by_lidar(match_transfers({kA.R, kA.t, xa, da}, {kB.R, kB.t, xb, db}, kK), 8));
 }
 
 TEST(FrontendLidarCheck, OnOneSlantedSurfaceOnlyTheKeypointsOwnCellIsACandidate) {
@@ -121,30 +123,33 @@ TEST(FrontendLidarCheck, APairsCommonPriorErrorIsRemovedBeforeTheBound) {
       xa.push_back(kA.project({x, y, 5}));
       xb.push_back(kB.project({x, y, 5}));
     }
-  std::vector<std::array<DepthView, 2>> matches;
+  std::vector<MatchTransfers> matches;
   for (size_t k = 0; k < xa.size(); ++k)
-    matches.push_back({DepthView{kA.R, kA.t, xa[k], da}, DepthView{b_prior.R, b_prior.t, xb[k], db}});
+    matches.push_back(match_transfers({kA.R, kA.t, xa[k], da}, {b_prior.R, b_prior.t, xb[k], db}, kK));
   const Eigen::Vector2d wrong_b = kB.project({0.45, 0.1, 5});  // the brick at x = 0.2 matched one period off
   const Eigen::Vector2d brick_a = kA.project({0.2, 0.1, 5});
-  const DepthView wa{kA.R, kA.t, brick_a, da}, wb{b_prior.R, b_prior.t, wrong_b, db};
-  matches.push_back({wa, wb});
+  const MatchTransfers wrong =
+      match_transfers({kA.R, kA.t, brick_a, da}, {b_prior.R, b_prior.t, wrong_b, db}, kK);
+  matches.push_back(wrong);
   size_t beyond_without_offset = 0;
-  for (const auto& [a, b] : matches) beyond_without_offset += contradicted_by_lidar(a, b, kK, 3);
+  for (const MatchTransfers& m : matches) beyond_without_offset += contradicted_by_lidar(m, 3);
   EXPECT_GE(beyond_without_offset, matches.size() - 1);  // the prior's error alone exceeds the bound
-  const PairTransferOffset offset = pair_transfer_offset(matches, kK, 15);
+  const PairTransferOffset offset = pair_transfer_offset(matches, 15);
   EXPECT_GT(offset.ab.norm(), 5.0);
   for (size_t k = 0; k + 1 < matches.size(); ++k)
-    EXPECT_FALSE(contradicted_by_lidar(matches[k][0], matches[k][1], kK, 3, offset.ab, offset.ba)) << k;
-  EXPECT_TRUE(contradicted_by_lidar(wa, wb, kK, 3, offset.ab, offset.ba));
+    EXPECT_FALSE(contradicted_by_lidar(matches[k], 3, offset.ab, offset.ba)) << k;
+  EXPECT_TRUE(contradicted_by_lidar(wrong, 3, offset.ab, offset.ba));
   // Too few matches to judge the pair by: no offset.
-  EXPECT_EQ(pair_transfer_offset(matches, kK, matches.size() + 1).ab, Eigen::Vector2d::Zero());
+  EXPECT_EQ(pair_transfer_offset(matches, matches.size() + 1).ab, Eigen::Vector2d::Zero());
 }
 
 TEST(FrontendLidarCheck, WithoutMapDepthTheMatchCannotBeJudgedAndIsKept) {
   const LidarDepthImage empty({}, kA.R, kA.t, kK, kWidth, kHeight, {});
   const Eigen::Vector2d xa(100, 100), xb(300, 20);  // far from consistent, but nothing to judge by
-  EXPECT_FALSE(lidar_transfer_px({kA.R, kA.t, xa, empty}, {kB.R, kB.t, xb, empty}, kK).has_value());
-  EXPECT_FALSE(contradicted_by_lidar({kA.R, kA.t, xa, empty}, {kB.R, kB.t, xb, empty}, kK, 8));
+  const MatchTransfers m = match_transfers({kA.R, kA.t, xa, empty}, {kB.R, kB.t, xb, empty}, kK);
+  EXPECT_FALSE(lidar_transfer_px(m.ab).has_value());
+  EXPECT_FALSE(lidar_transfer_px(m.ba).has_value());
+  EXPECT_FALSE(contradicted_by_lidar(m, 8));
 }
 
 TEST(FrontendLidarCheck, BadOptionsAreRefusedByName) {
