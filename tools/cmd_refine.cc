@@ -31,9 +31,9 @@ void add_refine_command(CLI::App& app) {
   c->add_option("--scan-weight", o->refine.ba.scan_weight, "Weight of each scan point-to-plane residual")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  c->add_flag(
-      "--points-on-scan-map", o->refine.scan_alignment.points_on_scan_map,
-      "Hold the track points to the planes of the map the scans build each round (not lidar/map.pcd)");
+  c->add_flag("--points-on-scan-map,!--points-on-lidar-map", o->refine.scan_alignment.points_on_scan_map,
+              "Once the scans join, hold the track points to the planes of the map the scans build each "
+              "round (--points-on-lidar-map: to lidar/map.pcd in every round)");
   c->add_option("--scan-gate", o->refine.scan_alignment.gate_start_m,
                 "Scan point-to-plane gate of the first round, metres (halved each round, floor 3 cm)")
       ->capture_default_str()

@@ -27,9 +27,10 @@ struct ScanAlignmentOptions {
   double search_radius_m = 0.3;  // nearest planar map point within this, or two of the round's voxels
   // Point-to-plane gate per round: start, halved each round, never below the floor (as the image points').
   double gate_start_m = 0.2, gate_floor_m = 0.03;
-  // The track points' plane term on this map too, instead of the scene's LiDAR map (which the prior poses
-  // placed): one map that moves with the poses.
-  bool points_on_scan_map = false;
+  // In the rounds the scans are in, the track points' plane term on this map too, instead of the scene's
+  // LiDAR map (which the drifting prior poses placed): one map that moves with the poses. It lowered the
+  // refined ATE most where the LiDAR map drifts (docs/experiments.md, 2026-12-07).
+  bool points_on_scan_map = true;
   // The refinement's round (0-based) the scans join in. Their map is built through the current poses, and
   // through poses that still carry most of the priors' drift it is smeared: the links it gives hold the
   // solve in that state (docs/refinement.md). From the fifth round the image term has done most of its work.
