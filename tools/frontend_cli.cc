@@ -12,6 +12,7 @@ namespace litgs::tools {
 host::frontend::FrontendOptions FrontendCli::resolved() const {
   host::frontend::FrontendOptions o = options;
   o.features.type = host::frontend::parse_feature_type(features);
+  o.features.grid_rows = o.features.grid_cols;  // --grid N is N x N
   o.match.matcher = matcher == "auto" ? (o.features.type == host::frontend::FeatureType::kXfeat
                                              ? host::frontend::Matcher::kMnn
                                              : host::frontend::Matcher::kRatio)
@@ -37,8 +38,7 @@ void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli
       ->capture_default_str();
   cmd.add_option(M::kThreads.flag, o.threads, M::kThreads.help)->capture_default_str();
   cmd.add_option("--grid", o.features.grid_cols, "Grid bucketing: N x N cells (0: off)")
-      ->capture_default_str()
-      ->each([&o](const std::string&) { o.features.grid_rows = o.features.grid_cols; });
+      ->capture_default_str();
   cmd.add_option("--keypoint-spacing", o.features.min_spacing_px,
                  "orb, sift, akaze: drop a keypoint nearer than this to a stronger one (pixels; 0: none)")
       ->capture_default_str();
