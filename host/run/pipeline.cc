@@ -168,8 +168,12 @@ class Runner {
     if (!plan.notes.empty()) entry["notes"] = plan.notes;
     json inputs = json::object();
     for (const fs::path& p : plan.inputs) inputs[fs::absolute(p).string()] = hash_of(p);
+    // The engine is an input too: a stage made by another build (other defaults, other code) is not this
+    // build's, so a rebuilt or upgraded engine runs its stages again.
+    const std::string engine = hash_of(ctx_.engine);
     const std::string key = hash_text(json{
         {"stage", stage.name},
+        {"engine", engine},
         {"inputs", inputs},
         {"options", plan.options},
         {"command", plan.command}}.dump());
@@ -229,6 +233,7 @@ class Runner {
     // Written last: until it exists, the stage is not done.
     write_json(manifest_path, {{"stage", stage.name},
                                {"key", key},
+                               {"engine", {{"path", ctx_.engine.string()}, {"hash", engine}}},
                                {"inputs", inputs},
                                {"options", plan.options},
                                {"command", plan.command},

@@ -112,6 +112,30 @@ TEST(RunPipeline, SyntheticEndToEndThenRerunsSkipAndFromForces) {
   EXPECT_EQ(stage_status(dir, "report"), "done");
 }
 
+// A stage made by another engine build is not up to date: a rebuilt engine (here a copy with one byte more,
+// run through LITGS_ENGINE) makes its stages again, and then skips them.
+TEST(RunPipeline, AnotherEngineBuildRunsTheStagesAgain) {
+  const fs::path dir = kRoot / "engine-build", other = kRoot / "engine-build-copy";
+  fs::remove_all(dir);
+  fs::remove(other);
+  const fs::path config = write_text(kRoot / "engine-build.yaml", small_run_yaml());
+  CommandResult r = run_engine(run_args("synth:facade", dir, config, "--until import"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  ASSERT_EQ(stage_status(dir, "import"), "done");
+  fs::copy_file(LITGS_ENGINE_BINARY, other);
+  std::ofstream(other, std::ios::app) << '\n';
+  ::setenv("LITGS_ENGINE", other.c_str(), 1);
+  r = run_engine(run_args("synth:facade", dir, config, "--until import"));
+  const std::string status_with_other_build = stage_status(dir, "import");
+  const CommandResult again = run_engine(run_args("synth:facade", dir, config, "--until import"));
+  ::unsetenv("LITGS_ENGINE");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(status_with_other_build, "done") << r.output;
+  EXPECT_EQ(read_json_file(dir / "import" / "manifest.json")["engine"]["path"], other.string());
+  ASSERT_EQ(again.status, 0) << again.output;
+  EXPECT_EQ(stage_status(dir, "import"), "up to date");
+}
+
 std::map<std::string, std::string> file_contents(const fs::path& dir) {
   std::map<std::string, std::string> files;
   for (const auto& e : fs::recursive_directory_iterator(dir))
