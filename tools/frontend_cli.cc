@@ -37,6 +37,7 @@ void add_frontend_options(CLI::App& cmd, const std::shared_ptr<FrontendCli>& cli
   cmd.add_option(M::kMaxKeypoints.flag, o.features.max_keypoints, M::kMaxKeypoints.help)
       ->capture_default_str();
   cmd.add_option(M::kThreads.flag, o.threads, M::kThreads.help)->capture_default_str();
+  cmd.add_option(M::kXfeatScale.flag, o.features.xfeat_scale, M::kXfeatScale.help)->capture_default_str();
   cmd.add_option("--grid", o.features.grid_cols, "Grid bucketing: N x N cells (0: off)")
       ->capture_default_str();
   cmd.add_option("--keypoint-spacing", o.features.min_spacing_px,

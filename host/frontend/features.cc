@@ -40,6 +40,8 @@ void FeatureOptions::check() const {
     throw std::invalid_argument("grid cells must be both 0 or both in 1..256");
   if (!(min_spacing_px >= 0 && min_spacing_px <= 64))
     throw std::invalid_argument("min_spacing_px must be in 0..64, got " + std::to_string(min_spacing_px));
+  if (!(xfeat_scale >= 0.25 && xfeat_scale <= 4))
+    throw std::invalid_argument("xfeat_scale must be in 0.25..4, got " + std::to_string(xfeat_scale));
 }
 
 std::vector<size_t> spaced_keypoints(const std::vector<float>& x, const std::vector<float>& y,

@@ -28,6 +28,10 @@ struct FeatureOptions {
   // none). A blurred feature found at two scales a pixel or two apart otherwise gives two keypoints whose
   // matches put both in one track, a conflict that costs one of them.
   double min_spacing_px = 0;
+  // XFeat: the frame is resized by this factor before the network. Its keypoints lie on whole pixels of the
+  // network's input and its descriptors on cells of 8 of them, so a larger input places both more finely
+  // in the frame (at the square of the factor in device time).
+  double xfeat_scale = 1;
   void check() const;  // std::invalid_argument naming the field
 };
 

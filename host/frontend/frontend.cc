@@ -437,6 +437,7 @@ std::string frontend_json(const FrontendResult& r) {
        {{"features", feature_name(o.features.type)},
         {"matcher", matcher_name(o.match.matcher)},
         {"max_keypoints", o.features.max_keypoints},
+        {"xfeat_scale", o.features.xfeat_scale},
         {"grid", {o.features.grid_cols, o.features.grid_rows}},
         {"clahe", o.preprocess.clahe},
         {"clahe_clip_limit", o.preprocess.clahe_clip_limit},

@@ -18,5 +18,9 @@ inline constexpr OptionName kPairs{
     "exhaustive"};
 inline constexpr OptionName kMaxKeypoints{"max_keypoints", "--max-keypoints", "Keypoint budget per image"};
 inline constexpr OptionName kThreads{"threads", "--threads", "Worker threads (0: all cores)"};
+inline constexpr OptionName kXfeatScale{
+    "xfeat_scale", "--xfeat-scale",
+    "xfeat: run the network on the frame resized by this factor (then to multiples of 32); keypoints are "
+    "given in the frame's pixels"};
 
 }  // namespace litgs::host::match_option

@@ -32,10 +32,13 @@ struct XfeatDetector {
     f.float_descriptors = true;
     f.descriptor_bytes = kDescriptorFloats * int(sizeof(float));
     if (frame.pixels.empty()) return f;
-    const int width = frame.width / 32 * 32, height = frame.height / 32 * 32;
+    const double scale = options.xfeat_scale;
+    const int width = int(std::lround(frame.width * scale)) / 32 * 32,
+              height = int(std::lround(frame.height * scale)) / 32 * 32;
     if (!width || !height)
-      throw std::invalid_argument("xfeat: a " + std::to_string(frame.width) + "x" +
-                                  std::to_string(frame.height) + " frame is smaller than 32x32");
+      throw std::invalid_argument(
+          "xfeat: a " + std::to_string(frame.width) + "x" + std::to_string(frame.height) + " frame" +
+          (scale != 1 ? " at xfeat_scale " + std::to_string(scale) : "") + " is smaller than 32x32");
     const bool resized = width != frame.width || height != frame.height;
     const std::vector<float> input =
         xfeat_input(resized ? frontend::resize_gray8(frame, width, height) : frame);

@@ -45,6 +45,7 @@ struct RunConfig {
     bool clahe = true;
     std::string pairs = "covisible";
     uint32_t max_keypoints = 3000;
+    double xfeat_scale = 1;
     uint32_t threads = 0;
     std::vector<std::string> extra_args;
   } match;
@@ -129,6 +130,7 @@ void for_each_field(Config& c, F&& f) {
   named("match", match_option::kClahe, c.match.clahe);
   named("match", match_option::kPairs, c.match.pairs);
   named("match", match_option::kMaxKeypoints, c.match.max_keypoints);
+  named("match", match_option::kXfeatScale, c.match.xfeat_scale);
   named("match", match_option::kThreads, c.match.threads);
   f("match", "extra_args", c.match.extra_args, "more flags for `litgs-engine match`, as is");
   f("refine", "enabled", c.refine.enabled, "refine the poses (poses.txt; the input kept as poses_prior.txt)");

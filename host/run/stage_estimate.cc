@@ -24,10 +24,11 @@ constexpr double kImportSecondsPerMpx = 0.05;  // reading and converting recorde
 constexpr double kEvalSecondsPerMpx = 0.05;    // rendering and scoring the held-out views
 constexpr double kMapSecondsPerScanMb = 0.026;
 constexpr double kMatchSecondsPerMpx = 0.8;  // on 2 threads
-// XFeat (match.features xfeat): its network on the device, and matching and tracks over its 3,000 keypoints
-// per frame with more conflicts (DUNR's 45 frames at 640x512: 56 s of features on lavapipe, 34 s of the
-// rest).
-constexpr double kXfeatCpuDeviceSecondsPerMpx = 3.8;
+// XFeat (match.features xfeat): its network on the device, per megapixel of the network's input (the
+// frames times match.xfeat_scale squared; DUNR's 45 frames at 640x512 on lavapipe: 12, 57 and 92 s of
+// features at scales 1, 2 and 3), and matching and tracks over its 3,000 keypoints per frame with more
+// conflicts.
+constexpr double kXfeatCpuDeviceSecondsPerMpx = 0.85;
 constexpr double kXfeatMatchSecondsPerMpx = 2.3;
 // Refine on 2 threads, with the LiDAR point-to-plane term: fitted to `ci/refine-bench`'s refinements
 // (facade, street and corridor at 320x256) with and without the scans, whose term is per scan for each
@@ -202,9 +203,11 @@ std::optional<StageEstimate> estimate_stage(const std::string& stage, InputKind 
   } else if (stage == "match") {
     const double threads = c.match.threads ? c.match.threads : cores;
     if (c.match.features == "xfeat")
-      e = fixed(1.0 + ((d.cpu ? kXfeatCpuDeviceSecondsPerMpx : 0.0) + kXfeatMatchSecondsPerMpx) * mpx *
-                          thread_factor(threads),
-                size_text(s) + ", XFeat on " + (d.name.empty() ? std::string("the device") : d.name));
+      e = fixed(
+          1.0 + ((d.cpu ? kXfeatCpuDeviceSecondsPerMpx * c.match.xfeat_scale * c.match.xfeat_scale : 0.0) +
+                 kXfeatMatchSecondsPerMpx) *
+                    mpx * thread_factor(threads),
+          size_text(s) + ", XFeat on " + (d.name.empty() ? std::string("the device") : d.name));
     else
       e = fixed(1.0 + kMatchSecondsPerMpx * mpx * thread_factor(threads),
                 size_text(s) + " on " + std::to_string(static_cast<int>(threads)) + " threads");

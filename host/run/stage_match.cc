@@ -19,7 +19,8 @@ StagePlan plan(const StageContext& c) {
   plan_on_scene_copy(
       c, "match", SceneCopy{scene, {}, {"sfm"}},
       option_flags(p.options, {match_option::kFeatures, match_option::kMatcher, match_option::kClahe,
-                               match_option::kPairs, match_option::kMaxKeypoints, match_option::kThreads}),
+                               match_option::kPairs, match_option::kMaxKeypoints, match_option::kXfeatScale,
+                               match_option::kThreads}),
       o.extra_args, p);
   return p;
 }

@@ -113,14 +113,21 @@ TEST(AblationStudies, VariantsOfEachStudyAndABadName) {
   base.train.max_gaussians = "8000";
   const auto all = ablation_studies("all", base);
   ASSERT_EQ(all.size(), 4u);
-  ASSERT_EQ(all[0].variants.size(), 3u);   // input, refined, true poses
-  EXPECT_EQ(all[1].variants.size(), 5u);   // lambda_geo 0 .. 0.8
-  ASSERT_EQ(all[2].variants.size(), 10u);  // orb, sift, akaze, xfeat (mnn), xfeat + lighterglue x CLAHE
+  ASSERT_EQ(all[0].variants.size(), 3u);  // input, refined, true poses
+  EXPECT_EQ(all[1].variants.size(), 5u);  // lambda_geo 0 .. 0.8
+  // orb, sift, akaze, xfeat (mnn) on inputs x1, x2, x3, xfeat + lighterglue, each without and with CLAHE
+  ASSERT_EQ(all[2].variants.size(), 14u);
   RunConfig lighterglue = base;
-  all[2].variants[9].apply(lighterglue);
+  all[2].variants[13].apply(lighterglue);
   EXPECT_EQ(lighterglue.match.features, "xfeat");
   EXPECT_EQ(lighterglue.match.matcher, "lighterglue");
   EXPECT_TRUE(lighterglue.match.clahe);
+  EXPECT_EQ(lighterglue.match.xfeat_scale, 1.0);
+  RunConfig tripled = base;
+  all[2].variants[11].apply(tripled);
+  EXPECT_EQ(all[2].variants[11].name, "xfeat-x3-clahe");
+  EXPECT_EQ(tripled.match.xfeat_scale, 3.0);
+  EXPECT_EQ(tripled.match.features, "xfeat");
   ASSERT_EQ(all[3].variants.size(), 6u);  // adc, mcmc x 3 budgets
   RunConfig c = base;
   all[0].variants[0].apply(c);

@@ -63,6 +63,59 @@ TEST_F(FrontendXfeat, TranslationOverATexturedPlaneGivesPointsOnThePlane) {
     }
 }
 
+// `--xfeat-scale 2`: the network runs on the frames enlarged twice (640x480), its keypoints come back in the
+// frames' pixels and lie on half pixels of them: the tracks agree with their points more closely than at
+// the frames' own size, and the points lie on the plane within the same bounds. A scale that leaves less
+// than 32x32, or one out of range, is refused by name.
+TEST_F(FrontendXfeat, TwiceTheInputGivesFinerKeypointsInTheFrame) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < 4; ++i) poses.push_back(testing::plane_view({0.4 * i, 0.05 * i, 0}));
+  testing::write_rendered_plane_scene(dir_, testing::PlaneCamera{}, poses);
+  const auto median_off_plane = [](const FrontendResult& r) {
+    std::vector<double> off;
+    for (const auto& p : r.data.points) off.push_back(std::abs(p.xyz.z() - testing::kPlaneZ));
+    std::sort(off.begin(), off.end());
+    return off.empty() ? 1e9 : off[off.size() / 2];
+  };
+  const FrontendResult once = run_frontend(dir_, options());
+  FrontendOptions o = options();
+  o.features.xfeat_scale = 2;
+  o = nn::with_learned_detector(o);
+  const FrontendResult twice = run_frontend(dir_, o);
+  ASSERT_GT(twice.summary.points, 100u);
+  EXPECT_LT(twice.summary.mean_error_px, 1.5);
+  const bool off_half_pixel = [&] {
+    for (const auto& image : twice.data.images)
+      for (const auto& k : image.keypoints) {
+        EXPECT_GE(k.x, -0.5f);
+        EXPECT_LT(k.x, 319.5f);
+        EXPECT_GE(k.y, -0.5f);
+        EXPECT_LT(k.y, 239.5f);
+        if (std::abs(k.x - std::round(k.x)) > 0.1f) return true;
+      }
+    return false;
+  }();
+  EXPECT_TRUE(off_half_pixel) << "every keypoint on a whole pixel of the frame: the input was not enlarged";
+  EXPECT_LT(twice.summary.mean_error_px, once.summary.mean_error_px);
+  EXPECT_LT(median_off_plane(twice), 0.015);
+  std::printf("xfeat over a plane, input x1 / x2: median %.4f / %.4f m off the plane, %.3f / %.3f px\n",
+              median_off_plane(once), median_off_plane(twice), once.summary.mean_error_px,
+              twice.summary.mean_error_px);
+
+  FrontendOptions small = options();
+  small.features.xfeat_scale = 0.5;
+  small = nn::with_learned_detector(small);
+  try {
+    small.learned_detector(Gray8{40, 40, std::vector<uint8_t>(40 * 40, 1)});
+    ADD_FAILURE() << "a 40x40 frame at half size was detected on";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("xfeat_scale"), std::string::npos) << e.what();
+  }
+  FeatureOptions too_large;
+  too_large.xfeat_scale = 5;
+  EXPECT_THROW(too_large.check(), std::invalid_argument);
+}
+
 // LighterGlue on the device as the matcher (`--matcher lighterglue`): the same plane, the same bounds as the
 // mnn matcher's above; a bit-string descriptor is refused with a message naming xfeat.
 TEST_F(FrontendXfeat, LighterGlueMatchesTheTranslationOverAPlane) {

@@ -60,6 +60,10 @@ TEST(StageEstimate, GrowsWithFramesPixelsIterationsAndBudget) {
   EXPECT_GT(seconds("match", larger, xfeat, cpu_device()), 3 * seconds("match", larger, c, cpu_device()));
   EXPECT_LT(seconds("match", larger, xfeat, {"NVIDIA H200", false, 2}),
             seconds("match", larger, xfeat, cpu_device()));
+  RunConfig tripled = xfeat;  // the network on 9 times the pixels
+  tripled.match.xfeat_scale = 3;
+  EXPECT_GT(seconds("match", larger, tripled, cpu_device()),
+            2 * seconds("match", larger, xfeat, cpu_device()));
 }
 
 TEST(StageEstimate, TheScansInTheRefinementCostTimeOnlyInTheRoundsTheyJoin) {
