@@ -114,19 +114,27 @@ void run_bench_features(const BenchFeaturesOptions& o) {
                   {"where", "device: " + context.info().name},
                   {"ms", median(ms)},
                   {"kernels", network_kernels}});
-  // What the front end pays per frame: normalization, network, keypoints, descriptors, grid bucketing.
+  // What the front end pays per frame: normalization, network, keypoints, descriptors, grid bucketing; also
+  // with the frame enlarged 2 and 3 times first (`match --xfeat-scale`).
   const host::frontend::LearnedDetector xfeat =
       host::nn::make_xfeat_detector(shared_context, weights, host::frontend::FeatureOptions{});
-  std::vector<double> detect_ms;
-  size_t xfeat_keypoints = 0;
-  for (uint32_t r = 0; r <= o.runs; ++r) {
-    const double t = time_ms([&] { xfeat_keypoints = xfeat(frame).keypoints.size(); });
-    if (r) detect_ms.push_back(t);
+  for (const int scale : {1, 2, 3}) {
+    host::frontend::FeatureOptions scaled;
+    scaled.xfeat_scale = scale;
+    const host::frontend::LearnedDetector detector =
+        scale == 1 ? xfeat : host::nn::make_xfeat_detector(shared_context, weights, scaled);
+    std::vector<double> detect_ms;
+    size_t xfeat_keypoints = 0;
+    for (uint32_t r = 0; r <= o.runs; ++r) {
+      const double t = time_ms([&] { xfeat_keypoints = detector(frame).keypoints.size(); });
+      if (r) detect_ms.push_back(t);
+    }
+    rows.push_back({{"detector", scale == 1 ? "xfeat" : "xfeat x" + std::to_string(scale)},
+                    {"where", "device: network, keypoints, descriptors" +
+                                  (scale == 1 ? std::string() : ", input x" + std::to_string(scale))},
+                    {"ms", median(detect_ms)},
+                    {"keypoints", xfeat_keypoints}});
   }
-  rows.push_back({{"detector", "xfeat"},
-                  {"where", "device: network, keypoints, descriptors"},
-                  {"ms", median(detect_ms)},
-                  {"keypoints", xfeat_keypoints}});
   // LighterGlue per pair of frames: attention is quadratic in the keypoints, so at 1000 and at all of them
   // (the frame matched with itself: the time does not depend on the content).
   const host::frontend::ImageFeatures detected = xfeat(frame);
