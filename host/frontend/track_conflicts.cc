@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <stdexcept>
+
+#include "host/frontend/observations_by_image.h"
 
 namespace litgs::host::frontend {
 namespace {
@@ -23,26 +26,23 @@ struct Support {
   Eigen::Vector3d X = Eigen::Vector3d::Constant(NAN);  // the point they agree with
 };
 
-// Per image, the remaining observation nearest X if within the bound.
-Support support_of(const Eigen::Vector3d& X, const std::vector<size_t>& remaining,
-                   const io::SfmTrack& component, const std::vector<std::optional<TriangulationView>>& views,
-                   double fx, double fy, double bound2) {
+// Per image, the unused observation nearest X (the first in index order on a tie) if within the bound.
+Support support_of(const Eigen::Vector3d& X, const std::vector<char>& used, const ObservationsByImage& index,
+                   const std::vector<std::optional<TriangulationView>>& views, double fx, double fy,
+                   double bound2) {
   Support s;
   s.X = X;
-  size_t k = 0;
-  while (k < remaining.size()) {
-    const uint32_t image = component.observations[remaining[k]].image;
+  for (size_t slot = 0; slot < index.slots(); ++slot) {
     size_t best = SIZE_MAX;
     double best_e2 = bound2;
-    for (; k < remaining.size() && component.observations[remaining[k]].image == image; ++k) {
-      const auto& v = views[remaining[k]];
-      if (!v) continue;
-      const double e2 = error2_px(*v, X, fx, fy);
-      if (e2 < best_e2) {
+    index.near(slot, X, [&](size_t i) {
+      if (used[i]) return;
+      const double e2 = error2_px(*views[i], X, fx, fy);
+      if (e2 < best_e2 || (e2 == best_e2 && best != SIZE_MAX && i < best)) {
         best_e2 = e2;
-        best = remaining[k];
+        best = i;
       }
-    }
+    });
     if (best != SIZE_MAX) {
       s.members.push_back(best);
       s.error2_sum += best_e2;
@@ -156,8 +156,8 @@ void attach_dropped(std::vector<std::vector<size_t>>& groups, std::vector<char>&
 // Where an image has several observations within the bound (a repeated feature close by, and priors that
 // drifted), the nearest through the priors may be the wrong one; the one with the most verified matches
 // to the members in the other images is the track's. Ties keep the nearest.
-void prefer_matched(Support& s, const std::vector<size_t>& remaining, const io::SfmTrack& component,
-                    const std::vector<std::optional<TriangulationView>>& views,
+void prefer_matched(Support& s, const std::vector<char>& used, const ObservationsByImage& index,
+                    const io::SfmTrack& component, const std::vector<std::optional<TriangulationView>>& views,
                     const std::vector<std::vector<size_t>>& adjacent, double fx, double fy, double bound2) {
   std::vector<char> member(component.observations.size(), 0);
   for (size_t m : s.members) member[m] = 1;
@@ -169,8 +169,11 @@ void prefer_matched(Support& s, const std::vector<size_t>& remaining, const io::
       return count;
     };
     size_t best = chosen, best_count = matched(chosen);
-    for (size_t i : remaining) {
-      if (i == chosen || component.observations[i].image != image || !views[i]) continue;
+    std::vector<size_t> candidates;  // in index order, as the nearest wins a tie
+    index.near(index.slot_of(chosen), s.X, [&](size_t i) { candidates.push_back(i); });
+    std::sort(candidates.begin(), candidates.end());
+    for (size_t i : candidates) {
+      if (i == chosen || used[i]) continue;
       if (!(error2_px(*views[i], s.X, fx, fy) <= bound2)) continue;
       const size_t count = matched(i);
       if (count > best_count) {
@@ -211,10 +214,8 @@ ConflictSplit split_conflicting_component(const io::SfmTrack& component,
   ConflictSplit out;
   std::vector<std::vector<size_t>> groups;  // the tracks as observation indices
   const double bound2 = o.max_error_px * o.max_error_px;
+  const ObservationsByImage index(component, views, fx, fy, o.max_error_px);
   while (true) {
-    std::vector<size_t> remaining;
-    for (size_t i = 0; i < n; ++i)
-      if (!used[i]) remaining.push_back(i);
     std::erase_if(open, [&](const auto& e) {
       return e[0] >= n || e[1] >= n || used[e[0]] || used[e[1]] || !views[e[0]] || !views[e[1]];
     });
@@ -224,7 +225,7 @@ ConflictSplit split_conflicting_component(const io::SfmTrack& component,
     for (size_t h = 0; h < open.size(); h += step) {
       const Eigen::Vector3d X = triangulate_linear({*views[open[h][0]], *views[open[h][1]]}, {0, 1});
       if (!X.allFinite()) continue;
-      Support s = support_of(X, remaining, component, views, fx, fy, bound2);
+      Support s = support_of(X, used, index, views, fx, fy, bound2);
       // Both ends of the hypothesis must agree with their own point (not behind a camera).
       if (std::find(s.members.begin(), s.members.end(), open[h][0]) == s.members.end() ||
           std::find(s.members.begin(), s.members.end(), open[h][1]) == s.members.end())
@@ -240,11 +241,11 @@ ConflictSplit split_conflicting_component(const io::SfmTrack& component,
     for (int round = 0; round < 3; ++round) {
       const Eigen::Vector3d X = point_of(best.members, views);
       if (!X.allFinite()) break;
-      Support grown = support_of(X, remaining, component, views, fx, fy, bound2);
+      Support grown = support_of(X, used, index, views, fx, fy, bound2);
       if (grown.members.size() <= best.members.size()) break;
       best = std::move(grown);
     }
-    prefer_matched(best, remaining, component, views, adjacent, fx, fy, bound2);
+    prefer_matched(best, used, index, component, views, adjacent, fx, fy, bound2);
     for (size_t m : best.members) used[m] = 1;
     groups.push_back(std::move(best.members));
   }

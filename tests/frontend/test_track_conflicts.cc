@@ -142,6 +142,55 @@ TEST(FrontendTrackConflicts, AnObservationJustBeyondTheBoundJoinsTheTrackItIsMat
   EXPECT_EQ(dropped.dropped, 2u);
 }
 
+TEST(FrontendTrackConflicts, AWallOfBricksMatchedOnePeriodOffSplitsIntoOneTrackPerBrick) {
+  // 40 x 10 bricks 0.25 m apart (15 px at 5 m), seen by 8 images: 3,200 observations in one component,
+  // 400 per image, rows of equal x, each keypoint jittered. Every brick is matched between neighbouring
+  // images, and every third also to the next brick of its row (one period off, on the epipolar line). Each
+  // brick must come back as one track through all 8 images: an agreeing observation missed by the search per
+  // image would shorten or drop tracks.
+  constexpr size_t kImages = 8, kColumns = 40, kRows = 10, kBricks = kColumns * kRows;
+  io::SfmTrack component;
+  std::vector<Eigen::Vector3d> seen;
+  for (uint32_t image = 0; image < kImages; ++image)
+    for (uint32_t b = 0; b < kBricks; ++b) {
+      component.observations.push_back({image, b});
+      // Each keypoint up to 1.2 px off its brick, so the agreeing observation is not at the projection.
+      const double jitter_x = 0.6 * static_cast<double>((b * 7 + image * 3) % 5) - 1.2;
+      const double jitter_y = 0.6 * static_cast<double>((b * 3 + image * 5) % 5) - 1.2;
+      seen.emplace_back(-2.0 + 0.25 * static_cast<double>(b % kColumns) + jitter_x * 5 / kF,
+                        -1.0 + 0.25 * static_cast<double>(b / kColumns) + jitter_y * 5 / kF, 5);
+    }
+  std::vector<std::array<size_t, 2>> edges;
+  for (size_t image = 0; image + 1 < kImages; ++image)
+    for (size_t b = 0; b < kBricks; ++b) {
+      edges.push_back({image * kBricks + b, (image + 1) * kBricks + b});
+      if (b % 3 == 0 && b % kColumns + 1 < kColumns)
+        edges.push_back({image * kBricks + b, (image + 1) * kBricks + b + 1});
+    }
+  // Uneven steps along the wall: with even ones a match one period off would be a point in front of the
+  // wall that every image sees one more period off, as consistent as the bricks.
+  const std::array<double, kImages> centre_x = {0, 0.37, 0.61, 1.05, 1.3, 1.72, 2.01, 2.44};
+  const ObservationView view = [&](const io::SfmObservation& o) -> std::optional<TriangulationView> {
+    TriangulationView v;
+    v.t_cam_world = Eigen::Vector3d(-centre_x[o.image], 0, 0);
+    const Eigen::Vector3d c = seen[o.image * kBricks + o.keypoint] + v.t_cam_world;
+    v.xy = {c.x() / c.z(), c.y() / c.z()};
+    return v;
+  };
+  const ConflictSplit split = split_conflicting_component(component, edges, view, kF, kF, {});
+  EXPECT_EQ(split.dropped, 0u);
+  ASSERT_EQ(split.tracks.size(), kBricks);
+  std::vector<char> brick_seen(kBricks, 0);
+  for (const auto& t : split.tracks) {
+    ASSERT_EQ(t.observations.size(), kImages);
+    const uint32_t brick = t.observations[0].keypoint;
+    for (uint32_t image = 0; image < kImages; ++image)
+      EXPECT_EQ(t.observations[image], (io::SfmObservation{image, brick}));
+    brick_seen[brick] = 1;
+  }
+  EXPECT_EQ(std::count(brick_seen.begin(), brick_seen.end(), 1), static_cast<long>(kBricks));
+}
+
 TEST(FrontendTracks, WithASplitterConflictsAreSplitAndTheLostMatchesCounted) {
   // A chain 0:0 - 1:0 - 2:0 and a match 0:0 - 2:1: with a splitter the component {0:0, 1:0, 2:0, 2:1}
   // reaches it whole (this splitter keeps image 2's keypoint 0); 1:1 - 2:2 is a track of its own.
