@@ -28,7 +28,8 @@ struct ConflictOptions {
 };
 
 // The geometry of an observation: its image's prior pose and its normalized undistorted coordinates;
-// nullopt where the image has no prior pose.
+// nullopt where the image has no prior pose. Every observation of one image has the same pose: the split
+// projects a point once per image (observations_by_image.h).
 using ObservationView = std::function<std::optional<TriangulationView>(const io::SfmObservation&)>;
 
 struct ConflictSplit {
