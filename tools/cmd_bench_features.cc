@@ -2,11 +2,12 @@
 // on one frame, in one run: ORB, SIFT and AKAZE (OpenCV, on the CPU, at the front end's defaults), XFeat's
 // network on the Vulkan device (upload, forward pass and download; and the device's time in each of its
 // kernels), XFeat as the front end runs it (network,
-// keypoints and descriptors on the device, at match's defaults) and XFeat's double-precision CPU reference
-// of the network (one run). The frame is cropped to multiples of 32.
+// keypoints and descriptors on the device, at match's defaults), LighterGlue per pair of frames (and the
+// device's time in each of its kernels) and XFeat's double-precision CPU reference of the network (one run). The frame is cropped to multiples of 32.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -23,6 +24,8 @@
 #include "host/nn/xfeat_features.h"
 #include "host/nn/xfeat_weights.h"
 #include "io/image.h"
+#include "kernels/nn/lighterglue.h"
+#include "kernels/nn/lighterglue_reference.h"
 #include "kernels/nn/xfeat.h"
 #include "kernels/nn/xfeat_reference.h"
 #include "tools/bench_stats.h"
@@ -67,6 +70,23 @@ host::frontend::Gray8 load_frame(const std::filesystem::path& path) {
     g.pixels.insert(g.pixels.end(), full.pixels.begin() + y * full.width,
                     full.pixels.begin() + y * full.width + g.width);
   return g;
+}
+
+// Where one pair's time goes: each kernel's device time in one more run of the network itself.
+nlohmann::json lighterglue_kernels(engine::Context& context, const kernels::nn::LighterGlueWeights& weights,
+                                   const host::frontend::ImageFeatures& f, const host::frontend::Gray8& frame) {
+  std::vector<float> xy;
+  for (const io::SfmKeypoint& k : f.keypoints) xy.insert(xy.end(), {k.x, k.y});
+  const std::vector<double> normalized =
+      kernels::nn::normalize_keypoints(xy, frame.width, frame.height).values;
+  const std::vector<float> keypoints(normalized.begin(), normalized.end());
+  std::vector<float> descriptors(f.descriptors.size() / sizeof(float));
+  std::memcpy(descriptors.data(), f.descriptors.data(), descriptors.size() * sizeof(float));
+  const kernels::LighterGlueNetwork network(context, weights);
+  nlohmann::json out = nlohmann::json::array();
+  for (const engine::KernelTime& k : network.match(keypoints, descriptors, keypoints, descriptors).kernel_times)
+    out.push_back({{"kernel", k.name}, {"dispatches", k.dispatches}, {"ms", k.ms}});
+  return out;
 }
 
 void run_bench_features(const BenchFeaturesOptions& o) {
@@ -138,8 +158,10 @@ void run_bench_features(const BenchFeaturesOptions& o) {
   // LighterGlue per pair of frames: attention is quadratic in the keypoints, so at 1000 and at all of them
   // (the frame matched with itself: the time does not depend on the content).
   const host::frontend::ImageFeatures detected = xfeat(frame);
-  const host::frontend::LearnedMatcher lighterglue = host::nn::make_lighterglue_matcher(
-      shared_context, host::nn::lighterglue_weights(host::nn::lighterglue_model()), 0.1);
+  const kernels::nn::LighterGlueWeights lighterglue_weights =
+      host::nn::lighterglue_weights(host::nn::lighterglue_model());
+  const host::frontend::LearnedMatcher lighterglue =
+      host::nn::make_lighterglue_matcher(shared_context, lighterglue_weights, 0.1);
   for (const size_t n : {size_t{1000}, detected.keypoints.size()}) {
     host::frontend::ImageFeatures f = detected;
     f.keypoints.resize(std::min(n, f.keypoints.size()));
@@ -153,7 +175,8 @@ void run_bench_features(const BenchFeaturesOptions& o) {
     rows.push_back({{"detector", "lighterglue"},
                     {"where", "device: one pair, " + std::to_string(f.keypoints.size()) + " keypoints each"},
                     {"ms", median(pair_ms)},
-                    {"matches", matches}});
+                    {"matches", matches},
+                    {"kernels", lighterglue_kernels(context, lighterglue_weights, f, frame)}});
     if (f.keypoints.size() == detected.keypoints.size()) break;
   }
   kernels::nn::FeatureMap image(1, frame.height, frame.width);

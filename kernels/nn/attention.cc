@@ -47,7 +47,8 @@ void AttentionKernels::linear(engine::Sequence& s, const engine::Buffer& a, uint
   p.outputs = out;
   p.has_bias = bias != nullptr;
   p.has_residual = residual != nullptr;
-  const uint64_t count = uint64_t{rows} * ((out + NN_LINEAR_OUTPUTS - 1) / NN_LINEAR_OUTPUTS);
+  const uint64_t count = uint64_t{(rows + NN_LINEAR_ROWS - 1) / NN_LINEAR_ROWS} *
+                         ((out + NN_LINEAR_RUN - 1) / NN_LINEAR_RUN) * NN_LINEAR_LANES;
   p.count = static_cast<uint32_t>(count);
   s.dispatch(*linear_, elementwise_groups(*context_, count, who),
              {{NN_LINEAR_BINDING_A, &a, engine::Access::kRead},

@@ -147,6 +147,7 @@ LighterGlueMatches LighterGlueNetwork::match(const std::vector<float>& kp0, cons
   linear(*state, d, nullptr, matchability_, nullptr, z);
   ops_.assignment(s, attention.buffer(), z.buffer(), lse.buffer(), scores.buffer(), n0, n1);
   s.submit_and_wait();
+  out.kernel_times = s.profile();
   out.scores = scores.download();
   nn::Matrix m(n0, n1);
   for (size_t i = 0; i < out.scores.size(); ++i) m.values[i] = out.scores[i];

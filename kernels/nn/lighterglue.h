@@ -9,6 +9,7 @@
 
 #include "engine/buffer.h"
 #include "engine/context.h"
+#include "engine/sequence.h"
 #include "kernels/nn/attention.h"
 #include "kernels/nn/nn_weights.h"
 
@@ -18,6 +19,7 @@ struct LighterGlueMatches {
   std::vector<float> scores;                // [n0][n1]: the log assignment
   std::vector<std::array<int, 2>> matches;  // mutual best pairs, in order of the first index
   std::vector<double> match_scores;         // exp(score) of each: a caller keeps those above a threshold
+  std::vector<engine::KernelTime> kernel_times;  // device time per kernel (none without timestamps)
 };
 
 class LighterGlueNetwork {

@@ -82,8 +82,13 @@ struct NnKeypointsParams {
 // ---- The attention matcher (LighterGlue; kernels/nn/attention_reference.h): matrices are row-major, one
 // row per keypoint ----
 
-// nn_linear.comp: y = [a | b] w + bias (+ r): one invocation per row and NN_LINEAR_OUTPUTS outputs.
-#define NN_LINEAR_OUTPUTS 8
+// nn_linear.comp: y = [a | b] w + bias (+ r): one invocation per tile of NN_LINEAR_ROWS rows x
+// NN_LINEAR_OUTPUTS outputs, the outputs interleaved over NN_LINEAR_LANES neighbouring invocations (as
+// nn_matmul.comp's tiles).
+#define NN_LINEAR_ROWS 8
+#define NN_LINEAR_OUTPUTS 4
+#define NN_LINEAR_LANES 8
+#define NN_LINEAR_RUN (NN_LINEAR_LANES * NN_LINEAR_OUTPUTS)
 #define NN_LINEAR_BINDING_A 0     // [rows][a_cols] (A, B and W: R32_SFLOAT texels)
 #define NN_LINEAR_BINDING_B 1     // [rows][b_cols], concatenated after a's columns (bound to a without)
 #define NN_LINEAR_BINDING_W 2     // [a_cols + b_cols][out]
@@ -95,7 +100,7 @@ struct NnKeypointsParams {
 struct NnLinearParams {
   uint rows, a_cols, b_cols, outputs;
   uint has_bias, has_residual;
-  uint count;  // rows * ceil(out / NN_LINEAR_OUTPUTS)
+  uint count;  // ceil(rows / ROWS) ceil(out / RUN) LANES
 };
 
 // nn_matmul.comp: y = scale a b^T (a [n][k], b [m][k]; transposed) or y = a b (a [n][k], b [k][m]): one

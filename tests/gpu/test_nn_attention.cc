@@ -71,18 +71,20 @@ class NnAttentionTest : public testing::GpuTest {
 
 TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
   kernels::AttentionKernels ops(context());
-  // Linear over [a | b] with a bias and a residual; 13 outputs: a partial block of NN_LINEAR_OUTPUTS.
-  const Matrix a = random_matrix(7, 5, 1), b = random_matrix(7, 3, 2), r = random_matrix(7, 13, 3);
-  kernels::nn::LinearWeights w{8, 13, floats(random_matrix(8, 13, 4).values),
-                               floats(random_matrix(1, 13, 5).values)};
+  // Linear over [a | b] with a bias and a residual; 19 rows and 45 outputs: a whole tile and a partial one
+  // of NN_LINEAR_ROWS rows, a whole run and a partial one of NN_LINEAR_RUN outputs.
+  const uint32_t n = 19, outputs = 45;
+  const Matrix a = random_matrix(n, 5, 1), b = random_matrix(n, 3, 2), r = random_matrix(n, outputs, 3);
+  kernels::nn::LinearWeights w{8, outputs, floats(random_matrix(8, outputs, 4).values),
+                               floats(random_matrix(1, outputs, 5).values)};
   const Matrix expected = kernels::nn::add(kernels::nn::linear(kernels::nn::concat_columns(a, b), w), r);
   auto da = upload(floats(a)), db = upload(floats(b)), dr = upload(floats(r)), dw = upload(w.weight),
        dbias = upload(w.bias);
-  DeviceArray<float> y(context(), "test: y", 7 * 13);
+  DeviceArray<float> y(context(), "test: y", n * outputs);
   {
     engine::Sequence s(context());
     ops.linear(s, da->buffer(), 5, &db->buffer(), 3, dw->buffer(), &dbias->buffer(), &dr->buffer(),
-               y.buffer(), 7, 13);
+               y.buffer(), n, outputs);
     s.submit_and_wait();
   }
   EXPECT_LT(relative_error(y.download(), expected.values), 1e-5);
@@ -154,16 +156,11 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
     s.submit_and_wait();
   }
   EXPECT_LT(relative_error(dassign.download(), assignment.values), 1e-5);
-  {
-    auto l = lse.download();
-    for (size_t i = 0; i < 15; ++i) printf("lse %zu %g\n", i, l[i]);
-    for (size_t i = 0; i < 6; ++i) {
-      double m = -1e30, sum = 0;
-      for (size_t j = 0; j < 9; ++j) m = std::max(m, s69.at(i, j));
-      for (size_t j = 0; j < 9; ++j) sum += std::exp(s69.at(i, j) - m);
-      printf("ref row %zu %g\n", i, m + std::log(sum));
-    }
-  }
+  // The rows' and the columns' log-sum-exps on their way.
+  std::vector<double> lse_expected;
+  for (size_t i = 0; i < 6; ++i) lse_expected.push_back(s69.at(i, 0) - rows.at(i, 0));
+  for (size_t j = 0; j < 9; ++j) lse_expected.push_back(s69.at(0, j) - cols.at(0, j));
+  EXPECT_LT(relative_error(lse.download(), lse_expected), 1e-5);
   Matrix qs(10, 8), ks(10, 8), vs(10, 8);
   for (size_t row = 0; row < 10; ++row)
     for (size_t d = 0; d < 8; ++d) {
