@@ -1,9 +1,9 @@
 // `litgs-engine bench features [--image FILE] [--runs N] [--json]`: milliseconds per image for each detector
 // on one frame, in one run: ORB, SIFT and AKAZE (OpenCV, on the CPU, at the front end's defaults), XFeat's
 // network on the Vulkan device (upload, forward pass and download; and the device's time in each of its
-// kernels), XFeat as the front end runs it (network,
-// keypoints and descriptors on the device, at match's defaults), LighterGlue per pair of frames (and the
-// device's time in each of its kernels) and XFeat's double-precision CPU reference of the network (one run). The frame is cropped to multiples of 32.
+// kernels), XFeat as the front end runs it (network, keypoints and descriptors on the device, at match's
+// defaults), LighterGlue per pair of frames (and the device's time in each of its kernels) and XFeat's
+// double-precision CPU reference of the network (one run). The frame is cropped to multiples of 32.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
@@ -74,7 +74,8 @@ host::frontend::Gray8 load_frame(const std::filesystem::path& path) {
 
 // Where one pair's time goes: each kernel's device time in one more run of the network itself.
 nlohmann::json lighterglue_kernels(engine::Context& context, const kernels::nn::LighterGlueWeights& weights,
-                                   const host::frontend::ImageFeatures& f, const host::frontend::Gray8& frame) {
+                                   const host::frontend::ImageFeatures& f,
+                                   const host::frontend::Gray8& frame) {
   std::vector<float> xy;
   for (const io::SfmKeypoint& k : f.keypoints) xy.insert(xy.end(), {k.x, k.y});
   const std::vector<double> normalized =
@@ -84,7 +85,8 @@ nlohmann::json lighterglue_kernels(engine::Context& context, const kernels::nn::
   std::memcpy(descriptors.data(), f.descriptors.data(), descriptors.size() * sizeof(float));
   const kernels::LighterGlueNetwork network(context, weights);
   nlohmann::json out = nlohmann::json::array();
-  for (const engine::KernelTime& k : network.match(keypoints, descriptors, keypoints, descriptors).kernel_times)
+  for (const engine::KernelTime& k :
+       network.match(keypoints, descriptors, keypoints, descriptors).kernel_times)
     out.push_back({{"kernel", k.name}, {"dispatches", k.dispatches}, {"ms", k.ms}});
   return out;
 }

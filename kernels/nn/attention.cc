@@ -22,7 +22,9 @@ AttentionKernels::AttentionKernels(engine::Context& context)
       matmul_(make_kernel(
           context, "nn/nn_matmul", NN_MATMUL_BINDING_COUNT, sizeof(NnMatmulParams), {},
           {{NN_MATMUL_BINDING_A, VK_FORMAT_R32_SFLOAT}, {NN_MATMUL_BINDING_B, VK_FORMAT_R32_SFLOAT}})),
-      rows_(make_kernel(context, "nn/nn_rows", NN_ROWS_BINDING_COUNT, sizeof(NnRowsParams))) {}
+      rows_(make_kernel(context, "nn/nn_rows", NN_ROWS_BINDING_COUNT, sizeof(NnRowsParams))),
+      softmax_(make_kernel(context, "nn/nn_softmax", NN_SOFTMAX_BINDING_COUNT, sizeof(NnSoftmaxParams), {},
+                           {{NN_SOFTMAX_BINDING_A, VK_FORMAT_R32_SFLOAT}})) {}
 
 AttentionKernels::~AttentionKernels() = default;
 
@@ -129,10 +131,37 @@ void AttentionKernels::layer_norm_gelu(engine::Sequence& s, const engine::Buffer
   rows_op(s, NN_ROWS_LAYER_NORM_GELU, a, scale, bias, a, rows, cols, rows, epsilon);
 }
 
-void AttentionKernels::softmax_rows(engine::Sequence& s, const engine::Buffer& a, uint32_t rows,
-                                    uint32_t cols) const {
-  check_binding("AttentionKernels::softmax_rows", "a", a, uint64_t{rows} * cols * sizeof(float));
-  rows_op(s, NN_ROWS_SOFTMAX, a, a, a, a, rows, cols, rows, 0.0f);
+void AttentionKernels::lines_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a,
+                                const engine::Buffer& out, uint32_t out_offset, uint32_t rows, uint32_t cols,
+                                bool columns) const {
+  static const char* who = "AttentionKernels: softmax";
+  if (!rows || !cols) throw std::invalid_argument(std::string(who) + ": an empty matrix");
+  const uint32_t lines = columns ? cols : rows, length = columns ? rows : cols;
+  check_binding(who, "a", a, uint64_t{rows} * cols * sizeof(float));
+  check_binding(
+      who, "out", out,
+      (uint64_t{out_offset} + (op == NN_SOFTMAX_SOFTMAX ? uint64_t{rows} * cols : lines)) * sizeof(float));
+  NnSoftmaxParams p{};
+  p.op = op;
+  p.lines = lines;
+  p.line_length = length;
+  p.line_step = columns ? 1 : cols;
+  p.step = columns ? cols : 1;
+  p.out_offset = out_offset;
+  s.dispatch(*softmax_, elementwise_groups(*context_, lines, who),
+             {{NN_SOFTMAX_BINDING_A, &a, engine::Access::kRead},
+              {NN_SOFTMAX_BINDING_OUT, &out, engine::Access::kWrite}},
+             p);
+}
+
+void AttentionKernels::softmax_rows(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out,
+                                    uint32_t rows, uint32_t cols) const {
+  lines_op(s, NN_SOFTMAX_SOFTMAX, a, out, 0, rows, cols, false);
+}
+
+void AttentionKernels::softmax_columns(engine::Sequence& s, const engine::Buffer& a,
+                                       const engine::Buffer& out, uint32_t rows, uint32_t cols) const {
+  lines_op(s, NN_SOFTMAX_SOFTMAX, a, out, 0, rows, cols, true);
 }
 
 void AttentionKernels::assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
@@ -143,8 +172,8 @@ void AttentionKernels::assignment(engine::Sequence& s, const engine::Buffer& sim
   check_binding(who, "z", z, (uint64_t{rows} + cols) * sizeof(float));
   check_binding(who, "lse", lse, (uint64_t{rows} + cols) * sizeof(float));
   check_binding(who, "out", out, uint64_t{rows} * cols * sizeof(float));
-  rows_op(s, NN_ROWS_LOG_SUM_EXP, sim, sim, sim, lse, rows, cols, rows, 0.0f);
-  rows_op(s, NN_COLUMNS_LOG_SUM_EXP, sim, sim, sim, lse, rows, cols, cols, 0.0f);
+  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, lse, 0, rows, cols, false);
+  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, lse, rows, rows, cols, true);
   rows_op(s, NN_ROWS_ASSIGNMENT, sim, lse, z, out, rows, cols, uint64_t{rows} * cols, 0.0f);
 }
 

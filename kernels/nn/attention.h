@@ -1,4 +1,5 @@
-// The attention matcher's operations on the device (nn_linear.comp, nn_matmul.comp, nn_rows.comp), each
+// The attention matcher's operations on the device (nn_linear.comp, nn_matmul.comp, nn_rows.comp,
+// nn_softmax.comp), each
 // tested against its CPU double reference in kernels/nn/attention_reference.h. Matrices are row-major float
 // arrays, one row per keypoint; both images' rows may share a buffer (the matrix products take offsets).
 #pragma once
@@ -36,8 +37,12 @@ class AttentionKernels {
   // a [rows][cols] = gelu(layer_norm(a) * scale + bias), in place.
   void layer_norm_gelu(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& scale,
                        const engine::Buffer& bias, uint32_t rows, uint32_t cols, float epsilon) const;
-  // a [rows][cols] = its rows' softmax, in place.
-  void softmax_rows(engine::Sequence& s, const engine::Buffer& a, uint32_t rows, uint32_t cols) const;
+  // out [rows][cols] = the softmax of each row of a [rows][cols].
+  void softmax_rows(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, uint32_t rows,
+                    uint32_t cols) const;
+  // out [cols][rows] = the softmax of each column of a [rows][cols], as a row.
+  void softmax_columns(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, uint32_t rows,
+                       uint32_t cols) const;
   // out [rows][cols]: the log assignment of sim [rows][cols] (its rows' and columns' log-sum-exps go to
   // lse [rows + cols]) with the matchability logits z [rows + cols] (the first image's, then the second's).
   void assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
@@ -54,8 +59,11 @@ class AttentionKernels {
                uint64_t count, float epsilon) const;
   void matmul(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
               uint32_t y_first, bool transposed, float scale) const;
+  // Each row's (columns: false) or each column's softmax or log-sum-exp (nn_softmax.comp).
+  void lines_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a, const engine::Buffer& out,
+                uint32_t out_offset, uint32_t rows, uint32_t cols, bool columns) const;
   engine::Context* context_;
-  std::unique_ptr<engine::Kernel> linear_, matmul_, rows_;
+  std::unique_ptr<engine::Kernel> linear_, matmul_, rows_, softmax_;
 };
 
 }  // namespace litgs::kernels

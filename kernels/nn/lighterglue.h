@@ -16,9 +16,9 @@
 namespace litgs::kernels {
 
 struct LighterGlueMatches {
-  std::vector<float> scores;                // [n0][n1]: the log assignment
-  std::vector<std::array<int, 2>> matches;  // mutual best pairs, in order of the first index
-  std::vector<double> match_scores;         // exp(score) of each: a caller keeps those above a threshold
+  std::vector<float> scores;                     // [n0][n1]: the log assignment
+  std::vector<std::array<int, 2>> matches;       // mutual best pairs, in order of the first index
+  std::vector<double> match_scores;              // exp(score) of each: a caller keeps those above a threshold
   std::vector<engine::KernelTime> kernel_times;  // device time per kernel (none without timestamps)
 };
 

@@ -1,8 +1,8 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // The attention matcher's row operations (nn_shared.h's NN_ROWS_*), each as kernels/nn/attention_reference.cc
-// and lighterglue_reference.cc compute it: layer norm then GELU, softmax, the log-sum-exps of rows and
-// columns, the log assignment, and the split of q, k, v with the rotary encoding of q and k.
+// and lighterglue_reference.cc compute it: layer norm then GELU, the log assignment, and the split of q, k, v
+// with the rotary encoding of q and k. The softmax and the log-sum-exps are nn_softmax.comp's.
 #include "limits.h"
 #include "nn/nn_shared.h"
 #include "elementwise.glsl"
@@ -23,15 +23,6 @@ float erf_as(float x) {
 
 float log_sigmoid(float z) { return z >= 0.0 ? -log(1.0 + exp(-z)) : z - log(1.0 + exp(z)); }
 
-// log sum exp of n values from `first` every `step`.
-float log_sum_exp(uint first, uint step, uint n) {
-  float top = -3.4e38;
-  for (uint i = 0u; i < n; ++i) top = max(top, a[first + i * step]);
-  float sum = 0.0;
-  for (uint i = 0u; i < n; ++i) sum += exp(a[first + i * step] - top);
-  return top + log(sum);
-}
-
 void main() {
   const uint e = elementwise_index();
   if (e >= p.count) return;
@@ -46,20 +37,6 @@ void main() {
       const float x = (a[first + i] - mean) * inv * b[i] + c[i];
       a[first + i] = 0.5 * x * (1.0 + erf_as(x * 0.70710678118654752));
     }
-  } else if (p.op == NN_ROWS_SOFTMAX) {
-    const uint first = e * p.cols;
-    float top = -3.4e38, sum = 0.0;
-    for (uint i = 0u; i < p.cols; ++i) top = max(top, a[first + i]);
-    for (uint i = 0u; i < p.cols; ++i) {
-      const float v = exp(a[first + i] - top);
-      a[first + i] = v;
-      sum += v;
-    }
-    for (uint i = 0u; i < p.cols; ++i) a[first + i] /= sum;
-  } else if (p.op == NN_ROWS_LOG_SUM_EXP) {
-    o[e] = log_sum_exp(e * p.cols, 1u, p.cols);
-  } else if (p.op == NN_COLUMNS_LOG_SUM_EXP) {
-    o[p.rows + e] = log_sum_exp(e, p.cols, p.rows);
   } else if (p.op == NN_ROWS_ASSIGNMENT) {
     const uint i = e / p.cols, j = e % p.cols;
     o[e] = (a[e] - b[i]) + (a[e] - b[p.rows + j]) + log_sigmoid(c[i]) + log_sigmoid(c[p.rows + j]);

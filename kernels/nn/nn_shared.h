@@ -125,15 +125,12 @@ struct NnMatmulParams {
 
 // nn_rows.comp: one invocation per row (or column, or element) of a; p.op chooses what it computes.
 #define NN_ROWS_LAYER_NORM_GELU 0  // a[r] = gelu(layer_norm(a[r]) * b + c) in place (b: scale, c: bias)
-#define NN_ROWS_SOFTMAX 1          // a[r] = softmax(a[r]) in place
-#define NN_ROWS_LOG_SUM_EXP 2      // out[r] = log sum exp a[r]
-#define NN_COLUMNS_LOG_SUM_EXP 3   // out[c] = log sum exp of a's column c
 // out[i][j] = (a[i][j] - b[i]) + (a[i][j] - b[rows + j]) + log sigmoid c[i] + log sigmoid c[rows + j] (b: the
 // row and column log-sum-exps, c: the two images' matchability logits)
-#define NN_ROWS_ASSIGNMENT 4
+#define NN_ROWS_ASSIGNMENT 1
 // From a [rows][3 dim] (q, k, v interleaved per channel) and the keypoints b [rows][2] with the rotary
 // weights c [2][dim / 2]: out [3][rows][dim] = q and k rotated, v. One invocation per row and channel pair.
-#define NN_ROWS_SPLIT_ROTARY 5
+#define NN_ROWS_SPLIT_ROTARY 2
 #define NN_ROWS_BINDING_A 0
 #define NN_ROWS_BINDING_B 1
 #define NN_ROWS_BINDING_C 2
@@ -145,6 +142,22 @@ struct NnRowsParams {
   uint rows, cols;
   uint count;     // invocations
   float epsilon;  // the layer norm's
+};
+
+// nn_softmax.comp: for each line l < lines (a row or a column of a), its `line_length` values
+// a[l line_step + t step]: out[out_offset + l line_length + t] = their softmax (NN_SOFTMAX_SOFTMAX), or
+// out[out_offset + l] = their log-sum-exp (NN_SOFTMAX_LOG_SUM_EXP). One invocation per line.
+#define NN_SOFTMAX_SOFTMAX 0
+#define NN_SOFTMAX_LOG_SUM_EXP 1
+#define NN_SOFTMAX_BINDING_A 0  // R32_SFLOAT texels
+#define NN_SOFTMAX_BINDING_OUT 1
+#define NN_SOFTMAX_BINDING_COUNT 2
+
+struct NnSoftmaxParams {
+  uint op;
+  uint lines, line_length;
+  uint line_step, step;  // in floats: rows (cols, 1), columns (1, cols)
+  uint out_offset;
 };
 
 #ifdef __cplusplus

@@ -1,11 +1,11 @@
 // The attention matcher on the device (kernels/nn/attention.h, lighterglue.h) against its double-precision
 // CPU references (kernels/nn/attention_reference.h, lighterglue_reference.h), validation layer on: each
 // operation on random inputs (linear with a concatenated input, bias and residual; the matrix products at
-// row offsets; layer norm with GELU; softmax; the log assignment; q, k, v split with the rotary encoding),
-// then the whole matcher on the inputs of tests/data/lighterglue/ (the same matches; scores within the
-// float32 spread measured against onnxruntime there), bit-identical twice, and the hard cases: an image
-// without keypoints, wrong sizes. Tolerances (float against double): each operation within 1e-5 of its
-// largest output (GELU's erf approximation: 1.5e-7).
+// row offsets; layer norm with GELU; the softmax of rows and of columns; the log assignment; q, k, v split
+// with the rotary encoding), then the whole matcher on the inputs of tests/data/lighterglue/ (the same
+// matches; scores within the float32 spread measured against onnxruntime there), bit-identical twice, and the
+// hard cases: an image without keypoints, wrong sizes. Tolerances (float against double): each operation
+// within 1e-5 of its largest output (GELU's erf approximation: 1.5e-7).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -120,18 +120,26 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
                                            floats(random_matrix(1, 192, 11).values), 1e-5};
   auto dh = upload(floats(h)), dscale = upload(norm.scale), dshift = upload(norm.bias);
   Matrix soft = random_matrix(5, 37, 12, 20.0);  // spread 20: the largest must be subtracted
+  Matrix soft_columns(37, 5);                    // its columns as rows
+  for (size_t i = 0; i < 5; ++i)
+    for (size_t j = 0; j < 37; ++j) soft_columns.at(j, i) = soft.at(i, j);
   auto dsoft = upload(floats(soft));
+  DeviceArray<float> rows_out(context(), "test: softmax", 5 * 37),
+      columns_out(context(), "test: softmax", 37 * 5);
   {
     engine::Sequence s(context());
     ops.layer_norm_gelu(s, dh->buffer(), dscale->buffer(), dshift->buffer(), 6, 192, 1e-5f);
-    ops.softmax_rows(s, dsoft->buffer(), 5, 37);
+    ops.softmax_rows(s, dsoft->buffer(), rows_out.buffer(), 5, 37);
+    ops.softmax_columns(s, dsoft->buffer(), columns_out.buffer(), 5, 37);
     s.submit_and_wait();
   }
   kernels::nn::layer_norm(h, norm);
   kernels::nn::gelu(h);
   kernels::nn::softmax_rows(soft);
+  kernels::nn::softmax_rows(soft_columns);
   EXPECT_LT(relative_error(dh->download(), h.values), 1e-5);
-  EXPECT_LT(relative_error(dsoft->download(), soft.values), 1e-5);
+  EXPECT_LT(relative_error(rows_out.download(), soft.values), 1e-5);
+  EXPECT_LT(relative_error(columns_out.download(), soft_columns.values), 1e-5);
 
   // The log assignment of a 6 x 9 similarity with matchability logits.
   const Matrix s69 = random_matrix(6, 9, 13, 5.0), z = random_matrix(15, 1, 14, 2.0);
