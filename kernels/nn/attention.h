@@ -1,7 +1,7 @@
 // The attention matcher's operations on the device (nn_linear.comp, nn_matmul.comp, nn_rows.comp,
-// nn_softmax.comp), each
-// tested against its CPU double reference in kernels/nn/attention_reference.h. Matrices are row-major float
-// arrays, one row per keypoint; both images' rows may share a buffer (the matrix products take offsets).
+// nn_softmax.comp), each tested against its CPU double reference in kernels/nn/attention_reference.h.
+// Matrices are row-major float arrays, one row per keypoint; both images' rows may share a buffer (the
+// matrix products take offsets).
 #pragma once
 
 #include <cstdint>

@@ -94,7 +94,7 @@ LighterGlueMatches LighterGlueNetwork::match(const std::vector<float>& kp0, cons
   Array hidden(c, "lighterglue: feed-forward", size_t{n} * 2 * d);
   const uint32_t largest = std::max(n0, n1);
   Array attention(c, "lighterglue: attention", size_t{largest} * largest),
-      probabilities(c, "lighterglue: attention", size_t{largest} * largest);
+      probabilities(c, "lighterglue: attention probabilities", size_t{largest} * largest);
   Array z(c, "lighterglue: matchability", n), lse(c, "lighterglue: log-sum-exp", n);
   Array scores(c, "lighterglue: scores", size_t{n0} * n1);
   engine::Sequence s(c);

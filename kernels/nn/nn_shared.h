@@ -123,7 +123,7 @@ struct NnMatmulParams {
   uint a_offset, b_offset, y_offset;  // in floats: both images' rows share one buffer
 };
 
-// nn_rows.comp: one invocation per row (or column, or element) of a; p.op chooses what it computes.
+// nn_rows.comp: one invocation per row (or element) of a; p.op chooses what it computes.
 #define NN_ROWS_LAYER_NORM_GELU 0  // a[r] = gelu(layer_norm(a[r]) * b + c) in place (b: scale, c: bias)
 // out[i][j] = (a[i][j] - b[i]) + (a[i][j] - b[rows + j]) + log sigmoid c[i] + log sigmoid c[rows + j] (b: the
 // row and column log-sum-exps, c: the two images' matchability logits)
