@@ -19,9 +19,11 @@ AttentionKernels::AttentionKernels(engine::Context& context)
                           {{NN_LINEAR_BINDING_A, VK_FORMAT_R32_SFLOAT},
                            {NN_LINEAR_BINDING_B, VK_FORMAT_R32_SFLOAT},
                            {NN_LINEAR_BINDING_W, VK_FORMAT_R32_SFLOAT}})),
-      matmul_(make_kernel(
-          context, "nn/nn_matmul", NN_MATMUL_BINDING_COUNT, sizeof(NnMatmulParams), {},
-          {{NN_MATMUL_BINDING_A, VK_FORMAT_R32_SFLOAT}, {NN_MATMUL_BINDING_B, VK_FORMAT_R32_SFLOAT}})),
+      matmul_(make_kernel(context, "nn/nn_matmul", NN_MATMUL_BINDING_COUNT, sizeof(NnMatmulParams), {},
+                          {{NN_MATMUL_BINDING_A, VK_FORMAT_R32_SFLOAT},
+                           {NN_MATMUL_BINDING_B, VK_FORMAT_R32_SFLOAT},
+                           {NN_MATMUL_BINDING_A4, VK_FORMAT_R32G32B32A32_SFLOAT},
+                           {NN_MATMUL_BINDING_B4, VK_FORMAT_R32G32B32A32_SFLOAT}})),
       rows_(make_kernel(context, "nn/nn_rows", NN_ROWS_BINDING_COUNT, sizeof(NnRowsParams))),
       softmax_(make_kernel(context, "nn/nn_softmax", NN_SOFTMAX_BINDING_COUNT, sizeof(NnSoftmaxParams), {},
                            {{NN_SOFTMAX_BINDING_A, VK_FORMAT_R32_SFLOAT}})) {}
@@ -62,6 +64,12 @@ void AttentionKernels::linear(engine::Sequence& s, const engine::Buffer& a, uint
              p);
 }
 
+bool matmul_reads_quads(const RowBlock& a, const RowBlock& b) {
+  const auto aligned = [](uint64_t floats) { return floats % 4 == 0; };
+  return aligned(uint64_t{a.first} * a.row_stride()) && aligned(a.row_stride()) &&
+         aligned(uint64_t{b.first} * b.cols) && aligned(b.cols);
+}
+
 void AttentionKernels::matmul(engine::Sequence& s, const RowBlock& a, const RowBlock& b,
                               const engine::Buffer& y, uint32_t y_first, bool transposed, float scale) const {
   static const char* who = "AttentionKernels: matrix product";
@@ -70,8 +78,11 @@ void AttentionKernels::matmul(engine::Sequence& s, const RowBlock& a, const RowB
   if (transposed ? a.cols != b.cols : a.cols != b.rows)
     throw std::invalid_argument(std::string(who) + ": inner sizes differ (" + std::to_string(a.cols) +
                                 " and " + std::to_string(transposed ? b.cols : b.rows) + ")");
+  if (a.row_stride() < a.cols || (b.stride && b.stride != b.cols))
+    throw std::invalid_argument(std::string(who) + ": a's rows narrower than its width, or b padded");
   const uint32_t m = transposed ? b.rows : b.cols;
-  check_binding(who, "a", *a.buffer, (uint64_t{a.first} + a.rows) * a.cols * sizeof(float));
+  check_binding(who, "a", *a.buffer,
+                ((uint64_t{a.first} + a.rows - 1) * a.row_stride() + a.cols) * sizeof(float));
   check_binding(who, "b", *b.buffer, (uint64_t{b.first} + b.rows) * b.cols * sizeof(float));
   check_binding(who, "y", y, (uint64_t{y_first} + a.rows) * m * sizeof(float));
   NnMatmulParams p{};
@@ -80,15 +91,20 @@ void AttentionKernels::matmul(engine::Sequence& s, const RowBlock& a, const RowB
   p.k = a.cols;
   p.transposed = transposed;
   p.scale = scale;
-  const uint64_t count = uint64_t{(a.rows + NN_MATMUL_ROWS - 1) / NN_MATMUL_ROWS} *
-                         ((m + NN_MATMUL_RUN - 1) / NN_MATMUL_RUN) * NN_MATMUL_LANES;
+  p.quads = matmul_reads_quads(a, b);
+  const uint64_t row_tiles = (a.rows + NN_MATMUL_ROWS - 1) / NN_MATMUL_ROWS;
+  const uint64_t count = p.quads ? row_tiles * ((m + 3) / 4)
+                                 : row_tiles * ((m + NN_MATMUL_RUN - 1) / NN_MATMUL_RUN) * NN_MATMUL_LANES;
   p.count = static_cast<uint32_t>(count);
-  p.a_offset = a.first * a.cols;
+  p.a_stride = a.row_stride();
+  p.a_offset = a.first * a.row_stride();
   p.b_offset = b.first * b.cols;
   p.y_offset = y_first * m;
   s.dispatch(*matmul_, elementwise_groups(*context_, count, who),
              {{NN_MATMUL_BINDING_A, a.buffer, engine::Access::kRead},
               {NN_MATMUL_BINDING_B, b.buffer, engine::Access::kRead},
+              {NN_MATMUL_BINDING_A4, a.buffer, engine::Access::kRead},
+              {NN_MATMUL_BINDING_B4, b.buffer, engine::Access::kRead},
               {NN_MATMUL_BINDING_Y, &y, engine::Access::kWrite}},
              p);
 }
@@ -132,15 +148,19 @@ void AttentionKernels::layer_norm_gelu(engine::Sequence& s, const engine::Buffer
 }
 
 void AttentionKernels::lines_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a,
-                                const engine::Buffer& out, uint32_t out_offset, uint32_t rows, uint32_t cols,
-                                bool columns) const {
+                                const engine::Buffer& out, uint32_t out_offset, uint32_t out_stride,
+                                uint32_t rows, uint32_t cols, bool columns) const {
   static const char* who = "AttentionKernels: softmax";
   if (!rows || !cols) throw std::invalid_argument(std::string(who) + ": an empty matrix");
   const uint32_t lines = columns ? cols : rows, length = columns ? rows : cols;
+  if (!out_stride) out_stride = length;
+  if (out_stride < length)
+    throw std::invalid_argument(std::string(who) + ": out's rows narrower than a line");
   check_binding(who, "a", a, uint64_t{rows} * cols * sizeof(float));
-  check_binding(
-      who, "out", out,
-      (uint64_t{out_offset} + (op == NN_SOFTMAX_SOFTMAX ? uint64_t{rows} * cols : lines)) * sizeof(float));
+  check_binding(who, "out", out,
+                (uint64_t{out_offset} +
+                 (op == NN_SOFTMAX_SOFTMAX ? (uint64_t{lines} - 1) * out_stride + length : lines)) *
+                    sizeof(float));
   NnSoftmaxParams p{};
   p.op = op;
   p.lines = lines;
@@ -148,6 +168,7 @@ void AttentionKernels::lines_op(engine::Sequence& s, uint32_t op, const engine::
   p.line_step = columns ? 1 : cols;
   p.step = columns ? cols : 1;
   p.out_offset = out_offset;
+  p.out_stride = out_stride;
   s.dispatch(*softmax_, elementwise_groups(*context_, lines, who),
              {{NN_SOFTMAX_BINDING_A, &a, engine::Access::kRead},
               {NN_SOFTMAX_BINDING_OUT, &out, engine::Access::kWrite}},
@@ -155,13 +176,14 @@ void AttentionKernels::lines_op(engine::Sequence& s, uint32_t op, const engine::
 }
 
 void AttentionKernels::softmax_rows(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out,
-                                    uint32_t rows, uint32_t cols) const {
-  lines_op(s, NN_SOFTMAX_SOFTMAX, a, out, 0, rows, cols, false);
+                                    uint32_t rows, uint32_t cols, uint32_t out_stride) const {
+  lines_op(s, NN_SOFTMAX_SOFTMAX, a, out, 0, out_stride, rows, cols, false);
 }
 
 void AttentionKernels::softmax_columns(engine::Sequence& s, const engine::Buffer& a,
-                                       const engine::Buffer& out, uint32_t rows, uint32_t cols) const {
-  lines_op(s, NN_SOFTMAX_SOFTMAX, a, out, 0, rows, cols, true);
+                                       const engine::Buffer& out, uint32_t rows, uint32_t cols,
+                                       uint32_t out_stride) const {
+  lines_op(s, NN_SOFTMAX_SOFTMAX, a, out, 0, out_stride, rows, cols, true);
 }
 
 void AttentionKernels::assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
@@ -172,8 +194,8 @@ void AttentionKernels::assignment(engine::Sequence& s, const engine::Buffer& sim
   check_binding(who, "z", z, (uint64_t{rows} + cols) * sizeof(float));
   check_binding(who, "lse", lse, (uint64_t{rows} + cols) * sizeof(float));
   check_binding(who, "out", out, uint64_t{rows} * cols * sizeof(float));
-  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, lse, 0, rows, cols, false);
-  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, lse, rows, rows, cols, true);
+  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, lse, 0, 0, rows, cols, false);
+  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, lse, rows, 0, rows, cols, true);
   rows_op(s, NN_ROWS_ASSIGNMENT, sim, lse, z, out, rows, cols, uint64_t{rows} * cols, 0.0f);
 }
 

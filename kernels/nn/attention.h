@@ -14,11 +14,24 @@
 
 namespace litgs::kernels {
 
-// A block of rows inside a buffer: `rows` rows of `cols` floats from row `first`.
+// A block of rows inside a buffer: `rows` rows of `cols` floats from row `first`, a row every `stride`
+// floats (0: cols; a wider stride pads each row).
 struct RowBlock {
   const engine::Buffer* buffer = nullptr;
-  uint32_t first = 0, rows = 0, cols = 0;
+  uint32_t first = 0, rows = 0, cols = 0, stride = 0;
+  uint32_t row_stride() const { return stride ? stride : cols; }
 };
+
+// The floats of a row of `cols` padded to a four-float boundary: the matrix products read such rows as
+// four-float texels.
+inline uint32_t padded_row(uint32_t cols) {
+  return (cols + 3u) / 4u * 4u;
+}
+
+// Whether the matrix products read a and b as four-float texels (nn_matmul.comp's quad path): every row of
+// a and of b starts on a four-float boundary, and b's rows (along k for a b^T, along the columns for a b)
+// are whole texels. a's rows need not be: their last floats past a whole texel are read one at a time.
+bool matmul_reads_quads(const RowBlock& a, const RowBlock& b);
 
 class AttentionKernels {
  public:
@@ -31,18 +44,19 @@ class AttentionKernels {
   // y (its rows from y_first) = scale a b^T: [a.rows][b.rows], a and b of one width.
   void multiply_transposed(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
                            float scale) const;
-  // y (its rows from y_first, b.cols wide) = a b: a [a.rows][b.rows].
+  // y (its rows from y_first, b.cols wide) = a b: a [a.rows][b.rows] (a may be padded; b may not).
   void multiply(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
                 uint32_t y_first) const;
   // a [rows][cols] = gelu(layer_norm(a) * scale + bias), in place.
   void layer_norm_gelu(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& scale,
                        const engine::Buffer& bias, uint32_t rows, uint32_t cols, float epsilon) const;
-  // out [rows][cols] = the softmax of each row of a [rows][cols].
+  // out [rows][cols] = the softmax of each row of a [rows][cols], a row of out every out_stride floats
+  // (0: cols).
   void softmax_rows(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, uint32_t rows,
-                    uint32_t cols) const;
-  // out [cols][rows] = the softmax of each column of a [rows][cols], as a row.
+                    uint32_t cols, uint32_t out_stride = 0) const;
+  // out [cols][rows] = the softmax of each column of a [rows][cols], as a row (every out_stride floats).
   void softmax_columns(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, uint32_t rows,
-                       uint32_t cols) const;
+                       uint32_t cols, uint32_t out_stride = 0) const;
   // out [rows][cols]: the log assignment of sim [rows][cols] (its rows' and columns' log-sum-exps go to
   // lse [rows + cols]) with the matchability logits z [rows + cols] (the first image's, then the second's).
   void assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
@@ -61,7 +75,7 @@ class AttentionKernels {
               uint32_t y_first, bool transposed, float scale) const;
   // Each row's (columns: false) or each column's softmax or log-sum-exp (nn_softmax.comp).
   void lines_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a, const engine::Buffer& out,
-                uint32_t out_offset, uint32_t rows, uint32_t cols, bool columns) const;
+                uint32_t out_offset, uint32_t out_stride, uint32_t rows, uint32_t cols, bool columns) const;
   engine::Context* context_;
   std::unique_ptr<engine::Kernel> linear_, matmul_, rows_, softmax_;
 };

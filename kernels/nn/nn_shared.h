@@ -103,23 +103,30 @@ struct NnLinearParams {
   uint count;  // ceil(rows / ROWS) ceil(out / RUN) LANES
 };
 
-// nn_matmul.comp: y = scale a b^T (a [n][k], b [m][k]; transposed) or y = a b (a [n][k], b [k][m]): one
-// invocation per tile of NN_MATMUL_ROWS rows x NN_MATMUL_OUTPUTS columns, the columns interleaved over
-// NN_MATMUL_LANES neighbouring invocations.
-#define NN_MATMUL_ROWS 8
+// nn_matmul.comp: y = scale a b^T (a [n][k], b [m][k]; transposed) or y = a b (a [n][k], b [k][m]).
+// Generic path: one invocation per tile of NN_MATMUL_ROWS rows x NN_MATMUL_OUTPUTS columns, the columns
+// interleaved over NN_MATMUL_LANES neighbouring invocations. Quad path (p.quads, where the operands' rows
+// start on four-float boundaries: matmul_reads_quads in attention.h): one invocation per NN_MATMUL_ROWS
+// rows x 4 neighbouring columns, a read as four-float texels along k, b along k (a b^T) or along its
+// columns (a b).
+#define NN_MATMUL_ROWS 16
 #define NN_MATMUL_OUTPUTS 4
 #define NN_MATMUL_LANES 8
 #define NN_MATMUL_RUN (NN_MATMUL_LANES * NN_MATMUL_OUTPUTS)
 #define NN_MATMUL_BINDING_A 0  // A and B: R32_SFLOAT texels
 #define NN_MATMUL_BINDING_B 1
 #define NN_MATMUL_BINDING_Y 2
-#define NN_MATMUL_BINDING_COUNT 3
+#define NN_MATMUL_BINDING_A4 3  // A and B again, as R32G32B32A32_SFLOAT texels (the quad path)
+#define NN_MATMUL_BINDING_B4 4
+#define NN_MATMUL_BINDING_COUNT 5
 
 struct NnMatmulParams {
   uint n, m, k;
   uint transposed;  // 1: a b^T
   float scale;
-  uint count;                         // ceil(n / ROWS) ceil(m / RUN) LANES
+  uint count;     // generic: ceil(n / ROWS) ceil(m / RUN) LANES; quads: ceil(n / ROWS) ceil(m / 4)
+  uint quads;     // 1: the quad path
+  uint a_stride;  // floats from one row of a to the next (>= k: a padded row)
   uint a_offset, b_offset, y_offset;  // in floats: both images' rows share one buffer
 };
 
@@ -145,7 +152,7 @@ struct NnRowsParams {
 };
 
 // nn_softmax.comp: for each line l < lines (a row or a column of a), its `line_length` values
-// a[l line_step + t step]: out[out_offset + l line_length + t] = their softmax (NN_SOFTMAX_SOFTMAX), or
+// a[l line_step + t step]: out[out_offset + l out_stride + t] = their softmax (NN_SOFTMAX_SOFTMAX), or
 // out[out_offset + l] = their log-sum-exp (NN_SOFTMAX_LOG_SUM_EXP). One invocation per line.
 #define NN_SOFTMAX_SOFTMAX 0
 #define NN_SOFTMAX_LOG_SUM_EXP 1
@@ -158,6 +165,7 @@ struct NnSoftmaxParams {
   uint lines, line_length;
   uint line_step, step;  // in floats: rows (cols, 1), columns (1, cols)
   uint out_offset;
+  uint out_stride;  // floats from one line's softmax to the next (>= line_length)
 };
 
 #ifdef __cplusplus

@@ -27,6 +27,6 @@ void main() {
     o[p.out_offset + line] = top + log(sum);
     return;
   }
-  const uint first_out = p.out_offset + line * p.line_length;
+  const uint first_out = p.out_offset + line * p.out_stride;
   for (uint t = 0u; t < p.line_length; ++t) o[first_out + t] = exp(texelFetch(a, int(first + t * p.step)).x - top) / sum;
 }

@@ -113,6 +113,43 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
   EXPECT_LT(relative_error(dsim.download(), sim.values), 1e-5);
   const std::vector<float> product_rows = dproduct.download(2 * 5, 5 * 5);  // written from row 2
   EXPECT_LT(relative_error(product_rows, product.values), 1e-5);
+  EXPECT_FALSE(
+      kernels::matmul_reads_quads(RowBlock{&dp->buffer(), 2, 5, 6}, RowBlock{&dq->buffer(), 1, 4, 6}));
+
+  // The same on the quad path (rows on four-float boundaries): 19 rows, a whole tile of NN_MATMUL_ROWS and a
+  // partial one; a b^T with 7 columns (a whole quad and a partial one) over k = 12; then a b with a padded
+  // to rows of 16 floats over k = 13 (three quads and one float), b 8 columns wide from its row 3. The
+  // padding holds NaN: a product that read it would show it.
+  const Matrix p19 = random_matrix(21, 12, 18), q7 = random_matrix(9, 12, 19), w13 = random_matrix(16, 8, 20);
+  Matrix p19_rows(19, 12), q7_rows(7, 12), a13(19, 13), w13_rows(13, 8);
+  for (size_t i = 0; i < 19; ++i)
+    for (size_t k = 0; k < 12; ++k) p19_rows.at(i, k) = p19.at(2 + i, k);
+  for (size_t i = 0; i < 7; ++i)
+    for (size_t k = 0; k < 12; ++k) q7_rows.at(i, k) = q7.at(1 + i, k);
+  std::vector<float> padded(19 * 16, std::nanf(""));
+  const Matrix a13_values = random_matrix(19, 13, 21);
+  for (size_t i = 0; i < 19; ++i)
+    for (size_t k = 0; k < 13; ++k)
+      padded[i * 16 + k] = static_cast<float>(a13.at(i, k) = a13_values.at(i, k));
+  for (size_t k = 0; k < 13; ++k)
+    for (size_t j = 0; j < 8; ++j) w13_rows.at(k, j) = w13.at(3 + k, j);
+  const Matrix sim19 = kernels::nn::multiply_transposed(p19_rows, q7_rows, 0.3);
+  const Matrix product19 = kernels::nn::multiply(a13, w13_rows);
+  auto dp19 = upload(floats(p19)), dq7 = upload(floats(q7)), da13 = upload(padded),
+       dw13 = upload(floats(w13));
+  const RowBlock p_block{&dp19->buffer(), 2, 19, 12}, q_block{&dq7->buffer(), 1, 7, 12},
+      a_block{&da13->buffer(), 0, 19, 13, 16}, w_block{&dw13->buffer(), 3, 13, 8};
+  EXPECT_TRUE(kernels::matmul_reads_quads(p_block, q_block));
+  EXPECT_TRUE(kernels::matmul_reads_quads(a_block, w_block));
+  DeviceArray<float> dsim19(context(), "test: sim", 19 * 7), dproduct19(context(), "test: product", 19 * 8);
+  {
+    engine::Sequence s(context());
+    ops.multiply_transposed(s, p_block, q_block, dsim19.buffer(), 0.3f);
+    ops.multiply(s, a_block, w_block, dproduct19.buffer(), 0);
+    s.submit_and_wait();
+  }
+  EXPECT_LT(relative_error(dsim19.download(), sim19.values), 1e-5);
+  EXPECT_LT(relative_error(dproduct19.download(), product19.values), 1e-5);
 
   // Layer norm then GELU, and softmax, in place.
   Matrix h = random_matrix(6, 192, 9, 3.0);
@@ -125,12 +162,13 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
     for (size_t j = 0; j < 37; ++j) soft_columns.at(j, i) = soft.at(i, j);
   auto dsoft = upload(floats(soft));
   DeviceArray<float> rows_out(context(), "test: softmax", 5 * 37),
-      columns_out(context(), "test: softmax", 37 * 5);
+      columns_out(context(), "test: softmax", 37 * 5), padded_out(context(), "test: softmax", 37 * 8);
   {
     engine::Sequence s(context());
     ops.layer_norm_gelu(s, dh->buffer(), dscale->buffer(), dshift->buffer(), 6, 192, 1e-5f);
     ops.softmax_rows(s, dsoft->buffer(), rows_out.buffer(), 5, 37);
     ops.softmax_columns(s, dsoft->buffer(), columns_out.buffer(), 5, 37);
+    ops.softmax_columns(s, dsoft->buffer(), padded_out.buffer(), 5, 37, 8);  // rows padded to 8 floats
     s.submit_and_wait();
   }
   kernels::nn::layer_norm(h, norm);
@@ -140,6 +178,11 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
   EXPECT_LT(relative_error(dh->download(), h.values), 1e-5);
   EXPECT_LT(relative_error(rows_out.download(), soft.values), 1e-5);
   EXPECT_LT(relative_error(columns_out.download(), soft_columns.values), 1e-5);
+  const std::vector<float> padded_rows = padded_out.download();
+  std::vector<float> unpadded;
+  for (size_t j = 0; j < 37; ++j)
+    unpadded.insert(unpadded.end(), &padded_rows[j * 8], &padded_rows[j * 8 + 5]);
+  EXPECT_LT(relative_error(unpadded, soft_columns.values), 1e-5);
 
   // The log assignment of a 6 x 9 similarity with matchability logits.
   const Matrix s69 = random_matrix(6, 9, 13, 5.0), z = random_matrix(15, 1, 14, 2.0);
