@@ -7,7 +7,6 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -25,7 +24,6 @@
 #include "host/nn/xfeat_weights.h"
 #include "io/image.h"
 #include "kernels/nn/lighterglue.h"
-#include "kernels/nn/lighterglue_reference.h"
 #include "kernels/nn/xfeat.h"
 #include "kernels/nn/xfeat_reference.h"
 #include "tools/bench_stats.h"
@@ -76,17 +74,12 @@ host::frontend::Gray8 load_frame(const std::filesystem::path& path) {
 nlohmann::json lighterglue_kernels(engine::Context& context, const kernels::nn::LighterGlueWeights& weights,
                                    const host::frontend::ImageFeatures& f,
                                    const host::frontend::Gray8& frame) {
-  std::vector<float> xy;
-  for (const io::SfmKeypoint& k : f.keypoints) xy.insert(xy.end(), {k.x, k.y});
-  const std::vector<double> normalized =
-      kernels::nn::normalize_keypoints(xy, frame.width, frame.height).values;
-  const std::vector<float> keypoints(normalized.begin(), normalized.end());
-  std::vector<float> descriptors(f.descriptors.size() / sizeof(float));
-  std::memcpy(descriptors.data(), f.descriptors.data(), descriptors.size() * sizeof(float));
   const kernels::LighterGlueNetwork network(context, weights);
+  const host::nn::LighterGlueInputs in =
+      host::nn::lighterglue_inputs(f, frame.width, frame.height, network.descriptor_width());
   nlohmann::json out = nlohmann::json::array();
   for (const engine::KernelTime& k :
-       network.match(keypoints, descriptors, keypoints, descriptors).kernel_times)
+       network.match(in.keypoints, in.descriptors, in.keypoints, in.descriptors).kernel_times)
     out.push_back({{"kernel", k.name}, {"dispatches", k.dispatches}, {"ms", k.ms}});
   return out;
 }

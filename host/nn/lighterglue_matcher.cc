@@ -9,6 +9,24 @@
 #include "kernels/nn/lighterglue_reference.h"
 
 namespace litgs::host::nn {
+
+LighterGlueInputs lighterglue_inputs(const frontend::ImageFeatures& f, int width, int height,
+                                     size_t descriptor_width) {
+  if (!f.keypoints.empty() &&
+      (!f.float_descriptors || size_t(f.descriptor_bytes) != descriptor_width * sizeof(float)))
+    throw std::invalid_argument("the lighterglue matcher needs " + std::to_string(descriptor_width) +
+                                " float descriptors per keypoint (features xfeat)");
+  std::vector<float> xy;
+  for (const io::SfmKeypoint& k : f.keypoints) xy.insert(xy.end(), {k.x, k.y});
+  const kernels::nn::Matrix normalized = kernels::nn::normalize_keypoints(xy, width, height);
+  LighterGlueInputs in;
+  in.keypoints.assign(normalized.values.begin(), normalized.values.end());
+  in.descriptors.resize(f.keypoints.size() * descriptor_width);
+  if (!in.descriptors.empty())
+    std::memcpy(in.descriptors.data(), f.descriptors.data(), in.descriptors.size() * sizeof(float));
+  return in;
+}
+
 namespace {
 
 struct LighterGlueMatcher {
@@ -17,32 +35,14 @@ struct LighterGlueMatcher {
   double min_score = 0.1;
   std::mutex device;  // one submit at a time on the shared context
 
-  // The keypoints normalized for LighterGlue and the descriptors as floats.
-  void inputs(const frontend::ImageFeatures& f, int width, int height, std::vector<float>& keypoints,
-              std::vector<float>& descriptors) const {
-    const size_t width_floats = network->descriptor_width();
-    if (!f.keypoints.empty() &&
-        (!f.float_descriptors || size_t(f.descriptor_bytes) != width_floats * sizeof(float)))
-      throw std::invalid_argument("the lighterglue matcher needs " + std::to_string(width_floats) +
-                                  " float descriptors per keypoint (features xfeat)");
-    std::vector<float> xy;
-    for (const io::SfmKeypoint& k : f.keypoints) xy.insert(xy.end(), {k.x, k.y});
-    const kernels::nn::Matrix normalized = kernels::nn::normalize_keypoints(xy, width, height);
-    keypoints.assign(normalized.values.begin(), normalized.values.end());
-    descriptors.resize(f.keypoints.size() * width_floats);
-    if (!descriptors.empty())
-      std::memcpy(descriptors.data(), f.descriptors.data(), descriptors.size() * sizeof(float));
-  }
-
   std::vector<std::array<uint32_t, 2>> operator()(const frontend::ImageFeatures& a,
                                                   const frontend::ImageFeatures& b, int width, int height) {
-    std::vector<float> ka, da, kb, db;
-    inputs(a, width, height, ka, da);
-    inputs(b, width, height, kb, db);
+    const LighterGlueInputs ia = lighterglue_inputs(a, width, height, network->descriptor_width()),
+                            ib = lighterglue_inputs(b, width, height, network->descriptor_width());
     kernels::LighterGlueMatches m;
     {
       std::lock_guard<std::mutex> lock(device);
-      m = network->match(ka, da, kb, db);
+      m = network->match(ia.keypoints, ia.descriptors, ib.keypoints, ib.descriptors);
     }
     std::vector<std::array<uint32_t, 2>> out;
     for (size_t i = 0; i < m.matches.size(); ++i)
