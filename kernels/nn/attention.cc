@@ -18,7 +18,10 @@ AttentionKernels::AttentionKernels(engine::Context& context)
       linear_(make_kernel(context, "nn/nn_linear", NN_LINEAR_BINDING_COUNT, sizeof(NnLinearParams), {},
                           {{NN_LINEAR_BINDING_A, VK_FORMAT_R32_SFLOAT},
                            {NN_LINEAR_BINDING_B, VK_FORMAT_R32_SFLOAT},
-                           {NN_LINEAR_BINDING_W, VK_FORMAT_R32_SFLOAT}})),
+                           {NN_LINEAR_BINDING_W, VK_FORMAT_R32_SFLOAT},
+                           {NN_LINEAR_BINDING_A4, VK_FORMAT_R32G32B32A32_SFLOAT},
+                           {NN_LINEAR_BINDING_B4, VK_FORMAT_R32G32B32A32_SFLOAT},
+                           {NN_LINEAR_BINDING_W4, VK_FORMAT_R32G32B32A32_SFLOAT}})),
       matmul_(make_kernel(context, "nn/nn_matmul", NN_MATMUL_BINDING_COUNT, sizeof(NnMatmulParams), {},
                           {{NN_MATMUL_BINDING_A, VK_FORMAT_R32_SFLOAT},
                            {NN_MATMUL_BINDING_B, VK_FORMAT_R32_SFLOAT},
@@ -51,8 +54,10 @@ void AttentionKernels::linear(engine::Sequence& s, const engine::Buffer& a, uint
   p.outputs = out;
   p.has_bias = bias != nullptr;
   p.has_residual = residual != nullptr;
-  const uint64_t count = uint64_t{(rows + NN_LINEAR_ROWS - 1) / NN_LINEAR_ROWS} *
-                         ((out + NN_LINEAR_RUN - 1) / NN_LINEAR_RUN) * NN_LINEAR_LANES;
+  p.quads = linear_reads_quads(a_cols, b_cols, out);
+  const uint64_t row_tiles = (rows + NN_LINEAR_ROWS - 1) / NN_LINEAR_ROWS;
+  const uint64_t count = p.quads ? row_tiles * (out / 4)
+                                 : row_tiles * ((out + NN_LINEAR_RUN - 1) / NN_LINEAR_RUN) * NN_LINEAR_LANES;
   p.count = static_cast<uint32_t>(count);
   s.dispatch(*linear_, elementwise_groups(*context_, count, who),
              {{NN_LINEAR_BINDING_A, &a, engine::Access::kRead},
@@ -60,8 +65,15 @@ void AttentionKernels::linear(engine::Sequence& s, const engine::Buffer& a, uint
               {NN_LINEAR_BINDING_W, &w, engine::Access::kRead},
               {NN_LINEAR_BINDING_BIAS, bias ? bias : &w, engine::Access::kRead},
               {NN_LINEAR_BINDING_R, residual ? residual : &a, engine::Access::kRead},
+              {NN_LINEAR_BINDING_A4, &a, engine::Access::kRead},
+              {NN_LINEAR_BINDING_B4, b ? b : &a, engine::Access::kRead},
+              {NN_LINEAR_BINDING_W4, &w, engine::Access::kRead},
               {NN_LINEAR_BINDING_Y, &y, engine::Access::kWrite}},
              p);
+}
+
+bool linear_reads_quads(uint32_t a_cols, uint32_t b_cols, uint32_t out) {
+  return a_cols % 4 == 0 && b_cols % 4 == 0 && out % 4 == 0;
 }
 
 bool matmul_reads_quads(const RowBlock& a, const RowBlock& b) {

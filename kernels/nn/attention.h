@@ -28,6 +28,10 @@ inline uint32_t padded_row(uint32_t cols) {
   return (cols + 3u) / 4u * 4u;
 }
 
+// Whether the linear layers read their rows and weights as four-float texels (nn_linear.comp's quad path):
+// the widths of a and b (0 without b) and the outputs are multiples of four.
+bool linear_reads_quads(uint32_t a_cols, uint32_t b_cols, uint32_t out);
+
 // Whether the matrix products read a and b as four-float texels (nn_matmul.comp's quad path): every row of
 // a and of b starts on a four-float boundary, and b's rows (along k for a b^T, along the columns for a b)
 // are whole texels. a's rows need not be: their last floats past a whole texel are read one at a time.

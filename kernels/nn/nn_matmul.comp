@@ -11,6 +11,7 @@
 #include "limits.h"
 #include "nn/nn_shared.h"
 #include "elementwise.glsl"
+#include "nn/nn_tiles.glsl"
 
 #if NN_MATMUL_OUTPUTS != 4
 #error "the quad path's tile is one four-float texel of b wide"
@@ -45,8 +46,8 @@ void main() {
   [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i)
     [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) sum[i][j] = 0.0;
   if (p.quads != 0u) {
-    const uint column_quads = (p.m + 3u) / 4u;
-    const uint c0 = (e % column_quads) * 4u, r0 = (e / column_quads) * NN_MATMUL_ROWS;
+    uint r0, c0;
+    quad_tile(e, p.m, NN_MATMUL_ROWS, r0, c0);
     const uint quads = p.k / 4u;
     if (p.transposed != 0u) {
       // a b^T: rows of a and of b both run along k (k a multiple of four).
@@ -94,10 +95,8 @@ void main() {
     store(r0, c0, 1u, sum);
     return;
   }
-  const uint runs = (p.m + NN_MATMUL_RUN - 1u) / NN_MATMUL_RUN;
-  const uint run = e / NN_MATMUL_LANES;
-  const uint c0 = (run % runs) * NN_MATMUL_RUN + e % NN_MATMUL_LANES;
-  const uint r0 = (run / runs) * NN_MATMUL_ROWS;
+  uint r0, c0;
+  interleaved_tile(e, p.m, NN_MATMUL_ROWS, NN_MATMUL_LANES, NN_MATMUL_OUTPUTS, r0, c0);
   for (uint k = 0u; k < p.k; ++k) {
     float va[NN_MATMUL_ROWS], vb[NN_MATMUL_OUTPUTS];
     [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i) va[i] = texelFetch(a, int(a_row(r0, i) + k)).x;

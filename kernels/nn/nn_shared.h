@@ -83,8 +83,9 @@ struct NnKeypointsParams {
 // row per keypoint ----
 
 // nn_linear.comp: y = [a | b] w + bias (+ r): one invocation per tile of NN_LINEAR_ROWS rows x
-// NN_LINEAR_OUTPUTS outputs, the outputs interleaved over NN_LINEAR_LANES neighbouring invocations (as
-// nn_matmul.comp's tiles).
+// NN_LINEAR_OUTPUTS outputs. Quad path (p.quads, where a's, b's and the outputs' widths are multiples of
+// four: linear_reads_quads in attention.h): the tile's outputs neighbours, the rows and the weights read as
+// four-float texels. Generic path: the outputs interleaved over NN_LINEAR_LANES neighbouring invocations.
 #define NN_LINEAR_ROWS 8
 #define NN_LINEAR_OUTPUTS 4
 #define NN_LINEAR_LANES 8
@@ -95,12 +96,16 @@ struct NnKeypointsParams {
 #define NN_LINEAR_BINDING_BIAS 3  // [out] (bound to w without)
 #define NN_LINEAR_BINDING_R 4     // [rows][out], added (bound to a without)
 #define NN_LINEAR_BINDING_Y 5     // [rows][out] (out)
-#define NN_LINEAR_BINDING_COUNT 6
+#define NN_LINEAR_BINDING_A4 6    // A, B and W again, as R32G32B32A32_SFLOAT texels (the quad path)
+#define NN_LINEAR_BINDING_B4 7
+#define NN_LINEAR_BINDING_W4 8
+#define NN_LINEAR_BINDING_COUNT 9
 
 struct NnLinearParams {
   uint rows, a_cols, b_cols, outputs;
   uint has_bias, has_residual;
-  uint count;  // ceil(rows / ROWS) ceil(out / RUN) LANES
+  uint count;  // generic: ceil(rows / ROWS) ceil(out / RUN) LANES; quads: ceil(rows / ROWS) out / 4
+  uint quads;  // 1: the quad path
 };
 
 // nn_matmul.comp: y = scale a b^T (a [n][k], b [m][k]; transposed) or y = a b (a [n][k], b [k][m]).

@@ -88,6 +88,25 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
     s.submit_and_wait();
   }
   EXPECT_LT(relative_error(y.download(), expected.values), 1e-5);
+  EXPECT_FALSE(kernels::linear_reads_quads(5, 3, outputs));
+
+  // The same on the quad path (widths that are multiples of four): a 8 and b 4 columns wide, 12 outputs.
+  const Matrix a8 = random_matrix(n, 8, 22), b4 = random_matrix(n, 4, 23), r12 = random_matrix(n, 12, 24);
+  kernels::nn::LinearWeights w12{12, 12, floats(random_matrix(12, 12, 25).values),
+                                 floats(random_matrix(1, 12, 26).values)};
+  const Matrix expected12 =
+      kernels::nn::add(kernels::nn::linear(kernels::nn::concat_columns(a8, b4), w12), r12);
+  auto da8 = upload(floats(a8)), db4 = upload(floats(b4)), dr12 = upload(floats(r12)),
+       dw12 = upload(w12.weight), dbias12 = upload(w12.bias);
+  DeviceArray<float> y12(context(), "test: y", n * 12);
+  EXPECT_TRUE(kernels::linear_reads_quads(8, 4, 12));
+  {
+    engine::Sequence s(context());
+    ops.linear(s, da8->buffer(), 8, &db4->buffer(), 4, dw12->buffer(), &dbias12->buffer(), &dr12->buffer(),
+               y12.buffer(), n, 12);
+    s.submit_and_wait();
+  }
+  EXPECT_LT(relative_error(y12.download(), expected12.values), 1e-5);
 
   // Products at row offsets: rows 2..6 of p against rows 1..4 of q (transposed), then against q's rows as b.
   const Matrix p = random_matrix(9, 6, 6), q = random_matrix(8, 6, 7), v = random_matrix(8, 5, 8);
