@@ -29,7 +29,8 @@ AttentionKernels::AttentionKernels(engine::Context& context)
                            {NN_MATMUL_BINDING_B4, VK_FORMAT_R32G32B32A32_SFLOAT}})),
       rows_(make_kernel(context, "nn/nn_rows", NN_ROWS_BINDING_COUNT, sizeof(NnRowsParams))),
       softmax_(make_kernel(context, "nn/nn_softmax", NN_SOFTMAX_BINDING_COUNT, sizeof(NnSoftmaxParams), {},
-                           {{NN_SOFTMAX_BINDING_A, VK_FORMAT_R32_SFLOAT}})) {}
+                           {{NN_SOFTMAX_BINDING_A, VK_FORMAT_R32_SFLOAT},
+                            {NN_SOFTMAX_BINDING_A4, VK_FORMAT_R32G32B32A32_SFLOAT}})) {}
 
 AttentionKernels::~AttentionKernels() = default;
 
@@ -83,7 +84,8 @@ bool matmul_reads_quads(const RowBlock& a, const RowBlock& b) {
 }
 
 void AttentionKernels::matmul(engine::Sequence& s, const RowBlock& a, const RowBlock& b,
-                              const engine::Buffer& y, uint32_t y_first, bool transposed, float scale) const {
+                              const engine::Buffer& y, uint32_t y_first, uint32_t y_stride, bool transposed,
+                              float scale) const {
   static const char* who = "AttentionKernels: matrix product";
   if (!a.buffer || !b.buffer || !a.rows || !b.rows || !a.cols || !b.cols)
     throw std::invalid_argument(std::string(who) + ": an empty operand");
@@ -93,10 +95,12 @@ void AttentionKernels::matmul(engine::Sequence& s, const RowBlock& a, const RowB
   if (a.row_stride() < a.cols || (b.stride && b.stride != b.cols))
     throw std::invalid_argument(std::string(who) + ": a's rows narrower than its width, or b padded");
   const uint32_t m = transposed ? b.rows : b.cols;
+  if (!y_stride) y_stride = m;
+  if (y_stride < m) throw std::invalid_argument(std::string(who) + ": y's rows narrower than its width");
   check_binding(who, "a", *a.buffer,
                 ((uint64_t{a.first} + a.rows - 1) * a.row_stride() + a.cols) * sizeof(float));
   check_binding(who, "b", *b.buffer, (uint64_t{b.first} + b.rows) * b.cols * sizeof(float));
-  check_binding(who, "y", y, (uint64_t{y_first} + a.rows) * m * sizeof(float));
+  check_binding(who, "y", y, ((uint64_t{y_first} + a.rows - 1) * y_stride + m) * sizeof(float));
   NnMatmulParams p{};
   p.n = a.rows;
   p.m = m;
@@ -111,7 +115,8 @@ void AttentionKernels::matmul(engine::Sequence& s, const RowBlock& a, const RowB
   p.a_stride = a.row_stride();
   p.a_offset = a.first * a.row_stride();
   p.b_offset = b.first * b.cols;
-  p.y_offset = y_first * m;
+  p.y_offset = y_first * y_stride;
+  p.y_stride = y_stride;
   s.dispatch(*matmul_, elementwise_groups(*context_, count, who),
              {{NN_MATMUL_BINDING_A, a.buffer, engine::Access::kRead},
               {NN_MATMUL_BINDING_B, b.buffer, engine::Access::kRead},
@@ -122,13 +127,13 @@ void AttentionKernels::matmul(engine::Sequence& s, const RowBlock& a, const RowB
 }
 
 void AttentionKernels::multiply_transposed(engine::Sequence& s, const RowBlock& a, const RowBlock& b,
-                                           const engine::Buffer& y, float scale) const {
-  matmul(s, a, b, y, 0, true, scale);
+                                           const engine::Buffer& y, float scale, uint32_t y_stride) const {
+  matmul(s, a, b, y, 0, y_stride, true, scale);
 }
 
 void AttentionKernels::multiply(engine::Sequence& s, const RowBlock& a, const RowBlock& b,
                                 const engine::Buffer& y, uint32_t y_first) const {
-  matmul(s, a, b, y, y_first, false, 1.0f);
+  matmul(s, a, b, y, y_first, 0, false, 1.0f);
 }
 
 void AttentionKernels::rows_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a,
@@ -159,16 +164,25 @@ void AttentionKernels::layer_norm_gelu(engine::Sequence& s, const engine::Buffer
   rows_op(s, NN_ROWS_LAYER_NORM_GELU, a, scale, bias, a, rows, cols, rows, epsilon);
 }
 
-void AttentionKernels::lines_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a,
+bool softmax_reads_quads(uint32_t a_stride) {
+  return a_stride % 4 == 0;
+}
+
+void AttentionKernels::lines_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a, uint32_t a_stride,
                                 const engine::Buffer& out, uint32_t out_offset, uint32_t out_stride,
                                 uint32_t rows, uint32_t cols, bool columns) const {
   static const char* who = "AttentionKernels: softmax";
   if (!rows || !cols) throw std::invalid_argument(std::string(who) + ": an empty matrix");
   const uint32_t lines = columns ? cols : rows, length = columns ? rows : cols;
+  if (!a_stride) a_stride = cols;
   if (!out_stride) out_stride = length;
-  if (out_stride < length)
-    throw std::invalid_argument(std::string(who) + ": out's rows narrower than a line");
-  check_binding(who, "a", a, uint64_t{rows} * cols * sizeof(float));
+  if (a_stride < cols || out_stride < length)
+    throw std::invalid_argument(std::string(who) + ": a row narrower than the matrix, or out's than a line");
+  // Column quads read whole texels: the last quad's columns past `cols` lie inside a's row stride.
+  const bool quads = softmax_reads_quads(a_stride);
+  check_binding(
+      who, "a", a,
+      ((uint64_t{rows} - 1) * a_stride + (columns && quads ? padded_row(cols) : cols)) * sizeof(float));
   check_binding(who, "out", out,
                 (uint64_t{out_offset} +
                  (op == NN_SOFTMAX_SOFTMAX ? (uint64_t{lines} - 1) * out_stride + length : lines)) *
@@ -177,25 +191,29 @@ void AttentionKernels::lines_op(engine::Sequence& s, uint32_t op, const engine::
   p.op = op;
   p.lines = lines;
   p.line_length = length;
-  p.line_step = columns ? 1 : cols;
-  p.step = columns ? cols : 1;
+  p.line_step = columns ? 1 : a_stride;
+  p.step = columns ? a_stride : 1;
   p.out_offset = out_offset;
   p.out_stride = out_stride;
-  s.dispatch(*softmax_, elementwise_groups(*context_, lines, who),
+  p.path = !quads ? NN_SOFTMAX_FLOATS : columns ? NN_SOFTMAX_COLUMN_QUADS : NN_SOFTMAX_ROW_QUADS;
+  p.count = p.path == NN_SOFTMAX_COLUMN_QUADS ? (lines + 3) / 4 : lines;
+  s.dispatch(*softmax_, elementwise_groups(*context_, p.count, who),
              {{NN_SOFTMAX_BINDING_A, &a, engine::Access::kRead},
+              {NN_SOFTMAX_BINDING_A4, &a, engine::Access::kRead},
               {NN_SOFTMAX_BINDING_OUT, &out, engine::Access::kWrite}},
              p);
 }
 
 void AttentionKernels::softmax_rows(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out,
-                                    uint32_t rows, uint32_t cols, uint32_t out_stride) const {
-  lines_op(s, NN_SOFTMAX_SOFTMAX, a, out, 0, out_stride, rows, cols, false);
+                                    uint32_t rows, uint32_t cols, uint32_t out_stride,
+                                    uint32_t a_stride) const {
+  lines_op(s, NN_SOFTMAX_SOFTMAX, a, a_stride, out, 0, out_stride, rows, cols, false);
 }
 
 void AttentionKernels::softmax_columns(engine::Sequence& s, const engine::Buffer& a,
                                        const engine::Buffer& out, uint32_t rows, uint32_t cols,
-                                       uint32_t out_stride) const {
-  lines_op(s, NN_SOFTMAX_SOFTMAX, a, out, 0, out_stride, rows, cols, true);
+                                       uint32_t out_stride, uint32_t a_stride) const {
+  lines_op(s, NN_SOFTMAX_SOFTMAX, a, a_stride, out, 0, out_stride, rows, cols, true);
 }
 
 void AttentionKernels::assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
@@ -206,8 +224,8 @@ void AttentionKernels::assignment(engine::Sequence& s, const engine::Buffer& sim
   check_binding(who, "z", z, (uint64_t{rows} + cols) * sizeof(float));
   check_binding(who, "lse", lse, (uint64_t{rows} + cols) * sizeof(float));
   check_binding(who, "out", out, uint64_t{rows} * cols * sizeof(float));
-  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, lse, 0, 0, rows, cols, false);
-  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, lse, rows, 0, rows, cols, true);
+  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, 0, lse, 0, 0, rows, cols, false);
+  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, 0, lse, rows, 0, rows, cols, true);
   rows_op(s, NN_ROWS_ASSIGNMENT, sim, lse, z, out, rows, cols, uint64_t{rows} * cols, 0.0f);
 }
 

@@ -28,6 +28,10 @@ inline uint32_t padded_row(uint32_t cols) {
   return (cols + 3u) / 4u * 4u;
 }
 
+// Whether the softmax reads a's rows (columns: false) or four neighbouring columns (true) as four-float
+// texels (nn_softmax.comp's quad layouts): a's rows, a_stride floats apart, start on four-float boundaries.
+bool softmax_reads_quads(uint32_t a_stride);
+
 // Whether the linear layers read their rows and weights as four-float texels (nn_linear.comp's quad path):
 // the widths of a and b (0 without b) and the outputs are multiples of four.
 bool linear_reads_quads(uint32_t a_cols, uint32_t b_cols, uint32_t out);
@@ -45,22 +49,23 @@ class AttentionKernels {
   void linear(engine::Sequence& s, const engine::Buffer& a, uint32_t a_cols, const engine::Buffer* b,
               uint32_t b_cols, const engine::Buffer& w, const engine::Buffer* bias,
               const engine::Buffer* residual, const engine::Buffer& y, uint32_t rows, uint32_t out) const;
-  // y (its rows from y_first) = scale a b^T: [a.rows][b.rows], a and b of one width.
+  // y = scale a b^T: [a.rows][b.rows], a row every y_stride floats (0: b.rows), a and b of one width.
   void multiply_transposed(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
-                           float scale) const;
+                           float scale, uint32_t y_stride = 0) const;
   // y (its rows from y_first, b.cols wide) = a b: a [a.rows][b.rows] (a may be padded; b may not).
   void multiply(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
                 uint32_t y_first) const;
   // a [rows][cols] = gelu(layer_norm(a) * scale + bias), in place.
   void layer_norm_gelu(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& scale,
                        const engine::Buffer& bias, uint32_t rows, uint32_t cols, float epsilon) const;
-  // out [rows][cols] = the softmax of each row of a [rows][cols], a row of out every out_stride floats
-  // (0: cols).
+  // out [rows][cols] = the softmax of each row of a [rows][cols]; a row of a every a_stride floats, of out
+  // every out_stride (0: cols).
   void softmax_rows(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, uint32_t rows,
-                    uint32_t cols, uint32_t out_stride = 0) const;
-  // out [cols][rows] = the softmax of each column of a [rows][cols], as a row (every out_stride floats).
+                    uint32_t cols, uint32_t out_stride = 0, uint32_t a_stride = 0) const;
+  // out [cols][rows] = the softmax of each column of a [rows][cols], as a row (every out_stride floats, 0:
+  // rows); a row of a every a_stride floats (0: cols).
   void softmax_columns(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, uint32_t rows,
-                       uint32_t cols, uint32_t out_stride = 0) const;
+                       uint32_t cols, uint32_t out_stride = 0, uint32_t a_stride = 0) const;
   // out [rows][cols]: the log assignment of sim [rows][cols] (its rows' and columns' log-sum-exps go to
   // lse [rows + cols]) with the matchability logits z [rows + cols] (the first image's, then the second's).
   void assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
@@ -76,10 +81,11 @@ class AttentionKernels {
                const engine::Buffer& c, const engine::Buffer& out, uint32_t rows, uint32_t cols,
                uint64_t count, float epsilon) const;
   void matmul(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
-              uint32_t y_first, bool transposed, float scale) const;
+              uint32_t y_first, uint32_t y_stride, bool transposed, float scale) const;
   // Each row's (columns: false) or each column's softmax or log-sum-exp (nn_softmax.comp).
-  void lines_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a, const engine::Buffer& out,
-                uint32_t out_offset, uint32_t out_stride, uint32_t rows, uint32_t cols, bool columns) const;
+  void lines_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a, uint32_t a_stride,
+                const engine::Buffer& out, uint32_t out_offset, uint32_t out_stride, uint32_t rows,
+                uint32_t cols, bool columns) const;
   engine::Context* context_;
   std::unique_ptr<engine::Kernel> linear_, matmul_, rows_, softmax_;
 };

@@ -93,8 +93,9 @@ LighterGlueMatches LighterGlueNetwork::match(const std::vector<float>& kp0, cons
       projected(c, "lighterglue: message", size_t{n} * d);
   Array hidden(c, "lighterglue: feed-forward", size_t{n} * 2 * d);
   const uint32_t largest = std::max(n0, n1);
-  // The probabilities' rows padded to four floats, so that the products read them as four-float texels.
-  Array attention(c, "lighterglue: attention", size_t{largest} * largest),
+  // The similarities' and the probabilities' rows padded to four floats, so that the softmax and the
+  // products read them as four-float texels.
+  Array attention(c, "lighterglue: attention", size_t{largest} * padded_row(largest)),
       probabilities(c, "lighterglue: attention probabilities", size_t{largest} * padded_row(largest));
   Array z(c, "lighterglue: matchability", n), lse(c, "lighterglue: log-sum-exp", n);
   Array scores(c, "lighterglue: scores", size_t{n0} * n1);
@@ -123,9 +124,9 @@ LighterGlueMatches LighterGlueNetwork::match(const std::vector<float>& kp0, cons
     for (int i = 0; i < 2; ++i) {  // each image attends to itself
       const RowBlock q{&split.buffer(), first[i], count[i], d}, k{&split.buffer(), n + first[i], count[i], d},
           v{&split.buffer(), 2 * n + first[i], count[i], d};
-      ops_.multiply_transposed(s, q, k, attention.buffer(), scale);
-      ops_.softmax_rows(s, attention.buffer(), probabilities.buffer(), count[i], count[i],
-                        padded_row(count[i]));
+      const uint32_t stride = padded_row(count[i]);
+      ops_.multiply_transposed(s, q, k, attention.buffer(), scale, stride);
+      ops_.softmax_rows(s, attention.buffer(), probabilities.buffer(), count[i], count[i], stride, stride);
       ops_.multiply(s, RowBlock{&probabilities.buffer(), 0, count[i], count[i], padded_row(count[i])}, v,
                     message.buffer(), first[i]);
     }
@@ -136,11 +137,12 @@ LighterGlueMatches LighterGlueNetwork::match(const std::vector<float>& kp0, cons
     // Each image attends to the other through one similarity [n0][n1]: the second image's attention is the
     // softmax of its columns (the same floats as a product of its own, whose terms commute).
     ops_.multiply_transposed(s, RowBlock{&wide.buffer(), 0, n0, d}, RowBlock{&wide.buffer(), n0, n1, d},
-                             attention.buffer(), scale);
-    ops_.softmax_rows(s, attention.buffer(), probabilities.buffer(), n0, n1, padded_row(n1));
+                             attention.buffer(), scale, padded_row(n1));
+    ops_.softmax_rows(s, attention.buffer(), probabilities.buffer(), n0, n1, padded_row(n1), padded_row(n1));
     ops_.multiply(s, RowBlock{&probabilities.buffer(), 0, n0, n1, padded_row(n1)},
                   RowBlock{&split.buffer(), n0, n1, d}, message.buffer(), 0);
-    ops_.softmax_columns(s, attention.buffer(), probabilities.buffer(), n0, n1, padded_row(n0));
+    ops_.softmax_columns(s, attention.buffer(), probabilities.buffer(), n0, n1, padded_row(n0),
+                         padded_row(n1));
     ops_.multiply(s, RowBlock{&probabilities.buffer(), 0, n1, n0, padded_row(n0)},
                   RowBlock{&split.buffer(), 0, n0, d}, message.buffer(), n0);
     linear(message, d, nullptr, L.cross_out, nullptr, projected);

@@ -34,7 +34,7 @@ void store(uint r0, uint c0, uint column_step, const float sum[NN_MATMUL_ROWS][N
     for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) {
       const uint c = c0 + j * column_step;
       if (c >= p.m) break;
-      y[p.y_offset + row * p.m + c] = p.transposed != 0u ? p.scale * sum[i][j] : sum[i][j];
+      y[p.y_offset + row * p.y_stride + c] = p.transposed != 0u ? p.scale * sum[i][j] : sum[i][j];
     }
   }
 }

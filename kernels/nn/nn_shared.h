@@ -133,6 +133,7 @@ struct NnMatmulParams {
   uint quads;     // 1: the quad path
   uint a_stride;  // floats from one row of a to the next (>= k: a padded row)
   uint a_offset, b_offset, y_offset;  // in floats: both images' rows share one buffer
+  uint y_stride;                      // floats from one row of y to the next (>= m: a padded row)
 };
 
 // nn_rows.comp: one invocation per row (or element) of a; p.op chooses what it computes.
@@ -158,19 +159,27 @@ struct NnRowsParams {
 
 // nn_softmax.comp: for each line l < lines (a row or a column of a), its `line_length` values
 // a[l line_step + t step]: out[out_offset + l out_stride + t] = their softmax (NN_SOFTMAX_SOFTMAX), or
-// out[out_offset + l] = their log-sum-exp (NN_SOFTMAX_LOG_SUM_EXP). One invocation per line.
+// out[out_offset + l] = their log-sum-exp (NN_SOFTMAX_LOG_SUM_EXP). p.path: one invocation per line read
+// one float at a time (NN_SOFTMAX_FLOATS), per row read as four-float texels (NN_SOFTMAX_ROW_QUADS: line_step
+// a multiple of four), or per four neighbouring columns (NN_SOFTMAX_COLUMN_QUADS: step a multiple of four).
 #define NN_SOFTMAX_SOFTMAX 0
 #define NN_SOFTMAX_LOG_SUM_EXP 1
+#define NN_SOFTMAX_FLOATS 0
+#define NN_SOFTMAX_ROW_QUADS 1
+#define NN_SOFTMAX_COLUMN_QUADS 2
 #define NN_SOFTMAX_BINDING_A 0  // R32_SFLOAT texels
 #define NN_SOFTMAX_BINDING_OUT 1
-#define NN_SOFTMAX_BINDING_COUNT 2
+#define NN_SOFTMAX_BINDING_A4 2  // a again, as R32G32B32A32_SFLOAT texels (the quad layouts)
+#define NN_SOFTMAX_BINDING_COUNT 3
 
 struct NnSoftmaxParams {
   uint op;
   uint lines, line_length;
-  uint line_step, step;  // in floats: rows (cols, 1), columns (1, cols)
+  uint line_step, step;  // in floats: rows (a's row stride, 1), columns (1, a's row stride)
   uint out_offset;
   uint out_stride;  // floats from one line's softmax to the next (>= line_length)
+  uint path;        // NN_SOFTMAX_FLOATS, _ROW_QUADS or _COLUMN_QUADS
+  uint count;       // invocations: lines, or ceil(lines / 4) for column quads
 };
 
 #ifdef __cplusplus

@@ -160,14 +160,19 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
       a_block{&da13->buffer(), 0, 19, 13, 16}, w_block{&dw13->buffer(), 3, 13, 8};
   EXPECT_TRUE(kernels::matmul_reads_quads(p_block, q_block));
   EXPECT_TRUE(kernels::matmul_reads_quads(a_block, w_block));
-  DeviceArray<float> dsim19(context(), "test: sim", 19 * 7), dproduct19(context(), "test: product", 19 * 8);
+  DeviceArray<float> dsim19(context(), "test: sim", 19 * 7), dproduct19(context(), "test: product", 19 * 8),
+      dsim19_padded(context(), "test: sim", 19 * 8);
   {
     engine::Sequence s(context());
     ops.multiply_transposed(s, p_block, q_block, dsim19.buffer(), 0.3f);
+    ops.multiply_transposed(s, p_block, q_block, dsim19_padded.buffer(), 0.3f, 8);  // rows of 8 floats
     ops.multiply(s, a_block, w_block, dproduct19.buffer(), 0);
     s.submit_and_wait();
   }
   EXPECT_LT(relative_error(dsim19.download(), sim19.values), 1e-5);
+  const std::vector<float> sim19_padded = dsim19_padded.download();
+  for (size_t i = 0; i < 19; ++i)
+    for (size_t j = 0; j < 7; ++j) EXPECT_EQ(sim19_padded[i * 8 + j], dsim19.download()[i * 7 + j]);
   EXPECT_LT(relative_error(dproduct19.download(), product19.values), 1e-5);
 
   // Layer norm then GELU, and softmax, in place.
@@ -180,14 +185,26 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
   for (size_t i = 0; i < 5; ++i)
     for (size_t j = 0; j < 37; ++j) soft_columns.at(j, i) = soft.at(i, j);
   auto dsoft = upload(floats(soft));
+  // The same matrix with rows of 40 floats, the padding NaN: the quad layouts (rows read four floats at a
+  // time with a last float alone; four columns per invocation, the last four one column and three of
+  // padding).
+  std::vector<float> soft_padded(5 * 40, std::nanf(""));
+  for (size_t i = 0; i < 5; ++i)
+    for (size_t j = 0; j < 37; ++j) soft_padded[i * 40 + j] = static_cast<float>(soft.at(i, j));
+  auto dsoft_padded = upload(soft_padded);
+  EXPECT_FALSE(kernels::softmax_reads_quads(37));
+  EXPECT_TRUE(kernels::softmax_reads_quads(40));
   DeviceArray<float> rows_out(context(), "test: softmax", 5 * 37),
-      columns_out(context(), "test: softmax", 37 * 5), padded_out(context(), "test: softmax", 37 * 8);
+      columns_out(context(), "test: softmax", 37 * 5), padded_out(context(), "test: softmax", 37 * 8),
+      rows_quads(context(), "test: softmax", 5 * 37), columns_quads(context(), "test: softmax", 37 * 5);
   {
     engine::Sequence s(context());
     ops.layer_norm_gelu(s, dh->buffer(), dscale->buffer(), dshift->buffer(), 6, 192, 1e-5f);
     ops.softmax_rows(s, dsoft->buffer(), rows_out.buffer(), 5, 37);
     ops.softmax_columns(s, dsoft->buffer(), columns_out.buffer(), 5, 37);
     ops.softmax_columns(s, dsoft->buffer(), padded_out.buffer(), 5, 37, 8);  // rows padded to 8 floats
+    ops.softmax_rows(s, dsoft_padded->buffer(), rows_quads.buffer(), 5, 37, 0, 40);
+    ops.softmax_columns(s, dsoft_padded->buffer(), columns_quads.buffer(), 5, 37, 0, 40);
     s.submit_and_wait();
   }
   kernels::nn::layer_norm(h, norm);
@@ -197,6 +214,8 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
   EXPECT_LT(relative_error(dh->download(), h.values), 1e-5);
   EXPECT_LT(relative_error(rows_out.download(), soft.values), 1e-5);
   EXPECT_LT(relative_error(columns_out.download(), soft_columns.values), 1e-5);
+  EXPECT_EQ(rows_quads.download(), rows_out.download()) << "each line's values in the same order";
+  EXPECT_EQ(columns_quads.download(), columns_out.download());
   const std::vector<float> padded_rows = padded_out.download();
   std::vector<float> unpadded;
   for (size_t j = 0; j < 37; ++j)
