@@ -48,12 +48,8 @@ void weight_quad(uint t, uint o0, out vec4 vw[4]) {
 
 // The quad path: adds four inputs of the tile's row r (v) times their weights (vw).
 void accumulate_quad(uint r, vec4 v, const vec4 vw[4]) {
-  [[unroll]] for (uint j = 0u; j < NN_LINEAR_OUTPUTS; ++j) {
-    sum[r][j] += v.x * vw[0][j];
-    sum[r][j] += v.y * vw[1][j];
-    sum[r][j] += v.z * vw[2][j];
-    sum[r][j] += v.w * vw[3][j];
-  }
+  [[unroll]] for (uint j = 0u; j < NN_LINEAR_OUTPUTS; ++j)
+    sum[r][j] = add_in_order(sum[r][j], v, vec4(vw[0][j], vw[1][j], vw[2][j], vw[3][j]));
 }
 
 void main() {

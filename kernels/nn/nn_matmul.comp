@@ -59,12 +59,8 @@ void main() {
         [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) vb[j] = texelFetch(b4, int(b_rows[j] + t));
         [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i) {
           const vec4 va = texelFetch(a4, int(a_row(r0, i) / 4u + t));
-          [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) {
-            sum[i][j] += va.x * vb[j].x;
-            sum[i][j] += va.y * vb[j].y;
-            sum[i][j] += va.z * vb[j].z;
-            sum[i][j] += va.w * vb[j].w;
-          }
+          [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j)
+            sum[i][j] = add_in_order(sum[i][j], va, vb[j]);
         }
       }
     } else {
@@ -76,12 +72,8 @@ void main() {
           vb[q] = texelFetch(b4, int((p.b_offset + (4u * t + q) * p.m + c0) / 4u));
         [[unroll]] for (uint i = 0u; i < NN_MATMUL_ROWS; ++i) {
           const vec4 va = texelFetch(a4, int(a_row(r0, i) / 4u + t));
-          [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j) {
-            sum[i][j] += va.x * vb[0][j];
-            sum[i][j] += va.y * vb[1][j];
-            sum[i][j] += va.z * vb[2][j];
-            sum[i][j] += va.w * vb[3][j];
-          }
+          [[unroll]] for (uint j = 0u; j < NN_MATMUL_OUTPUTS; ++j)
+            sum[i][j] = add_in_order(sum[i][j], va, vec4(vb[0][j], vb[1][j], vb[2][j], vb[3][j]));
         }
       }
       for (uint k = quads * 4u; k < p.k; ++k) {
