@@ -27,7 +27,11 @@ AttentionKernels::AttentionKernels(engine::Context& context)
                            {NN_MATMUL_BINDING_B, VK_FORMAT_R32_SFLOAT},
                            {NN_MATMUL_BINDING_A4, VK_FORMAT_R32G32B32A32_SFLOAT},
                            {NN_MATMUL_BINDING_B4, VK_FORMAT_R32G32B32A32_SFLOAT}})),
-      rows_(make_kernel(context, "nn/nn_rows", NN_ROWS_BINDING_COUNT, sizeof(NnRowsParams))),
+      rows_(make_kernel(context, "nn/nn_rows", NN_ROWS_BINDING_COUNT, sizeof(NnRowsParams), {},
+                        {{NN_ROWS_BINDING_A, VK_FORMAT_R32_SFLOAT},
+                         {NN_ROWS_BINDING_B, VK_FORMAT_R32_SFLOAT},
+                         {NN_ROWS_BINDING_C, VK_FORMAT_R32_SFLOAT},
+                         {NN_ROWS_BINDING_A4, VK_FORMAT_R32G32B32A32_SFLOAT}})),
       softmax_(make_kernel(context, "nn/nn_softmax", NN_SOFTMAX_BINDING_COUNT, sizeof(NnSoftmaxParams), {},
                            {{NN_SOFTMAX_BINDING_A, VK_FORMAT_R32_SFLOAT},
                             {NN_SOFTMAX_BINDING_A4, VK_FORMAT_R32G32B32A32_SFLOAT}})) {}
@@ -138,7 +142,8 @@ void AttentionKernels::multiply(engine::Sequence& s, const RowBlock& a, const Ro
 
 void AttentionKernels::rows_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a,
                                const engine::Buffer& b, const engine::Buffer& c, const engine::Buffer& out,
-                               uint32_t rows, uint32_t cols, uint64_t count, float epsilon) const {
+                               uint32_t rows, uint32_t cols, uint64_t count, float epsilon, bool quads,
+                               uint32_t out_offset) const {
   if (!rows || !cols) throw std::invalid_argument("AttentionKernels: an empty matrix");
   NnRowsParams p{};
   p.op = op;
@@ -146,8 +151,20 @@ void AttentionKernels::rows_op(engine::Sequence& s, uint32_t op, const engine::B
   p.cols = cols;
   p.count = static_cast<uint32_t>(count);
   p.epsilon = epsilon;
+  p.quads = quads;
+  p.out_offset = out_offset;
+  // Only the quad path reads a's four-float view; otherwise it is bound to an operand that holds one whole
+  // texel (a pair's few matchability logits may not).
+  const engine::Buffer* a4 = &a;
+  if (!quads)
+    for (const engine::Buffer* x : {&a, &b, &c, &out})
+      if (x->size_bytes() >= 4 * sizeof(float)) {
+        a4 = x;
+        break;
+      }
   s.dispatch(*rows_, elementwise_groups(*context_, count, "AttentionKernels"),
-             {{NN_ROWS_BINDING_A, &a, engine::Access::kReadWrite},
+             {{NN_ROWS_BINDING_A, &a, engine::Access::kRead},
+              {NN_ROWS_BINDING_A4, a4, engine::Access::kRead},
               {NN_ROWS_BINDING_B, &b, engine::Access::kRead},
               {NN_ROWS_BINDING_C, &c, engine::Access::kRead},
               {NN_ROWS_BINDING_OUT, &out, engine::Access::kWrite}},
@@ -161,7 +178,7 @@ void AttentionKernels::layer_norm_gelu(engine::Sequence& s, const engine::Buffer
   check_binding(who, "a", a, uint64_t{rows} * cols * sizeof(float));
   check_binding(who, "scale", scale, uint64_t{cols} * sizeof(float));
   check_binding(who, "bias", bias, uint64_t{cols} * sizeof(float));
-  rows_op(s, NN_ROWS_LAYER_NORM_GELU, a, scale, bias, a, rows, cols, rows, epsilon);
+  rows_op(s, NN_ROWS_LAYER_NORM_GELU, a, scale, bias, a, rows, cols, rows, epsilon, cols % 4 == 0);
 }
 
 bool softmax_reads_quads(uint32_t a_stride) {
@@ -222,11 +239,12 @@ void AttentionKernels::assignment(engine::Sequence& s, const engine::Buffer& sim
   static const char* who = "AttentionKernels::assignment";
   check_binding(who, "sim", sim, uint64_t{rows} * cols * sizeof(float));
   check_binding(who, "z", z, (uint64_t{rows} + cols) * sizeof(float));
-  check_binding(who, "lse", lse, (uint64_t{rows} + cols) * sizeof(float));
+  check_binding(who, "lse", lse, 2 * (uint64_t{rows} + cols) * sizeof(float));
   check_binding(who, "out", out, uint64_t{rows} * cols * sizeof(float));
   lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, 0, lse, 0, 0, rows, cols, false);
   lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, 0, lse, rows, 0, rows, cols, true);
-  rows_op(s, NN_ROWS_ASSIGNMENT, sim, lse, z, out, rows, cols, uint64_t{rows} * cols, 0.0f);
+  rows_op(s, NN_ROWS_LOG_SIGMOID, z, z, z, lse, rows, cols, uint64_t{rows} + cols, 0.0f, false, rows + cols);
+  rows_op(s, NN_ROWS_ASSIGNMENT, sim, lse, lse, out, rows, cols, uint64_t{rows} * cols, 0.0f);
 }
 
 void AttentionKernels::split_rotary(engine::Sequence& s, const engine::Buffer& qkv,

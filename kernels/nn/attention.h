@@ -66,8 +66,9 @@ class AttentionKernels {
   // rows); a row of a every a_stride floats (0: cols).
   void softmax_columns(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, uint32_t rows,
                        uint32_t cols, uint32_t out_stride = 0, uint32_t a_stride = 0) const;
-  // out [rows][cols]: the log assignment of sim [rows][cols] (its rows' and columns' log-sum-exps go to
-  // lse [rows + cols]) with the matchability logits z [rows + cols] (the first image's, then the second's).
+  // out [rows][cols]: the log assignment of sim [rows][cols] with the matchability logits z [rows + cols]
+  // (the first image's, then the second's). On the way lse [2 (rows + cols)] gets the rows' and the columns'
+  // log-sum-exps, then the log-sigmoids of z.
   void assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
                   const engine::Buffer& lse, const engine::Buffer& out, uint32_t rows, uint32_t cols) const;
   // out [3][rows][dim]: q and k rotated by the keypoints' frequencies, and v, from qkv [rows][3 dim]
@@ -79,7 +80,7 @@ class AttentionKernels {
  private:
   void rows_op(engine::Sequence& s, uint32_t op, const engine::Buffer& a, const engine::Buffer& b,
                const engine::Buffer& c, const engine::Buffer& out, uint32_t rows, uint32_t cols,
-               uint64_t count, float epsilon) const;
+               uint64_t count, float epsilon, bool quads = false, uint32_t out_offset = 0) const;
   void matmul(engine::Sequence& s, const RowBlock& a, const RowBlock& b, const engine::Buffer& y,
               uint32_t y_first, uint32_t y_stride, bool transposed, float scale) const;
   // Each row's (columns: false) or each column's softmax or log-sum-exp (nn_softmax.comp).

@@ -97,7 +97,8 @@ LighterGlueMatches LighterGlueNetwork::match(const std::vector<float>& kp0, cons
   // products read them as four-float texels.
   Array attention(c, "lighterglue: attention", size_t{largest} * padded_row(largest)),
       probabilities(c, "lighterglue: attention probabilities", size_t{largest} * padded_row(largest));
-  Array z(c, "lighterglue: matchability", n), lse(c, "lighterglue: log-sum-exp", n);
+  Array z(c, "lighterglue: matchability", n),
+      lse(c, "lighterglue: log-sum-exps and log-sigmoids", 2 * size_t{n});
   Array scores(c, "lighterglue: scores", size_t{n0} * n1);
   engine::Sequence s(c);
   const auto linear = [&](const Array& a, uint32_t a_cols, const Array* b, const Linear& l,

@@ -137,24 +137,31 @@ struct NnMatmulParams {
 };
 
 // nn_rows.comp: one invocation per row (or element) of a; p.op chooses what it computes.
-#define NN_ROWS_LAYER_NORM_GELU 0  // a[r] = gelu(layer_norm(a[r]) * b + c) in place (b: scale, c: bias)
-// out[i][j] = (a[i][j] - b[i]) + (a[i][j] - b[rows + j]) + log sigmoid c[i] + log sigmoid c[rows + j] (b: the
-// row and column log-sum-exps, c: the two images' matchability logits)
+// a[r] = gelu(layer_norm(a[r]) * b + c) in place through out (b: scale, c: bias); p.quads: rows read four
+// floats at a time (cols a multiple of four)
+#define NN_ROWS_LAYER_NORM_GELU 0
+// out[i][j] = (a[i][j] - b[i]) + (a[i][j] - b[rows + j]) + c[rows + cols + i] + c[rows + cols + rows + j]
+// (b: the row and column log-sum-exps, c: the same buffer, its log-sigmoids after them)
 #define NN_ROWS_ASSIGNMENT 1
 // From a [rows][3 dim] (q, k, v interleaved per channel) and the keypoints b [rows][2] with the rotary
 // weights c [2][dim / 2]: out [3][rows][dim] = q and k rotated, v. One invocation per row and channel pair.
 #define NN_ROWS_SPLIT_ROTARY 2
-#define NN_ROWS_BINDING_A 0
+// out[out_offset + e] = log sigmoid a[e]: the matchability logits' once each, not once per pair.
+#define NN_ROWS_LOG_SIGMOID 3
+#define NN_ROWS_BINDING_A 0  // A, B and C: R32_SFLOAT texels
 #define NN_ROWS_BINDING_B 1
 #define NN_ROWS_BINDING_C 2
 #define NN_ROWS_BINDING_OUT 3
-#define NN_ROWS_BINDING_COUNT 4
+#define NN_ROWS_BINDING_A4 4  // a again, as R32G32B32A32_SFLOAT texels (the layer norm's quad path)
+#define NN_ROWS_BINDING_COUNT 5
 
 struct NnRowsParams {
   uint op;
   uint rows, cols;
   uint count;     // invocations
   float epsilon;  // the layer norm's
+  uint quads;     // the layer norm's rows read as four-float texels
+  uint out_offset;
 };
 
 // nn_softmax.comp: for each line l < lines (a row or a column of a), its `line_length` values

@@ -8,7 +8,9 @@
 // within 1e-5 of its largest output (GELU's erf approximation: 1.5e-7).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <random>
 #include <vector>
 
@@ -175,11 +177,15 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
     for (size_t j = 0; j < 7; ++j) EXPECT_EQ(sim19_padded[i * 8 + j], dsim19.download()[i * 7 + j]);
   EXPECT_LT(relative_error(dproduct19.download(), product19.values), 1e-5);
 
-  // Layer norm then GELU, and softmax, in place.
-  Matrix h = random_matrix(6, 192, 9, 3.0);
+  // Layer norm then GELU, in place: rows of 192 (LighterGlue's, read four floats at a time) and of 190 (one
+  // float at a time). And softmax.
+  Matrix h = random_matrix(6, 192, 9, 3.0), h190 = random_matrix(6, 190, 18, 3.0);
   const kernels::nn::LayerNormWeights norm{floats(random_matrix(1, 192, 10).values),
                                            floats(random_matrix(1, 192, 11).values), 1e-5};
+  const kernels::nn::LayerNormWeights norm190{floats(random_matrix(1, 190, 19).values),
+                                              floats(random_matrix(1, 190, 20).values), 1e-5};
   auto dh = upload(floats(h)), dscale = upload(norm.scale), dshift = upload(norm.bias);
+  auto dh190 = upload(floats(h190)), dscale190 = upload(norm190.scale), dshift190 = upload(norm190.bias);
   Matrix soft = random_matrix(5, 37, 12, 20.0);  // spread 20: the largest must be subtracted
   Matrix soft_columns(37, 5);                    // its columns as rows
   for (size_t i = 0; i < 5; ++i)
@@ -200,6 +206,7 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
   {
     engine::Sequence s(context());
     ops.layer_norm_gelu(s, dh->buffer(), dscale->buffer(), dshift->buffer(), 6, 192, 1e-5f);
+    ops.layer_norm_gelu(s, dh190->buffer(), dscale190->buffer(), dshift190->buffer(), 6, 190, 1e-5f);
     ops.softmax_rows(s, dsoft->buffer(), rows_out.buffer(), 5, 37);
     ops.softmax_columns(s, dsoft->buffer(), columns_out.buffer(), 5, 37);
     ops.softmax_columns(s, dsoft->buffer(), padded_out.buffer(), 5, 37, 8);  // rows padded to 8 floats
@@ -209,9 +216,12 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
   }
   kernels::nn::layer_norm(h, norm);
   kernels::nn::gelu(h);
+  kernels::nn::layer_norm(h190, norm190);
+  kernels::nn::gelu(h190);
   kernels::nn::softmax_rows(soft);
   kernels::nn::softmax_rows(soft_columns);
   EXPECT_LT(relative_error(dh->download(), h.values), 1e-5);
+  EXPECT_LT(relative_error(dh190->download(), h190.values), 1e-5);
   EXPECT_LT(relative_error(rows_out.download(), soft.values), 1e-5);
   EXPECT_LT(relative_error(columns_out.download(), soft_columns.values), 1e-5);
   EXPECT_EQ(rows_quads.download(), rows_out.download()) << "each line's values in the same order";
@@ -232,7 +242,7 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
       assignment.at(i, j) =
           rows.at(i, j) + cols.at(i, j) + log_sigmoid(z.values[i]) + log_sigmoid(z.values[6 + j]);
   auto dsim69 = upload(floats(s69)), dz = upload(floats(z));
-  DeviceArray<float> lse(context(), "test: lse", 15), dassign(context(), "test: assignment", 54);
+  DeviceArray<float> lse(context(), "test: lse", 30), dassign(context(), "test: assignment", 54);
   // Rotary: q, k, v interleaved per channel, 10 rows of width 8.
   const Matrix qkv = random_matrix(10, 24, 15), points = random_matrix(10, 2, 16, 0.5);
   const std::vector<float> rotary = floats(random_matrix(1, 8, 17, 3.0).values);
@@ -245,10 +255,11 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
     s.submit_and_wait();
   }
   EXPECT_LT(relative_error(dassign.download(), assignment.values), 1e-5);
-  // The rows' and the columns' log-sum-exps on their way.
+  // The rows' and the columns' log-sum-exps on their way, then the logits' log-sigmoids.
   std::vector<double> lse_expected;
   for (size_t i = 0; i < 6; ++i) lse_expected.push_back(s69.at(i, 0) - rows.at(i, 0));
   for (size_t j = 0; j < 9; ++j) lse_expected.push_back(s69.at(0, j) - cols.at(0, j));
+  for (size_t k = 0; k < 15; ++k) lse_expected.push_back(log_sigmoid(z.values[k]));
   EXPECT_LT(relative_error(lse.download(), lse_expected), 1e-5);
   Matrix qs(10, 8), ks(10, 8), vs(10, 8);
   for (size_t row = 0; row < 10; ++row)
@@ -286,6 +297,27 @@ TEST_F(NnAttentionTest, LighterGlueMatchesTheReferenceAndIsDeterministic) {
   EXPECT_EQ(out.matches, ref.matches);
   const kernels::LighterGlueMatches again = run();
   EXPECT_EQ(again.scores, out.scores) << "not bit-identical";
+}
+
+// A pair's matchability logits fill less than one four-float texel: the row operations still bind and the
+// scores match the reference.
+TEST_F(NnAttentionTest, OneKeypointPerImageMatchesTheReference) {
+  namespace in = testing::lighterglue_inputs;
+  const kernels::nn::LighterGlueWeights w = weights();
+  const auto first_row = [](const Matrix& m) {
+    Matrix row(1, m.cols);
+    row.values.assign(m.values.begin(), m.values.begin() + static_cast<std::ptrdiff_t>(m.cols));
+    return row;
+  };
+  const Matrix k0 = first_row(in::keypoints0()), d0 = first_row(in::descriptors0()),
+               k1 = first_row(in::keypoints1()), d1 = first_row(in::descriptors1());
+  const kernels::nn::LighterGlueOutputs ref = kernels::nn::lighterglue(w, k0, d0, k1, d1);
+  const kernels::LighterGlueNetwork network(context(), w);
+  const kernels::LighterGlueMatches out = network.match(floats(k0), floats(d0), floats(k1), floats(d1));
+  ASSERT_EQ(out.scores.size(), 1u);
+  ASSERT_TRUE(std::isfinite(out.scores[0]));
+  EXPECT_NEAR(out.scores[0], ref.scores.values[0], 3e-3 * std::max(1.0, std::abs(ref.scores.values[0])));
+  EXPECT_EQ(out.matches, ref.matches);
 }
 
 TEST_F(NnAttentionTest, NoKeypointsGiveNoMatchesAndWrongSizesAreRefused) {
