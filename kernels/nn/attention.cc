@@ -31,7 +31,8 @@ AttentionKernels::AttentionKernels(engine::Context& context)
                         {{NN_ROWS_BINDING_A, VK_FORMAT_R32_SFLOAT},
                          {NN_ROWS_BINDING_B, VK_FORMAT_R32_SFLOAT},
                          {NN_ROWS_BINDING_C, VK_FORMAT_R32_SFLOAT},
-                         {NN_ROWS_BINDING_A4, VK_FORMAT_R32G32B32A32_SFLOAT}})),
+                         {NN_ROWS_BINDING_A4, VK_FORMAT_R32G32B32A32_SFLOAT},
+                         {NN_ROWS_BINDING_B4, VK_FORMAT_R32G32B32A32_SFLOAT}})),
       softmax_(make_kernel(context, "nn/nn_softmax", NN_SOFTMAX_BINDING_COUNT, sizeof(NnSoftmaxParams), {},
                            {{NN_SOFTMAX_BINDING_A, VK_FORMAT_R32_SFLOAT},
                             {NN_SOFTMAX_BINDING_A4, VK_FORMAT_R32G32B32A32_SFLOAT}})) {}
@@ -153,18 +154,18 @@ void AttentionKernels::rows_op(engine::Sequence& s, uint32_t op, const engine::B
   p.epsilon = epsilon;
   p.quads = quads;
   p.out_offset = out_offset;
-  // Only the quad path reads a's four-float view; otherwise it is bound to an operand that holds one whole
-  // texel (a pair's few matchability logits may not).
-  const engine::Buffer* a4 = &a;
-  if (!quads)
-    for (const engine::Buffer* x : {&a, &b, &c, &out})
-      if (x->size_bytes() >= 4 * sizeof(float)) {
-        a4 = x;
-        break;
-      }
+  // Only the quad paths read the four-float views; otherwise they are bound to an operand that holds one
+  // whole texel (a pair's few matchability logits may not).
+  const auto four_floats = [&](const engine::Buffer& x) {
+    if (quads) return &x;
+    for (const engine::Buffer* y : {&x, &a, &b, &c, &out})
+      if (y->size_bytes() >= 4 * sizeof(float)) return y;
+    return &x;
+  };
   s.dispatch(*rows_, elementwise_groups(*context_, count, "AttentionKernels"),
              {{NN_ROWS_BINDING_A, &a, engine::Access::kRead},
-              {NN_ROWS_BINDING_A4, a4, engine::Access::kRead},
+              {NN_ROWS_BINDING_A4, four_floats(a), engine::Access::kRead},
+              {NN_ROWS_BINDING_B4, four_floats(b), engine::Access::kRead},
               {NN_ROWS_BINDING_B, &b, engine::Access::kRead},
               {NN_ROWS_BINDING_C, &c, engine::Access::kRead},
               {NN_ROWS_BINDING_OUT, &out, engine::Access::kWrite}},
@@ -239,12 +240,15 @@ void AttentionKernels::assignment(engine::Sequence& s, const engine::Buffer& sim
   static const char* who = "AttentionKernels::assignment";
   check_binding(who, "sim", sim, uint64_t{rows} * cols * sizeof(float));
   check_binding(who, "z", z, (uint64_t{rows} + cols) * sizeof(float));
-  check_binding(who, "lse", lse, 2 * (uint64_t{rows} + cols) * sizeof(float));
+  check_binding(who, "lse", lse, assignment_scratch_floats(rows, cols) * sizeof(float));
   check_binding(who, "out", out, uint64_t{rows} * cols * sizeof(float));
+  const uint32_t columns = padded_row(rows), sigmoids = columns + padded_row(cols);
   lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, 0, lse, 0, 0, rows, cols, false);
-  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, 0, lse, rows, 0, rows, cols, true);
-  rows_op(s, NN_ROWS_LOG_SIGMOID, z, z, z, lse, rows, cols, uint64_t{rows} + cols, 0.0f, false, rows + cols);
-  rows_op(s, NN_ROWS_ASSIGNMENT, sim, lse, lse, out, rows, cols, uint64_t{rows} * cols, 0.0f);
+  lines_op(s, NN_SOFTMAX_LOG_SUM_EXP, sim, 0, lse, columns, 0, rows, cols, true);
+  rows_op(s, NN_ROWS_LOG_SIGMOID, z, z, z, lse, rows, cols, uint64_t{rows} + cols, 0.0f, false, sigmoids);
+  const bool quads = cols % 4 == 0;
+  rows_op(s, NN_ROWS_ASSIGNMENT, sim, lse, lse, out, rows, cols, uint64_t{rows} * (quads ? cols / 4 : cols),
+          0.0f, quads);
 }
 
 void AttentionKernels::split_rotary(engine::Sequence& s, const engine::Buffer& qkv,

@@ -28,6 +28,11 @@ inline uint32_t padded_row(uint32_t cols) {
   return (cols + 3u) / 4u * 4u;
 }
 
+// The floats AttentionKernels::assignment's lse buffer holds for a [rows][cols] similarity.
+inline uint64_t assignment_scratch_floats(uint32_t rows, uint32_t cols) {
+  return 2 * (uint64_t{padded_row(rows)} + padded_row(cols));
+}
+
 // Whether the softmax reads a's rows (columns: false) or four neighbouring columns (true) as four-float
 // texels (nn_softmax.comp's quad layouts): a's rows, a_stride floats apart, start on four-float boundaries.
 bool softmax_reads_quads(uint32_t a_stride);
@@ -67,8 +72,8 @@ class AttentionKernels {
   void softmax_columns(engine::Sequence& s, const engine::Buffer& a, const engine::Buffer& out, uint32_t rows,
                        uint32_t cols, uint32_t out_stride = 0, uint32_t a_stride = 0) const;
   // out [rows][cols]: the log assignment of sim [rows][cols] with the matchability logits z [rows + cols]
-  // (the first image's, then the second's). On the way lse [2 (rows + cols)] gets the rows' and the columns'
-  // log-sum-exps, then the log-sigmoids of z.
+  // (the first image's, then the second's). On the way lse [assignment_scratch_floats] gets the rows' and the
+  // columns' log-sum-exps, then the log-sigmoids of z, each part from a four-float boundary (nn_shared.h).
   void assignment(engine::Sequence& s, const engine::Buffer& sim, const engine::Buffer& z,
                   const engine::Buffer& lse, const engine::Buffer& out, uint32_t rows, uint32_t cols) const;
   // out [3][rows][dim]: q and k rotated by the keypoints' frequencies, and v, from qkv [rows][3 dim]

@@ -98,7 +98,7 @@ LighterGlueMatches LighterGlueNetwork::match(const std::vector<float>& kp0, cons
   Array attention(c, "lighterglue: attention", size_t{largest} * padded_row(largest)),
       probabilities(c, "lighterglue: attention probabilities", size_t{largest} * padded_row(largest));
   Array z(c, "lighterglue: matchability", n),
-      lse(c, "lighterglue: log-sum-exps and log-sigmoids", 2 * size_t{n});
+      lse(c, "lighterglue: log-sum-exps and log-sigmoids", assignment_scratch_floats(n0, n1));
   Array scores(c, "lighterglue: scores", size_t{n0} * n1);
   engine::Sequence s(c);
   const auto linear = [&](const Array& a, uint32_t a_cols, const Array* b, const Linear& l,

@@ -8,11 +8,12 @@
 #include "nn/nn_shared.h"
 #include "elementwise.glsl"
 
-// a, b and c are uniform texel buffers (R32_SFLOAT, and a again as R32G32B32A32_SFLOAT): a vector gather, or
+// a, b and c are uniform texel buffers (R32_SFLOAT, a and b again as R32G32B32A32_SFLOAT): a vector gather, or
 // one load per lane, on CPU drivers, where a storage buffer read at a per-lane index is a loop over the
 // lanes. The layer norm writes its rows through `o`, bound to a's buffer.
 layout(binding = NN_ROWS_BINDING_A) uniform samplerBuffer a;
 layout(binding = NN_ROWS_BINDING_A4) uniform samplerBuffer a4;
+layout(binding = NN_ROWS_BINDING_B4) uniform samplerBuffer b4;
 layout(binding = NN_ROWS_BINDING_B) uniform samplerBuffer b;
 layout(binding = NN_ROWS_BINDING_C) uniform samplerBuffer c;
 layout(std430, binding = NN_ROWS_BINDING_OUT) writeonly buffer Out { float o[]; };
@@ -76,17 +77,39 @@ void layer_norm_gelu(uint r) {
     o[first + i] = gelu(vec4((at(a, first + i) - mean) * inv * at(b, i) + at(c, i))).x;
 }
 
+uint padded(uint n) { return (n + 3u) / 4u * 4u; }
+
+// b: the rows' log-sum-exps, then the columns' from padded(rows); their log-sigmoids after them, from
+// padded(rows) + padded(cols) (c, the same buffer). p.quads: four neighbouring entries of a row per
+// invocation, each computed as the one-entry path computes it.
+void assignment(uint e) {
+  const uint columns = padded(p.rows), sigmoids = columns + padded(p.cols);
+  if (p.quads != 0u) {
+    const uint quads = p.cols / 4u, i = e / quads, q = e % quads;
+    const vec4 s = texelFetch(a4, int(e));  // row i starts on a four-float boundary: e = i quads + q
+    const vec4 y = (s - at(b, i)) + (s - texelFetch(b4, int(columns / 4u + q))) + at(b, sigmoids + i) +
+                   texelFetch(b4, int((sigmoids + columns) / 4u + q));
+    const uint first = 4u * e;
+    o[first] = y.x;
+    o[first + 1u] = y.y;
+    o[first + 2u] = y.z;
+    o[first + 3u] = y.w;
+    return;
+  }
+  const uint i = e / p.cols, j = e % p.cols;
+  const float s = at(a, e);
+  o[e] = (s - at(b, i)) + (s - at(b, columns + j)) + at(c, sigmoids + i) + at(c, sigmoids + columns + j);
+}
+
 void main() {
   const uint e = elementwise_index();
   if (e >= p.count) return;
   if (p.op == NN_ROWS_LAYER_NORM_GELU) {
     layer_norm_gelu(e);
   } else if (p.op == NN_ROWS_LOG_SIGMOID) {
-    o[p.out_offset + e] = log_sigmoid(at(a, e));
+    o[p.out_offset + (e < p.rows ? e : e - p.rows + padded(p.rows))] = log_sigmoid(at(a, e));
   } else if (p.op == NN_ROWS_ASSIGNMENT) {
-    const uint i = e / p.cols, j = e % p.cols, sigmoids = p.rows + p.cols;
-    const float s = at(a, e);
-    o[e] = (s - at(b, i)) + (s - at(b, p.rows + j)) + at(c, sigmoids + i) + at(c, sigmoids + p.rows + j);
+    assignment(e);
   } else if (p.op == NN_ROWS_SPLIT_ROTARY) {
     const uint half_dim = p.cols / 2u;
     const uint row = e / half_dim, k = e % half_dim;

@@ -140,27 +140,30 @@ struct NnMatmulParams {
 // a[r] = gelu(layer_norm(a[r]) * b + c) in place through out (b: scale, c: bias); p.quads: rows read four
 // floats at a time (cols a multiple of four)
 #define NN_ROWS_LAYER_NORM_GELU 0
-// out[i][j] = (a[i][j] - b[i]) + (a[i][j] - b[rows + j]) + c[rows + cols + i] + c[rows + cols + rows + j]
-// (b: the row and column log-sum-exps, c: the same buffer, its log-sigmoids after them)
+// out[i][j] = (a[i][j] - b[i]) + (a[i][j] - b[R + j]) + c[S + i] + c[S + R + j], R = rows and S = rows + cols
+// each padded to four floats (b: the row and column log-sum-exps, c: the same buffer, the log-sigmoids from
+// S); p.quads: four entries per invocation (cols a multiple of four)
 #define NN_ROWS_ASSIGNMENT 1
 // From a [rows][3 dim] (q, k, v interleaved per channel) and the keypoints b [rows][2] with the rotary
 // weights c [2][dim / 2]: out [3][rows][dim] = q and k rotated, v. One invocation per row and channel pair.
 #define NN_ROWS_SPLIT_ROTARY 2
-// out[out_offset + e] = log sigmoid a[e]: the matchability logits' once each, not once per pair.
+// out[out_offset + e] = log sigmoid a[e], the entries from `rows` on shifted to rows padded to four floats:
+// the matchability logits' once each, not once per pair.
 #define NN_ROWS_LOG_SIGMOID 3
 #define NN_ROWS_BINDING_A 0  // A, B and C: R32_SFLOAT texels
 #define NN_ROWS_BINDING_B 1
 #define NN_ROWS_BINDING_C 2
 #define NN_ROWS_BINDING_OUT 3
-#define NN_ROWS_BINDING_A4 4  // a again, as R32G32B32A32_SFLOAT texels (the layer norm's quad path)
-#define NN_ROWS_BINDING_COUNT 5
+#define NN_ROWS_BINDING_A4 4  // a and b again, as R32G32B32A32_SFLOAT texels (the quad paths)
+#define NN_ROWS_BINDING_B4 5
+#define NN_ROWS_BINDING_COUNT 6
 
 struct NnRowsParams {
   uint op;
   uint rows, cols;
   uint count;     // invocations
   float epsilon;  // the layer norm's
-  uint quads;     // the layer norm's rows read as four-float texels
+  uint quads;     // the layer norm's and the assignment's four-float paths
   uint out_offset;
 };
 

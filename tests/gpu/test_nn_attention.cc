@@ -12,6 +12,8 @@
 #include <cmath>
 #include <cstddef>
 #include <random>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "engine/buffer.h"
@@ -232,17 +234,48 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
     unpadded.insert(unpadded.end(), &padded_rows[j * 8], &padded_rows[j * 8 + 5]);
   EXPECT_LT(relative_error(unpadded, soft_columns.values), 1e-5);
 
-  // The log assignment of a 6 x 9 similarity with matchability logits.
-  const Matrix s69 = random_matrix(6, 9, 13, 5.0), z = random_matrix(15, 1, 14, 2.0);
-  const Matrix rows = kernels::nn::log_softmax_rows(s69), cols = kernels::nn::log_softmax_columns(s69);
+  // The log assignment with matchability logits: 6 x 9 (an entry per invocation) and 5 x 8 (four per
+  // invocation); neither's row count is a multiple of four, so the columns' part of lse starts after padding.
   const auto log_sigmoid = [](double x) { return -std::log1p(std::exp(-x)); };
-  Matrix assignment(6, 9);
-  for (size_t i = 0; i < 6; ++i)
-    for (size_t j = 0; j < 9; ++j)
-      assignment.at(i, j) =
-          rows.at(i, j) + cols.at(i, j) + log_sigmoid(z.values[i]) + log_sigmoid(z.values[6 + j]);
-  auto dsim69 = upload(floats(s69)), dz = upload(floats(z));
-  DeviceArray<float> lse(context(), "test: lse", 30), dassign(context(), "test: assignment", 54);
+  for (const auto& [n0, n1] : {std::pair<uint32_t, uint32_t>{6, 9}, {5, 8}}) {
+    SCOPED_TRACE(std::to_string(n0) + " x " + std::to_string(n1));
+    const Matrix logits = random_matrix(n0, n1, 13 + n1, 5.0), z = random_matrix(n0 + n1, 1, 14, 2.0);
+    const Matrix rows = kernels::nn::log_softmax_rows(logits),
+                 cols = kernels::nn::log_softmax_columns(logits);
+    Matrix assignment(n0, n1);
+    for (size_t i = 0; i < n0; ++i)
+      for (size_t j = 0; j < n1; ++j)
+        assignment.at(i, j) =
+            rows.at(i, j) + cols.at(i, j) + log_sigmoid(z.values[i]) + log_sigmoid(z.values[n0 + j]);
+    auto dlogits = upload(floats(logits)), dz = upload(floats(z));
+    DeviceArray<float> lse(context(), "test: lse", kernels::assignment_scratch_floats(n0, n1)),
+        dassign(context(), "test: assignment", size_t{n0} * n1);
+    {
+      engine::Sequence s(context());
+      ops.assignment(s, dlogits->buffer(), dz->buffer(), lse.buffer(), dassign.buffer(), n0, n1);
+      s.submit_and_wait();
+    }
+    EXPECT_LT(relative_error(dassign.download(), assignment.values), 1e-5);
+    // The rows' and the columns' log-sum-exps on their way, then the logits' log-sigmoids, each part from a
+    // four-float boundary.
+    const std::vector<float> scratch = lse.download();
+    const size_t columns = kernels::padded_row(n0), sigmoids = columns + kernels::padded_row(n1);
+    std::vector<double> scratch_expected;
+    std::vector<float> got;
+    for (size_t i = 0; i < n0; ++i) {
+      scratch_expected.push_back(logits.at(i, 0) - rows.at(i, 0));
+      got.push_back(scratch[i]);
+      scratch_expected.push_back(log_sigmoid(z.values[i]));
+      got.push_back(scratch[sigmoids + i]);
+    }
+    for (size_t j = 0; j < n1; ++j) {
+      scratch_expected.push_back(logits.at(0, j) - cols.at(0, j));
+      got.push_back(scratch[columns + j]);
+      scratch_expected.push_back(log_sigmoid(z.values[n0 + j]));
+      got.push_back(scratch[sigmoids + columns + j]);
+    }
+    EXPECT_LT(relative_error(got, scratch_expected), 1e-5);
+  }
   // Rotary: q, k, v interleaved per channel, 10 rows of width 8.
   const Matrix qkv = random_matrix(10, 24, 15), points = random_matrix(10, 2, 16, 0.5);
   const std::vector<float> rotary = floats(random_matrix(1, 8, 17, 3.0).values);
@@ -250,17 +283,9 @@ TEST_F(NnAttentionTest, EachOperationMatchesItsReference) {
   DeviceArray<float> dsplit(context(), "test: split", 10 * 24);
   {
     engine::Sequence s(context());
-    ops.assignment(s, dsim69->buffer(), dz->buffer(), lse.buffer(), dassign.buffer(), 6, 9);
     ops.split_rotary(s, dqkv->buffer(), dpoints->buffer(), drotary->buffer(), dsplit.buffer(), 10, 8);
     s.submit_and_wait();
   }
-  EXPECT_LT(relative_error(dassign.download(), assignment.values), 1e-5);
-  // The rows' and the columns' log-sum-exps on their way, then the logits' log-sigmoids.
-  std::vector<double> lse_expected;
-  for (size_t i = 0; i < 6; ++i) lse_expected.push_back(s69.at(i, 0) - rows.at(i, 0));
-  for (size_t j = 0; j < 9; ++j) lse_expected.push_back(s69.at(0, j) - cols.at(0, j));
-  for (size_t k = 0; k < 15; ++k) lse_expected.push_back(log_sigmoid(z.values[k]));
-  EXPECT_LT(relative_error(lse.download(), lse_expected), 1e-5);
   Matrix qs(10, 8), ks(10, 8), vs(10, 8);
   for (size_t row = 0; row < 10; ++row)
     for (size_t d = 0; d < 8; ++d) {
