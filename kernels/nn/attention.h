@@ -11,6 +11,7 @@
 #include "engine/context.h"
 #include "engine/kernel.h"
 #include "engine/sequence.h"
+#include "kernels/nn/nn_shared.h"
 
 namespace litgs::kernels {
 
@@ -25,7 +26,7 @@ struct RowBlock {
 // The floats of a row of `cols` padded to a four-float boundary: the matrix products read such rows as
 // four-float texels.
 inline uint32_t padded_row(uint32_t cols) {
-  return (cols + 3u) / 4u * 4u;
+  return NN_PADDED_ROW(cols);
 }
 
 // The floats AttentionKernels::assignment's lse buffer holds for a [rows][cols] similarity.

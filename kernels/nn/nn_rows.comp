@@ -77,13 +77,11 @@ void layer_norm_gelu(uint r) {
     o[first + i] = gelu(vec4((at(a, first + i) - mean) * inv * at(b, i) + at(c, i))).x;
 }
 
-uint padded(uint n) { return (n + 3u) / 4u * 4u; }
-
-// b: the rows' log-sum-exps, then the columns' from padded(rows); their log-sigmoids after them, from
-// padded(rows) + padded(cols) (c, the same buffer). p.quads: four neighbouring entries of a row per
-// invocation, each computed as the one-entry path computes it.
+// b: the rows' log-sum-exps, then the columns' from NN_PADDED_ROW(rows); their log-sigmoids after them,
+// from NN_PADDED_ROW(rows) + NN_PADDED_ROW(cols) (c, the same buffer). p.quads: four neighbouring entries of a
+// row per invocation, each computed as the one-entry path computes it.
 void assignment(uint e) {
-  const uint columns = padded(p.rows), sigmoids = columns + padded(p.cols);
+  const uint columns = NN_PADDED_ROW(p.rows), sigmoids = columns + NN_PADDED_ROW(p.cols);
   if (p.quads != 0u) {
     const uint quads = p.cols / 4u, i = e / quads, q = e % quads;
     const vec4 s = texelFetch(a4, int(e));  // row i starts on a four-float boundary: e = i quads + q
@@ -107,7 +105,7 @@ void main() {
   if (p.op == NN_ROWS_LAYER_NORM_GELU) {
     layer_norm_gelu(e);
   } else if (p.op == NN_ROWS_LOG_SIGMOID) {
-    o[p.out_offset + (e < p.rows ? e : e - p.rows + padded(p.rows))] = log_sigmoid(at(a, e));
+    o[p.out_offset + (e < p.rows ? e : e - p.rows + NN_PADDED_ROW(p.rows))] = log_sigmoid(at(a, e));
   } else if (p.op == NN_ROWS_ASSIGNMENT) {
     assignment(e);
   } else if (p.op == NN_ROWS_SPLIT_ROTARY) {

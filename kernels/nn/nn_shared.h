@@ -136,6 +136,9 @@ struct NnMatmulParams {
   uint y_stride;                      // floats from one row of y to the next (>= m: a padded row)
 };
 
+// The floats of a row of n padded to a four-float boundary, where the kernels read rows as four-float texels.
+#define NN_PADDED_ROW(n) ((((n) + 3u) / 4u) * 4u)
+
 // nn_rows.comp: one invocation per row (or element) of a; p.op chooses what it computes.
 // a[r] = gelu(layer_norm(a[r]) * b + c) in place through out (b: scale, c: bias); p.quads: rows read four
 // floats at a time (cols a multiple of four)
